@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# dev.sh: the project's entry point. Usage: bash dev.sh {deps|run [args]|test|asan|bench}
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+cd "$ROOT"
+JOBS="${JOBS:-$(nproc 2>/dev/null || echo 2)}"
+
+# Debian packages the project needs. gnuplot-nox is listed so that apt satisfies gnuplot's
+# "gnuplot-qt | gnuplot-x11 | gnuplot-nox" without pulling in Qt.
+DEPS=(cmake g++ ninja-build libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev libgmp-dev
+      gnuplot gnuplot-nox clang libclang-rt-14-dev)
+
+deps() {
+  local missing=() p
+  for p in "${DEPS[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+  done
+  ((${#missing[@]} == 0)) && return 0
+  echo "dev.sh: installing missing packages: ${missing[*]}" >&2
+  local sudo=""
+  [[ $(id -u) -eq 0 ]] || sudo=sudo
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get update
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}" </dev/null
+}
+
+# build DIR [cmake args...]: configure with Ninja and build.
+build() {
+  local dir=$1; shift
+  cmake -S "$ROOT" -B "$dir" -G Ninja "$@"
+  cmake --build "$dir" -j "$JOBS"
+}
+
+build_release() { build build/release -DCMAKE_BUILD_TYPE=Release; }
+
+# has_opt NAME ARGS...: true if ARGS contain NAME or NAME=...
+has_opt() {
+  local name=$1 a; shift
+  for a in "$@"; do [[ $a == "$name" || $a == "$name="* ]] && return 0; done
+  return 1
+}
+
+# ==== MAIN JOB: what `bash dev.sh run` runs. =============================================
+# Switch this to the dynmesh demo once dynmesh lands. Arguments override the defaults.
+main_job() {
+  local args=("$@")
+  has_opt --n "$@" || args+=(--n 100000)
+  has_opt --updates "$@" || args+=(--updates 100)
+  build/release/bin/sac_suite "${args[@]}"
+}
+# ==========================================================================================
+
+# Benchmark figures at the README sizes (bench/RESULTS.md records them with this command).
+# Extra arguments (e.g. --csv, --apps map,filter) go to every run.
+BENCH_SIZES=(10000 100000 1000000)
+BENCH_UPDATES=100
+bench_job() {
+  local n
+  for n in "${BENCH_SIZES[@]}"; do
+    build/release/bin/sac_suite --n "$n" --updates "$BENCH_UPDATES" "$@"
+  done
+}
+
+cmd_run() { deps; build_release; main_job "$@"; }
+
+cmd_test() {
+  deps
+  # RelWithDebInfo without -DNDEBUG: optimised, with debug info and assertions on.
+  build build/debug -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g" \
+    -DSAC_WARNINGS_AS_ERRORS=ON
+  ctest --test-dir build/debug --output-on-failure --no-tests=error -j "$JOBS"
+}
+
+cmd_asan() {
+  deps
+  local cxx=g++
+  command -v clang++ >/dev/null && cxx=clang++
+  build build/asan -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug -DSAC_SANITIZE=ON
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir build/asan --output-on-failure --no-tests=error -j "$JOBS" -LE '^bench$'
+}
+
+cmd_bench() { deps; build_release; bench_job "$@"; }
+
+usage() {
+  cat >&2 <<'USAGE'
+usage: bash dev.sh COMMAND [args]
+  deps         install missing Debian packages (apt-get; sudo when not root)
+  run [args]   Release build into build/release, then the main job (sac_suite --n 100000 --updates 100)
+  test         RelWithDebInfo build (asserts on, -Werror) into build/debug, then every ctest test
+  asan         Debug build with ASan+UBSan (clang++ if present) into build/asan, then ctest
+  bench        Release build, then sac_suite at the README sizes
+USAGE
+}
+
+cmd=${1:-}
+(($#)) && shift
+case "$cmd" in
+  deps) deps ;;
+  run) cmd_run "$@" ;;
+  test) cmd_test ;;
+  asan) cmd_asan ;;
+  bench) cmd_bench "$@" ;;
+  -h|--help|help) usage ;;
+  *) usage; exit 2 ;;
+esac

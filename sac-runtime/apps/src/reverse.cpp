@@ -1,0 +1,6 @@
+// PLACEHOLDER until the app lands (replaced by its implementation).
+#include <stdexcept>
+#include "sacapps/app.hpp"
+namespace sacapps {
+std::unique_ptr<App> make_reverse() { throw std::logic_error("reverse: not implemented yet"); }
+}  // namespace sacapps

@@ -1,0 +1,90 @@
+// sac/detail/intrusive_hash.hpp — chained hash table over trace records (memo and allocation
+// tables).
+//
+// The records carry their own chain link (hnext) and know their hash through their ops, so
+// the table is one bucket array. Lookups return every record of a bucket; the engine filters
+// by ops, key and trace window.
+// Invariants: every record is in bucket hash(record) & mask; size() counts them;
+//             buckets.size() is a power of two >= size() / 1 (grows at load factor 1).
+// Complexity: insert O(1) amortized, erase O(chain), lookup O(chain).
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "sac/errors.hpp"
+
+namespace sac::detail {
+
+template <class N>
+class IntrusiveHash {
+ public:
+  template <class HashOf>
+  void insert(N* n, std::size_t h, HashOf&& hash_of) {
+    if (size_ + 1 > buckets_.size()) grow(hash_of);
+    N*& b = buckets_[h & (buckets_.size() - 1)];
+    n->hnext = b;
+    b = n;
+    ++size_;
+  }
+
+  void erase(N* n, std::size_t h) {
+    N** pp = &buckets_[h & (buckets_.size() - 1)];
+    while (*pp != n) pp = &(*pp)->hnext;
+    *pp = n->hnext;
+    n->hnext = nullptr;
+    --size_;
+  }
+
+  N* bucket(std::size_t h) const {
+    return buckets_.empty() ? nullptr : buckets_[h & (buckets_.size() - 1)];
+  }
+
+  std::size_t size() const { return size_; }
+  std::size_t memory_bytes() const { return buckets_.capacity() * sizeof(N*); }
+
+  template <class HashOf, class Visit>
+  void check_invariants(const char* name, HashOf&& hash_of, Visit&& visit) const {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < buckets_.size(); ++i)
+      for (N* x = buckets_[i]; x; x = x->hnext) {
+        if ((hash_of(x) & (buckets_.size() - 1)) != i)
+          throw InvariantError(std::string(name) + ": record in the wrong bucket");
+        visit(x);
+        ++n;
+      }
+    if (n != size_) throw InvariantError(std::string(name) + ": size mismatch");
+  }
+
+  template <class Visit>
+  void for_each(Visit&& visit) const {
+    for (N* b : buckets_)
+      for (N* x = b; x;) {
+        N* nx = x->hnext;
+        visit(x);
+        x = nx;
+      }
+  }
+
+ private:
+  template <class HashOf>
+  void grow(HashOf& hash_of) {
+    std::vector<N*> old;
+    old.swap(buckets_);
+    buckets_.assign(old.empty() ? 64 : old.size() * 2, nullptr);
+    for (N* b : old)
+      for (N* x = b; x;) {
+        N* nx = x->hnext;
+        N*& nb = buckets_[hash_of(x) & (buckets_.size() - 1)];
+        x->hnext = nb;
+        nb = x;
+        x = nx;
+      }
+  }
+
+  std::vector<N*> buckets_;
+  std::size_t size_ = 0;
+};
+
+}  // namespace sac::detail

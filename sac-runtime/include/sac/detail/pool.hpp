@@ -1,0 +1,85 @@
+// sac/detail/pool.hpp — size-class pool allocator for trace nodes, closures and versions.
+//
+// Purpose: the hot paths (reads, writes, allocations) must not call the general-purpose heap
+// once per event. Blocks are carved from 64 KiB chunks, one free list per 8-byte size class.
+// Invariants: live_bytes() == sum of sizes of blocks handed out and not yet returned;
+//             a block is returned with the same size it was requested with.
+// Complexity: allocate/deallocate O(1); chunks are released only when the pool dies.
+// Blocks larger than kMaxSmall bytes go to ::operator new.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <new>
+#include <vector>
+
+namespace sac::detail {
+
+class Pool {
+ public:
+  static constexpr std::size_t kGrain = 8;
+  static constexpr std::size_t kMaxSmall = 512;
+  static constexpr std::size_t kChunk = 64 * 1024;
+
+  Pool() = default;
+  Pool(const Pool&) = delete;
+  Pool& operator=(const Pool&) = delete;
+  ~Pool() {
+    for (void* c : chunks_) ::operator delete(c);
+  }
+
+  void* allocate(std::size_t n) {
+    n = round(n);
+    live_bytes_ += n;
+    if (n > kMaxSmall) return ::operator new(n);
+    Free*& head = free_[n / kGrain];
+    if (head) {
+      Free* b = head;
+      head = b->next;
+      return b;
+    }
+    return carve(n);
+  }
+
+  void deallocate(void* p, std::size_t n) noexcept {
+    n = round(n);
+    live_bytes_ -= n;
+    if (n > kMaxSmall) {
+      ::operator delete(p);
+      return;
+    }
+    Free* b = static_cast<Free*>(p);
+    b->next = free_[n / kGrain];
+    free_[n / kGrain] = b;
+  }
+
+  std::size_t live_bytes() const { return live_bytes_; }
+  std::size_t reserved_bytes() const { return chunks_.size() * kChunk; }
+
+ private:
+  struct Free {
+    Free* next;
+  };
+  static constexpr std::size_t round(std::size_t n) {
+    return n < kGrain ? kGrain : (n + kGrain - 1) & ~(kGrain - 1);
+  }
+  void* carve(std::size_t n) {
+    if (static_cast<std::size_t>(end_ - cur_) < n) {
+      // The chunk tail is abandoned (at most kMaxSmall bytes per 64 KiB).
+      cur_ = static_cast<char*>(::operator new(kChunk));
+      chunks_.push_back(cur_);
+      end_ = cur_ + kChunk;
+    }
+    void* p = cur_;
+    cur_ += n;
+    return p;
+  }
+
+  Free* free_[kMaxSmall / kGrain + 1] = {};
+  std::vector<void*> chunks_;
+  char* cur_ = nullptr;
+  char* end_ = nullptr;
+  std::size_t live_bytes_ = 0;
+};
+
+}  // namespace sac::detail

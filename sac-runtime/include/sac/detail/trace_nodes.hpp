@@ -1,0 +1,146 @@
+// sac/detail/trace_nodes.hpp — the records the trace is made of.
+//
+// Every record embeds its Stamp(s) at a fixed offset so that a stamp met while walking the
+// order list leads back to its record (container_of by kind). Records come from the engine's
+// Pool; their type-specific behaviour (destroy, compare, hash, invoke) sits in a static ops
+// table per instantiated type, so a record costs one pointer for it and no vtable.
+//
+// Layout (bytes, 64-bit): VersionBase 48 + value; ReadNode 72 + closure; AllocNode 32 +
+// key + object; MemoNode 56 + closure.
+// Invariants: see Engine::check_invariants().
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "sac/order_list.hpp"
+
+namespace sac {
+class Engine;
+class ModBase;
+}  // namespace sac
+
+namespace sac::detail {
+
+struct VersionBase;
+struct ReadNode;
+struct AllocNode;
+struct MemoNode;
+
+struct VersionOps {
+  void (*destroy)(VersionBase*) noexcept;
+  bool (*equal)(const VersionBase*, const VersionBase*);
+  std::uint32_t size;
+};
+
+/// One value of a modifiable, valid from its stamp until the next version's stamp.
+/// A base version (set by the mutator) has kind Sentinel, is never in the order list and
+/// precedes every computation time.
+struct VersionBase {
+  Stamp stamp;
+  const VersionOps* ops;
+  ModBase* mod;
+  VersionBase* older;    // next older version of the same modifiable
+  ReadNode* readers;     // the reads that see this version
+
+  bool is_base() const { return stamp.kind() == StampKind::Sentinel; }
+};
+
+template <class T>
+struct Version : VersionBase {
+  T value;
+  template <class... A>
+  explicit Version(A&&... a) : VersionBase{}, value(static_cast<A&&>(a)...) {}
+};
+
+struct ReadOps {
+  void (*invoke)(Engine&, ReadNode*, const VersionBase*);
+  void (*destroy)(ReadNode*) noexcept;
+  bool (*equal)(const ReadNode*, const void* closure);  // null: not memoizable
+  std::uint32_t size;
+};
+
+inline constexpr std::uint32_t kReadDead = 1;       // start stamp undone
+inline constexpr std::uint32_t kReadEndLinked = 2;  // end stamp in the order list
+
+struct ReadNode {
+  Stamp start;
+  Stamp end;
+  const ModBase* mod;
+  ReadNode* rnext;
+  ReadNode** rpprev;     // null when attached to no version
+  const ReadOps* ops;
+  std::uint32_t qpos;
+  std::uint32_t flags;
+};
+static_assert(sizeof(ReadNode) == 72);
+
+template <class F>
+struct ReadNodeT : ReadNode {
+  F fn;
+  template <class G>
+  explicit ReadNodeT(G&& g) : ReadNode{}, fn(static_cast<G&&>(g)) {}
+};
+
+struct AllocOps {
+  void (*destroy)(AllocNode*) noexcept;
+  bool (*key_equal)(const AllocNode*, const void* key);  // null: unkeyed
+  std::size_t (*hash)(const AllocNode*);
+  std::uint32_t size;
+};
+
+struct AllocNode {
+  Stamp stamp;
+  const AllocOps* ops;
+  AllocNode* hnext;
+};
+
+template <class T, class K>
+struct AllocNodeT : AllocNode {
+  K key;
+  T object;
+  template <class... A>
+  AllocNodeT(const K& k, A&&... a) : AllocNode{}, key(k), object(static_cast<A&&>(a)...) {}
+};
+
+template <class T>
+struct PlainAllocNodeT : AllocNode {
+  T object;
+  template <class... A>
+  explicit PlainAllocNodeT(A&&... a) : AllocNode{}, object(static_cast<A&&>(a)...) {}
+};
+
+struct MemoOps {
+  void (*destroy)(MemoNode*) noexcept;
+  bool (*equal)(const MemoNode*, const void* closure);
+  std::size_t (*hash)(const MemoNode*);
+  std::uint32_t size;
+};
+
+struct MemoNode {
+  Stamp start;
+  Stamp end;
+  MemoNode* hnext;
+  const MemoOps* ops;
+  std::uint64_t flags;   // kReadDead / kReadEndLinked, as for reads
+};
+
+template <class F>
+struct MemoNodeT : MemoNode {
+  F fn;
+  template <class G>
+  explicit MemoNodeT(G&& g) : MemoNode{}, fn(static_cast<G&&>(g)) {}
+};
+
+inline ReadNode* read_of_start(Stamp* s) { return reinterpret_cast<ReadNode*>(s); }
+inline ReadNode* read_of_end(Stamp* s) {
+  return reinterpret_cast<ReadNode*>(reinterpret_cast<char*>(s) - offsetof(ReadNode, end));
+}
+inline VersionBase* version_of(Stamp* s) { return reinterpret_cast<VersionBase*>(s); }
+inline AllocNode* alloc_of(Stamp* s) { return reinterpret_cast<AllocNode*>(s); }
+inline MemoNode* memo_of_start(Stamp* s) { return reinterpret_cast<MemoNode*>(s); }
+inline MemoNode* memo_of_end(Stamp* s) {
+  return reinterpret_cast<MemoNode*>(reinterpret_cast<char*>(s) - offsetof(MemoNode, end));
+}
+
+}  // namespace sac::detail

@@ -1,0 +1,445 @@
+// sac/engine.hpp — the self-adjusting computation engine.
+//
+// Purpose: run an ordinary-looking program once from scratch while recording its trace, then
+// after input changes bring every output to exactly what a from-scratch run would produce,
+// re-executing only the affected reads (change propagation). The model is Acar's imperative
+// self-adjusting computation (Acar, Ahmed, Blume POPL'08; Hammer, Acar, Chen "CEAL",
+// PLDI'09), as a C++ library without a compiler:
+//
+//   rt.read(m, body)        record a read of m over the interval of body(value); on change,
+//                           body is re-run in its own interval.
+//   rt.write(m, v)          add a version of m at the current time (cut off if equal).
+//   rt.alloc<T>(key, a...)  keyed allocation: re-executions that allocate under the same key
+//                           inside the re-execution window get the same object back.
+//   rt.make<T>(a...)        unkeyed allocation, freed when its allocation is undone.
+//   rt.memo(fn)             memoized call: an equal call of the old trace inside the window is
+//                           reused (trace between is undone, affected reads inside it are
+//                           propagated, execution jumps to its end).
+//   rt.memo_read(m, fn)     read(m, fn) memoized on (m, fn) with no extra record.
+//
+// Bodies are stored in the trace and re-run later: they capture by value (or pointers to
+// modifiables and keyed objects), never references to the stack. They may take
+// (Engine&, const T&) or (const T&); memoized closures must be equality comparable and
+// hashable (use sac::fn<f>(args...)).
+//
+// Invariants (check_invariants()): the order list, queue and tables are valid; the trace is
+// well nested (every read's interval contains exactly the events its body created); every
+// live read is attached to the version visible at its start time; versions of a modifiable
+// are ordered by time; every memo entry and keyed allocation is in its table; outside
+// propagate() the queue is empty.
+// Complexity: read/write/alloc O(1) amortized plus the version walk of the touched
+// modifiable; propagate() O(trace distance x log(queue size)) for monotone programs.
+#pragma once
+
+#include <concepts>
+#include <cstddef>
+#include <iosfwd>
+#include <new>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "sac/detail/intrusive_hash.hpp"
+#include "sac/detail/pool.hpp"
+#include "sac/detail/trace_nodes.hpp"
+#include "sac/errors.hpp"
+#include "sac/fn.hpp"
+#include "sac/hash.hpp"
+#include "sac/mod.hpp"
+#include "sac/order_list.hpp"
+#include "sac/stamp_queue.hpp"
+#include "sac/stats.hpp"
+
+namespace sac {
+
+namespace detail {
+
+struct ReadQueueTraits {
+  static const Stamp* stamp(const ReadNode* r) { return &r->start; }
+  static std::uint32_t& pos(ReadNode* r) { return r->qpos; }
+  static std::uint32_t pos(const ReadNode* r) { return r->qpos; }
+};
+
+template <class F, class T>
+void call_body(F& f, Engine& e, const T& v) {
+  if constexpr (std::is_invocable_v<F&, Engine&, const T&>) f(e, v);
+  else f(v);
+}
+
+template <class F>
+void call_thunk(F& f, Engine& e) {
+  if constexpr (std::is_invocable_v<F&, Engine&>) f(e);
+  else f();
+}
+
+template <class T>
+struct VersionOpsFor {
+  static void destroy(VersionBase* v) noexcept { static_cast<Version<T>*>(v)->~Version<T>(); }
+  static bool equal(const VersionBase* a, const VersionBase* b) {
+    if constexpr (std::equality_comparable<T>)
+      return static_cast<const Version<T>*>(a)->value == static_cast<const Version<T>*>(b)->value;
+    else
+      return false;  // no cut-off without operator==
+  }
+  static constexpr VersionOps ops{&destroy, &equal, sizeof(Version<T>)};
+};
+
+template <class T, class F>
+struct ReadOpsFor {
+  static void invoke(Engine& e, ReadNode* r, const VersionBase* v) {
+    call_body(static_cast<ReadNodeT<F>*>(r)->fn, e, static_cast<const Version<T>*>(v)->value);
+  }
+  static void destroy(ReadNode* r) noexcept { static_cast<ReadNodeT<F>*>(r)->~ReadNodeT<F>(); }
+  static bool equal(const ReadNode* r, const void* c) {
+    return static_cast<const ReadNodeT<F>*>(r)->fn == *static_cast<const F*>(c);
+  }
+  static constexpr ReadOps ops{&invoke, &destroy,
+                               std::equality_comparable<F> ? &equal : nullptr,
+                               sizeof(ReadNodeT<F>)};
+};
+
+template <class T, class K>
+struct AllocOpsFor {
+  using N = AllocNodeT<T, K>;
+  static void destroy(AllocNode* n) noexcept { static_cast<N*>(n)->~N(); }
+  static bool key_equal(const AllocNode* n, const void* k) {
+    return static_cast<const N*>(n)->key == *static_cast<const K*>(k);
+  }
+  static std::size_t hash(const AllocNode* n) { return Hash<K>{}(static_cast<const N*>(n)->key); }
+  static constexpr AllocOps ops{&destroy, &key_equal, &hash, sizeof(N)};
+};
+
+template <class T>
+struct PlainAllocOpsFor {
+  using N = PlainAllocNodeT<T>;
+  static void destroy(AllocNode* n) noexcept { static_cast<N*>(n)->~N(); }
+  static constexpr AllocOps ops{&destroy, nullptr, nullptr, sizeof(N)};
+};
+
+template <class F>
+struct MemoOpsFor {
+  using N = MemoNodeT<F>;
+  static void destroy(MemoNode* n) noexcept { static_cast<N*>(n)->~N(); }
+  static bool equal(const MemoNode* n, const void* c) {
+    return static_cast<const N*>(n)->fn == *static_cast<const F*>(c);
+  }
+  static std::size_t hash(const MemoNode* n) { return Hash<F>{}(static_cast<const N*>(n)->fn); }
+  static constexpr MemoOps ops{&destroy, &equal, &hash, sizeof(N)};
+};
+
+}  // namespace detail
+
+class Engine {
+ public:
+  Engine();
+  ~Engine();
+  Engine(const Engine&) = delete;
+  Engine& operator=(const Engine&) = delete;
+
+  // ---------------------------------------------------------------- mutator
+  /// Sets the base (input) value of m. Outside the computation only. Readers of the old
+  /// base value are affected unless the value is equal.
+  template <class T, class U>
+  void set(Mod<T>& m, U&& value);
+
+  /// Releases m's base version so that m's storage may be reused. m must have no readers
+  /// and no versions written by the computation.
+  void retire(ModBase& m);
+
+  /// Runs f(Engine&) (or f()) from scratch, appending its trace after earlier runs.
+  template <class F>
+  void run(F&& f);
+
+  /// Brings the trace and all outputs up to date with the changed inputs.
+  void propagate();
+
+  // ---------------------------------------------------------------- computation
+  template <class T, class F>
+  void read(const Mod<T>& m, F&& body);
+
+  template <class T, class F>
+  void memo_read(const Mod<T>& m, F&& body);
+
+  template <class T, class U>
+  void write(Mod<T>& m, U&& value);
+
+  template <class T, class K, class... A>
+  T* alloc(const K& key, A&&... args);
+
+  template <class T, class... A>
+  T* make(A&&... args);
+
+  template <class F>
+  void memo(F&& f);
+
+  // ---------------------------------------------------------------- introspection
+  const Stats& stats() const { return stats_; }
+  /// Bytes held by the trace: records, closures, versions, tables, order-list groups, queue.
+  std::size_t trace_bytes() const;
+  /// Bytes of live trace records only (exactly equal for equal traces; no table slack).
+  std::size_t record_bytes() const { return pool_.live_bytes(); }
+  std::uint64_t live_events() const { return stats_.live_events; }
+  bool in_computation() const { return in_computation_; }
+  bool poisoned() const { return poisoned_; }
+  const OrderList& order() const { return order_; }
+
+  /// Checks every structure (order list, queue, trace, memo and allocation tables); throws
+  /// InvariantError on the first violation. Outside the computation only. O(trace size).
+  void check_invariants() const;
+
+  /// Writes the trace as a Graphviz digraph (intended for small traces).
+  void dump_dot(std::ostream& os) const;
+
+ private:
+  using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits>;
+
+  void require_mutator(const char* what) const;
+  void require_computation(const char* what) const {
+    if (!in_computation_) [[unlikely]]
+      fail_not_in_computation(what);
+  }
+  [[noreturn]] void fail_not_in_computation(const char* what) const;
+  void poison() noexcept;
+
+  void* allocate(std::size_t n) { return pool_.allocate(n); }
+  void deallocate(void* p, std::size_t n) noexcept { pool_.deallocate(p, n); }
+
+  // Trace machinery (engine.cpp).
+  void run_read(detail::ReadNode* r);
+  void rerun(detail::ReadNode* r);
+  void link_write(detail::VersionBase* v);
+  void link_alloc(detail::AllocNode* n, std::size_t h);
+  void link_memo(detail::MemoNode* n, std::size_t h);
+  void set_base(ModBase& m, detail::VersionBase* fresh,
+                bool (*assign_if_changed)(detail::VersionBase*, detail::VersionBase*));
+  detail::ReadNode* find_read_match(const ModBase& m, const detail::ReadOps* ops,
+                                    const void* closure) const;
+  detail::AllocNode* find_alloc_match(const detail::AllocOps* ops, std::size_t h,
+                                      const void* key) const;
+  detail::MemoNode* find_memo_match(const detail::MemoOps* ops, std::size_t h,
+                                    const void* closure) const;
+  void reuse_alloc(detail::AllocNode* n);
+  void memo_hit(Stamp* start, Stamp* end);
+  void undo_between(Stamp* a, Stamp* b);
+  void undo(Stamp* s);
+  void enqueue(detail::ReadNode* r);
+  void free_deferred() noexcept;
+  void destroy_all() noexcept;
+
+  detail::VersionBase* visible(const ModBase& m, const Stamp* t) const;
+  bool in_window(const Stamp* start, const Stamp* end) const {
+    return order_.less(now_, start) && order_.less(end, window_end_);
+  }
+  static void attach(detail::ReadNode* r, detail::VersionBase* v) {
+    r->rnext = v->readers;
+    if (v->readers) v->readers->rpprev = &r->rnext;
+    v->readers = r;
+    r->rpprev = &v->readers;
+  }
+  static void detach(detail::ReadNode* r) {
+    if (!r->rpprev) return;
+    *r->rpprev = r->rnext;
+    if (r->rnext) r->rnext->rpprev = r->rpprev;
+    r->rpprev = nullptr;
+    r->rnext = nullptr;
+  }
+
+  detail::Pool pool_;
+  OrderList order_;
+  ReadQueue queue_{order_};
+  detail::IntrusiveHash<detail::AllocNode> allocs_;
+  detail::IntrusiveHash<detail::MemoNode> memos_;
+  std::vector<detail::AllocNode*> deferred_;   // undone allocations, freed by propagate()
+  std::vector<detail::VersionBase*> bases_;    // base versions; index kept in stamp.label
+
+  Stamp* now_ = nullptr;          // events are inserted after this stamp
+  Stamp* window_end_ = nullptr;   // end of the re-execution window; null when running fresh
+  Stamp* tail_ = nullptr;         // last stamp of the last run()
+  bool in_computation_ = false;
+  bool poisoned_ = false;
+  Stats stats_;
+};
+
+// ------------------------------------------------------------------ templates
+
+template <class T, class U>
+void Engine::set(Mod<T>& m, U&& value) {
+  require_mutator("set");
+  using V = detail::Version<T>;
+  void* mem = allocate(sizeof(V));
+  V* v;
+  try {
+    v = new (mem) V(std::forward<U>(value));
+  } catch (...) {
+    deallocate(mem, sizeof(V));
+    throw;
+  }
+  v->ops = &detail::VersionOpsFor<T>::ops;
+  v->mod = &m;
+  set_base(m, v, [](detail::VersionBase* old_base, detail::VersionBase* fresh) {
+    auto* o = static_cast<V*>(old_base);
+    auto* f = static_cast<V*>(fresh);
+    if constexpr (std::equality_comparable<T>)
+      if (o->value == f->value) return false;
+    if constexpr (std::is_move_assignable_v<T>) {
+      o->value = std::move(f->value);
+    } else {
+      o->value.~T();
+      new (&o->value) T(std::move(f->value));
+    }
+    return true;
+  });
+}
+
+template <class F>
+void Engine::run(F&& f) {
+  require_mutator("run");
+  in_computation_ = true;
+  now_ = tail_;
+  window_end_ = nullptr;
+  try {
+    detail::call_thunk(f, *this);
+  } catch (...) {
+    poison();
+    throw;
+  }
+  tail_ = now_;
+  now_ = nullptr;
+  in_computation_ = false;
+}
+
+template <class T, class F>
+void Engine::read(const Mod<T>& m, F&& body) {
+  using Fn = std::decay_t<F>;
+  using N = detail::ReadNodeT<Fn>;
+  static_assert(alignof(N) <= detail::Pool::kGrain, "closure over-aligned");
+  require_computation("read");
+  void* mem = allocate(sizeof(N));
+  N* r;
+  try {
+    r = new (mem) N(std::forward<F>(body));
+  } catch (...) {
+    deallocate(mem, sizeof(N));
+    throw;
+  }
+  r->mod = &m;
+  r->ops = &detail::ReadOpsFor<T, Fn>::ops;
+  r->qpos = kNotQueued;
+  run_read(r);
+}
+
+template <class T, class F>
+void Engine::memo_read(const Mod<T>& m, F&& body) {
+  using Fn = std::decay_t<F>;
+  static_assert(std::equality_comparable<Fn>,
+                "memo_read needs an equality-comparable closure: use sac::fn<f>(args...)");
+  require_computation("memo_read");
+  if (window_end_) {
+    const Fn& key = body;
+    if (detail::ReadNode* hit = find_read_match(m, &detail::ReadOpsFor<T, Fn>::ops, &key)) {
+      memo_hit(&hit->start, &hit->end);
+      return;
+    }
+    ++stats_.memo_misses;
+  }
+  read(m, std::forward<F>(body));
+}
+
+template <class T, class U>
+void Engine::write(Mod<T>& m, U&& value) {
+  using V = detail::Version<T>;
+  require_computation("write");
+  void* mem = allocate(sizeof(V));
+  V* v;
+  try {
+    v = new (mem) V(std::forward<U>(value));
+  } catch (...) {
+    deallocate(mem, sizeof(V));
+    throw;
+  }
+  v->ops = &detail::VersionOpsFor<T>::ops;
+  v->mod = &m;
+  link_write(v);
+}
+
+template <class T, class K, class... A>
+T* Engine::alloc(const K& key, A&&... args) {
+  static_assert(Hashable<K> && std::equality_comparable<K>,
+                "alloc keys must be hashable (sac::Hash) and equality comparable");
+  using N = detail::AllocNodeT<T, K>;
+  static_assert(alignof(N) <= detail::Pool::kGrain, "object over-aligned");
+  require_computation("alloc");
+  const detail::AllocOps* ops = &detail::AllocOpsFor<T, K>::ops;
+  const std::size_t h = Hash<K>{}(key);
+  if (window_end_) {
+    if (detail::AllocNode* hit = find_alloc_match(ops, h, &key)) {
+      reuse_alloc(hit);
+      return &static_cast<N*>(hit)->object;
+    }
+  }
+  void* mem = allocate(sizeof(N));
+  N* n;
+  try {
+    n = new (mem) N(key, std::forward<A>(args)...);
+  } catch (...) {
+    deallocate(mem, sizeof(N));
+    throw;
+  }
+  n->ops = ops;
+  link_alloc(n, h);
+  return &n->object;
+}
+
+template <class T, class... A>
+T* Engine::make(A&&... args) {
+  using N = detail::PlainAllocNodeT<T>;
+  static_assert(alignof(N) <= detail::Pool::kGrain, "object over-aligned");
+  require_computation("make");
+  void* mem = allocate(sizeof(N));
+  N* n;
+  try {
+    n = new (mem) N(std::forward<A>(args)...);
+  } catch (...) {
+    deallocate(mem, sizeof(N));
+    throw;
+  }
+  n->ops = &detail::PlainAllocOpsFor<T>::ops;
+  link_alloc(n, 0);
+  return &n->object;
+}
+
+template <class F>
+void Engine::memo(F&& f) {
+  using Fn = std::decay_t<F>;
+  using N = detail::MemoNodeT<Fn>;
+  static_assert(std::equality_comparable<Fn> && Hashable<Fn>,
+                "memo needs an equality-comparable, hashable closure: use sac::fn<f>(args...)");
+  static_assert(alignof(N) <= detail::Pool::kGrain, "closure over-aligned");
+  require_computation("memo");
+  const detail::MemoOps* ops = &detail::MemoOpsFor<Fn>::ops;
+  const std::size_t h = Hash<Fn>{}(f);
+  if (window_end_) {
+    const Fn& key = f;
+    if (detail::MemoNode* hit = find_memo_match(ops, h, &key)) {
+      memo_hit(&hit->start, &hit->end);
+      return;
+    }
+    ++stats_.memo_misses;
+  }
+  void* mem = allocate(sizeof(N));
+  N* n;
+  try {
+    n = new (mem) N(std::forward<F>(f));
+  } catch (...) {
+    deallocate(mem, sizeof(N));
+    throw;
+  }
+  n->ops = ops;
+  link_memo(n, h);
+  detail::call_thunk(n->fn, *this);
+  order_.insert_after(now_, &n->end, StampKind::MemoEnd);
+  now_ = &n->end;
+  n->flags |= detail::kReadEndLinked;
+}
+
+}  // namespace sac

@@ -1,0 +1,89 @@
+// sac/hash.hpp — hashing of memo keys and allocation keys.
+//
+// Purpose: keys of memo(), memo_read() and alloc() are hashed with sac::Hash<K>. Built in:
+// integers, enums, pointers, floating point (by bit pattern), std::pair, std::tuple, and any
+// type with a `std::size_t hash() const` member (sac::Fn closures have one).
+// Hash values only choose buckets; matches are decided by operator==, and among equal keys
+// by trace time, so results never depend on pointer values (see DESIGN.md, determinism).
+// Invariants: a == b implies Hash(a) == Hash(b). Complexity: O(size of the key).
+#pragma once
+
+#include <bit>
+#include <concepts>
+#include <cstddef>
+#include <cstdint>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+
+namespace sac {
+
+inline std::uint64_t mix64(std::uint64_t x) {
+  // splitmix64 finaliser
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebULL;
+  x ^= x >> 31;
+  return x;
+}
+
+inline std::uint64_t hash_combine(std::uint64_t seed, std::uint64_t h) {
+  return mix64(seed ^ (h + 0x9e3779b97f4a7c15ULL + (seed << 6) + (seed >> 2)));
+}
+
+template <class K, class = void>
+struct Hash;
+
+template <class K>
+  requires(std::is_integral_v<K> || std::is_enum_v<K> || std::is_pointer_v<K>)
+struct Hash<K> {
+  std::size_t operator()(const K& k) const {
+    if constexpr (std::is_pointer_v<K>)
+      return mix64(static_cast<std::uint64_t>(reinterpret_cast<std::uintptr_t>(k)));
+    else
+      return mix64(static_cast<std::uint64_t>(k));
+  }
+};
+
+template <class K>
+  requires std::is_floating_point_v<K>
+struct Hash<K> {
+  std::size_t operator()(const K& k) const {
+    K z = k == K(0) ? K(0) : k;  // +0 and -0 compare equal, so they must hash equal
+    if constexpr (sizeof(K) == 8) return mix64(std::bit_cast<std::uint64_t>(z));
+    else if constexpr (sizeof(K) == 4) return mix64(std::bit_cast<std::uint32_t>(z));
+    else return mix64(static_cast<std::uint64_t>(static_cast<double>(z)));
+  }
+};
+
+template <class K>
+  requires requires(const K& k) {
+    { k.hash() } -> std::convertible_to<std::size_t>;
+  }
+struct Hash<K> {
+  std::size_t operator()(const K& k) const { return k.hash(); }
+};
+
+template <class A, class B>
+struct Hash<std::pair<A, B>> {
+  std::size_t operator()(const std::pair<A, B>& p) const {
+    return hash_combine(Hash<A>{}(p.first), Hash<B>{}(p.second));
+  }
+};
+
+template <class... Ts>
+struct Hash<std::tuple<Ts...>> {
+  std::size_t operator()(const std::tuple<Ts...>& t) const {
+    std::uint64_t h = 0x51ed27a5ULL;
+    std::apply([&](const Ts&... x) { ((h = hash_combine(h, Hash<Ts>{}(x))), ...); }, t);
+    return h;
+  }
+};
+
+template <class K>
+concept Hashable = requires(const K& k) {
+  { Hash<K>{}(k) } -> std::convertible_to<std::size_t>;
+};
+
+}  // namespace sac

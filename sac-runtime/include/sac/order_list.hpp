@@ -1,0 +1,165 @@
+// sac/order_list.hpp — order-maintenance list of timestamps (two-level).
+//
+// Purpose: every trace event owns a Stamp; the list keeps them in execution order and answers
+// "does a come before b?" in O(1). Follows Dietz & Sleator (STOC'87) and Bender, Cole,
+// Demaine, Farach-Colton & Zito, "Two simplified algorithms for maintaining order in a list"
+// (ESA'02): the top level is a list of groups with 64-bit labels relabelled by the
+// density-threshold rule; the bottom level puts at most kGroupCap stamps in each group,
+// labelled with 32-bit labels.
+//
+// Stamps are intrusive (16 bytes) and owned by the caller; the list never allocates them.
+// The bottom level is singly linked: a stamp's predecessor is found by walking its group,
+// which holds at most kGroupCap stamps, so single erase is O(kGroupCap) = O(1); whole
+// intervals, which is how the trace is undone, are erased in O(length).
+//
+// Invariants (check_invariants()):
+//   - the stamps reachable from base() are exactly the linked ones, size() of them plus base;
+//   - the stamps of one group are contiguous; group.first is the first of them;
+//     group.count is their number, 1 <= count <= kGroupCap;
+//   - labels strictly increase within a group, and group labels strictly increase along the
+//     top-level list, so less() is the list order.
+// Complexity: less O(1); insert_after O(1) amortized (group relabel/split O(kGroupCap),
+//             top-level relabel O(log n) amortized, spread over Theta(kGroupCap) inserts);
+//             erase O(kGroupCap); erase_between O(number erased).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace sac {
+
+/// What a stamp marks in the trace; stored in the low bits of the stamp's link.
+enum class StampKind : std::uint8_t {
+  Sentinel = 0,
+  ReadStart = 1,
+  ReadEnd = 2,
+  Write = 3,
+  Alloc = 4,
+  MemoStart = 5,
+  MemoEnd = 6,
+  User = 7,  // free for tests and other clients of OrderList
+};
+
+/// A timestamp. 16 bytes; must be 8-byte aligned (the kind lives in the link's low bits).
+struct Stamp {
+  static constexpr std::uint32_t kUnlinked = 0xffffffffu;
+
+  std::uintptr_t link = 0;             // next stamp | kind
+  std::uint32_t group = kUnlinked;     // index of the group, kUnlinked when not in a list
+  std::uint32_t label = 0;             // label within the group
+
+  Stamp* next() const { return reinterpret_cast<Stamp*>(link & ~std::uintptr_t{7}); }
+  StampKind kind() const { return static_cast<StampKind>(link & 7); }
+  bool linked() const { return group != kUnlinked; }
+
+  void set_next(Stamp* n) { link = reinterpret_cast<std::uintptr_t>(n) | (link & 7); }
+  void set_kind(StampKind k) { link = (link & ~std::uintptr_t{7}) | static_cast<std::uintptr_t>(k); }
+};
+static_assert(sizeof(Stamp) == 16);
+
+class OrderList {
+ public:
+  static constexpr std::uint32_t kGroupCap = 64;
+
+  OrderList();
+  OrderList(const OrderList&) = delete;
+  OrderList& operator=(const OrderList&) = delete;
+
+  /// The sentinel that precedes every other stamp. Never erased.
+  Stamp* base() { return &base_; }
+  const Stamp* base() const { return &base_; }
+
+  /// True iff a comes strictly before b. Both must be linked.
+  bool less(const Stamp* a, const Stamp* b) const {
+    if (a->group == b->group) return a->label < b->label;
+    return groups_[a->group].label < groups_[b->group].label;
+  }
+
+  /// Links s (unlinked) right after pos (linked), with kind k.
+  void insert_after(Stamp* pos, Stamp* s, StampKind k) {
+    s->link = static_cast<std::uintptr_t>(k);
+    Group& g = groups_[pos->group];
+    Stamp* n = pos->next();
+    // Fast path: room in the group and between the labels (appends step by kAppendStep).
+    if (g.count < kGroupCap) {
+      std::uint64_t lo = pos->label;
+      std::uint64_t hi = (n && n->group == pos->group) ? n->label : kBottomRange;
+      if (hi - lo >= 2) {
+        std::uint64_t lab = (hi == kBottomRange && hi - lo > kAppendStep) ? lo + kAppendStep
+                                                                          : lo + (hi - lo) / 2;
+        s->label = static_cast<std::uint32_t>(lab);
+        s->group = pos->group;
+        s->set_next(n);
+        pos->set_next(s);
+        ++g.count;
+        ++size_;
+        return;
+      }
+    }
+    insert_slow(pos, s);
+  }
+
+  /// Unlinks a single stamp (not base()). O(kGroupCap).
+  void erase(Stamp* s);
+
+  /// Unlinks every stamp strictly between a and b (b == nullptr: to the end), in order,
+  /// calling on_erase(stamp) after each is unlinked. on_erase may free the stamp's memory but
+  /// must not insert into or erase from this list.
+  template <class F>
+  void erase_between(Stamp* a, Stamp* b, F&& on_erase) {
+    Stamp* x = a->next();
+    while (x != b) {
+      Stamp* nx = x->next();
+      unlink_from_group(x, nx);
+      on_erase(x);
+      x = nx;
+    }
+    a->set_next(b);
+  }
+
+  std::size_t size() const { return size_; }
+  std::size_t group_count() const { return group_count_; }
+  std::size_t memory_bytes() const { return groups_.capacity() * sizeof(Group); }
+  std::uint64_t top_relabels() const { return top_relabels_; }
+
+  /// Throws sac::InvariantError describing the first broken invariant.
+  void check_invariants() const;
+
+ private:
+  static constexpr std::uint64_t kBottomRange = std::uint64_t{1} << 32;
+  static constexpr std::uint64_t kAppendStep = kBottomRange / kGroupCap;
+  static constexpr std::uint64_t kTopAppendStep = std::uint64_t{1} << 24;
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+
+  struct Group {
+    std::uint64_t label = 0;
+    Stamp* first = nullptr;
+    std::uint32_t prev = kNone;
+    std::uint32_t next = kNone;  // also the free-list link
+    std::uint32_t count = 0;
+  };
+
+  void insert_slow(Stamp* pos, Stamp* s);
+  void unlink_from_group(Stamp* x, Stamp* nx) {
+    Group& g = groups_[x->group];
+    if (g.first == x) g.first = (nx && nx->group == x->group) ? nx : nullptr;
+    if (--g.count == 0) free_group(x->group);
+    x->group = Stamp::kUnlinked;
+    --size_;
+  }
+  std::uint32_t new_group_after(std::uint32_t g);
+  void free_group(std::uint32_t g);
+  void relabel_top(std::uint32_t g);
+  void relabel_group(std::uint32_t g);
+  void split_group(std::uint32_t g);
+
+  Stamp base_;
+  std::vector<Group> groups_;
+  std::uint32_t free_list_ = kNone;
+  std::size_t size_ = 0;
+  std::size_t group_count_ = 0;
+  std::uint64_t top_relabels_ = 0;
+};
+
+}  // namespace sac

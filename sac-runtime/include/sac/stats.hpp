@@ -1,0 +1,43 @@
+// sac/stats.hpp — counters kept by the engine.
+//
+// Purpose: what change propagation did, for tests ("a single insertion re-executes O(1)
+// reads") and for the stability experiments (trace distance per update).
+// Trace distance of a propagation = events created + events undone during it (DESIGN.md).
+// An event is one trace record: a read, a write, an allocation or a memo entry.
+// Invariants: live_events == events created - events undone (over the engine's life).
+// Complexity: all O(1) to read.
+#pragma once
+
+#include <cstdint>
+#include <ostream>
+
+namespace sac {
+
+struct Stats {
+  std::uint64_t events_created = 0;
+  std::uint64_t events_undone = 0;
+  std::uint64_t reads_reexecuted = 0;
+  std::uint64_t memo_hits = 0;
+  std::uint64_t memo_misses = 0;
+  std::uint64_t alloc_reuses = 0;
+  std::uint64_t queue_pushes = 0;
+  std::uint64_t queue_pops = 0;
+  std::uint64_t queue_removes = 0;
+  std::uint64_t propagations = 0;
+  std::uint64_t live_events = 0;
+  /// Trace distance (created + undone) of the last propagate().
+  std::uint64_t last_trace_distance = 0;
+  /// Reads re-executed by the last propagate().
+  std::uint64_t last_reexecuted = 0;
+
+  friend std::ostream& operator<<(std::ostream& os, const Stats& s) {
+    return os << "created=" << s.events_created << " undone=" << s.events_undone
+              << " reexecuted=" << s.reads_reexecuted << " memo_hits=" << s.memo_hits
+              << " memo_misses=" << s.memo_misses << " alloc_reuses=" << s.alloc_reuses
+              << " queue_pushes=" << s.queue_pushes << " queue_pops=" << s.queue_pops
+              << " queue_removes=" << s.queue_removes << " live_events=" << s.live_events
+              << " last_trace_distance=" << s.last_trace_distance;
+  }
+};
+
+}  // namespace sac

@@ -1,0 +1,578 @@
+// The engine's non-template machinery: change propagation, undo, memo matching, checks.
+#include "sac/engine.hpp"
+
+#include <cstdio>
+#include <ostream>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace sac {
+
+using detail::AllocNode;
+using detail::MemoNode;
+using detail::ReadNode;
+using detail::VersionBase;
+
+Engine::Engine() { tail_ = order_.base(); }
+
+Engine::~Engine() { destroy_all(); }
+
+void Engine::require_mutator(const char* what) const {
+  if (poisoned_)
+    throw PoisonedError(std::string("sac::Engine::") + what +
+                        ": the engine is poisoned (a body threw earlier)");
+  if (in_computation_)
+    throw UsageError(std::string("sac::Engine::") + what +
+                     ": called from inside the computation (mutator only)");
+}
+
+void Engine::fail_not_in_computation(const char* what) const {
+  if (poisoned_)
+    throw PoisonedError(std::string("sac::Engine::") + what + ": the engine is poisoned");
+  throw UsageError(std::string("sac::Engine::") + what +
+                   ": only allowed inside run() or propagate() (the computation)");
+}
+
+void Engine::poison() noexcept {
+  poisoned_ = true;
+  in_computation_ = false;
+  now_ = nullptr;
+  window_end_ = nullptr;
+}
+
+// ------------------------------------------------------------------ versions
+
+VersionBase* Engine::visible(const ModBase& m, const Stamp* t) const {
+  VersionBase* v = m.newest_;
+  while (v && !(v->is_base() || order_.less(&v->stamp, t))) v = v->older;
+  return v;
+}
+
+void Engine::link_write(VersionBase* v) {
+  order_.insert_after(now_, &v->stamp, StampKind::Write);
+  now_ = &v->stamp;
+  ++stats_.events_created;
+  ++stats_.live_events;
+  ModBase& m = *v->mod;
+  VersionBase** pp = &m.newest_;
+  while (*pp && !((*pp)->is_base() || order_.less(&(*pp)->stamp, &v->stamp))) pp = &(*pp)->older;
+  VersionBase* older = *pp;
+  v->older = older;
+  v->readers = nullptr;
+  *pp = v;
+  // Readers of the older version that come after v now see v. When v is the last stamp of
+  // the whole trace (every from-scratch write) none can.
+  if (older && older->readers && v->stamp.next() != nullptr) {
+    const bool same = v->ops->equal(v, older);
+    for (ReadNode* r = older->readers; r;) {
+      ReadNode* nx = r->rnext;
+      if (order_.less(&v->stamp, &r->start)) {
+        detach(r);
+        attach(r, v);
+        if (!same) enqueue(r);
+      }
+      r = nx;
+    }
+  }
+}
+
+void Engine::set_base(ModBase& m, VersionBase* fresh,
+                      bool (*assign_if_changed)(VersionBase*, VersionBase*)) {
+  VersionBase** pp = &m.newest_;
+  while (*pp && !(*pp)->is_base()) pp = &(*pp)->older;
+  if (VersionBase* base = *pp) {
+    const bool changed = assign_if_changed(base, fresh);
+    fresh->ops->destroy(fresh);
+    deallocate(fresh, fresh->ops->size);
+    if (changed)
+      for (ReadNode* r = base->readers; r; r = r->rnext) enqueue(r);
+    return;
+  }
+  // A new base version: it precedes every computation write, so nobody saw "nothing" here
+  // (such a read would have failed), and no reader is affected.
+  fresh->stamp.link = static_cast<std::uintptr_t>(StampKind::Sentinel);
+  fresh->stamp.label = static_cast<std::uint32_t>(bases_.size());
+  fresh->older = nullptr;
+  fresh->readers = nullptr;
+  bases_.push_back(fresh);
+  *pp = fresh;
+}
+
+void Engine::retire(ModBase& m) {
+  require_mutator("retire");
+  VersionBase* v = m.newest_;
+  if (!v) return;
+  if (!v->is_base() || v->older)
+    throw UsageError("sac::Engine::retire: the modifiable has versions written by the computation");
+  if (v->readers) throw UsageError("sac::Engine::retire: the modifiable is still read");
+  const std::uint32_t i = v->stamp.label;
+  bases_[i] = bases_.back();
+  bases_[i]->stamp.label = i;
+  bases_.pop_back();
+  m.newest_ = nullptr;
+  const detail::VersionOps* ops = v->ops;
+  ops->destroy(v);
+  deallocate(v, ops->size);
+}
+
+// ------------------------------------------------------------------ reads
+
+void Engine::run_read(ReadNode* r) {
+  order_.insert_after(now_, &r->start, StampKind::ReadStart);
+  now_ = &r->start;
+  ++stats_.events_created;
+  ++stats_.live_events;
+  VersionBase* v = visible(*r->mod, &r->start);
+  if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
+  attach(r, v);
+  r->ops->invoke(*this, r, v);
+  order_.insert_after(now_, &r->end, StampKind::ReadEnd);
+  now_ = &r->end;
+  r->flags |= detail::kReadEndLinked;
+}
+
+void Engine::rerun(ReadNode* r) {
+  Stamp* const saved_now = now_;
+  Stamp* const saved_end = window_end_;
+  now_ = &r->start;
+  window_end_ = &r->end;
+  ++stats_.reads_reexecuted;
+  ++stats_.last_reexecuted;
+  detach(r);
+  VersionBase* v = visible(*r->mod, &r->start);
+  if (!v) throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
+  attach(r, v);
+  r->ops->invoke(*this, r, v);
+  undo_between(now_, window_end_);
+  now_ = saved_now;
+  window_end_ = saved_end;
+}
+
+void Engine::enqueue(ReadNode* r) {
+  if (r->qpos != kNotQueued) return;
+  queue_.push(r);
+  ++stats_.queue_pushes;
+}
+
+void Engine::propagate() {
+  require_mutator("propagate");
+  in_computation_ = true;
+  window_end_ = nullptr;
+  const std::uint64_t created0 = stats_.events_created;
+  const std::uint64_t undone0 = stats_.events_undone;
+  stats_.last_reexecuted = 0;
+  try {
+    while (!queue_.empty()) {
+      ReadNode* r = queue_.pop();
+      ++stats_.queue_pops;
+      rerun(r);
+    }
+  } catch (...) {
+    poison();
+    throw;
+  }
+  free_deferred();
+  now_ = nullptr;
+  in_computation_ = false;
+  ++stats_.propagations;
+  stats_.last_trace_distance =
+      (stats_.events_created - created0) + (stats_.events_undone - undone0);
+}
+
+// ------------------------------------------------------------------ memoization
+
+ReadNode* Engine::find_read_match(const ModBase& m, const detail::ReadOps* ops,
+                                  const void* closure) const {
+  ReadNode* best = nullptr;
+  for (VersionBase* v = m.newest_; v; v = v->older)
+    for (ReadNode* r = v->readers; r; r = r->rnext)
+      if (r->ops == ops && in_window(&r->start, &r->end) &&
+          ops->equal(r, closure) && (!best || order_.less(&r->start, &best->start)))
+        best = r;
+  return best;
+}
+
+AllocNode* Engine::find_alloc_match(const detail::AllocOps* ops, std::size_t h,
+                                    const void* key) const {
+  AllocNode* best = nullptr;
+  for (AllocNode* n = allocs_.bucket(h); n; n = n->hnext)
+    if (n->ops == ops && in_window(&n->stamp, &n->stamp) && ops->key_equal(n, key) &&
+        (!best || order_.less(&n->stamp, &best->stamp)))
+      best = n;
+  return best;
+}
+
+MemoNode* Engine::find_memo_match(const detail::MemoOps* ops, std::size_t h,
+                                  const void* closure) const {
+  MemoNode* best = nullptr;
+  for (MemoNode* n = memos_.bucket(h); n; n = n->hnext)
+    if (n->ops == ops && in_window(&n->start, &n->end) && ops->equal(n, closure) &&
+        (!best || order_.less(&n->start, &best->start)))
+      best = n;
+  return best;
+}
+
+void Engine::memo_hit(Stamp* start, Stamp* end) {
+  ++stats_.memo_hits;
+  undo_between(now_, start);
+  // Affected reads inside the reused stretch are brought up to date before execution
+  // continues after it.
+  while (!queue_.empty() && order_.less(&queue_.top()->start, end)) {
+    ReadNode* r = queue_.pop();
+    ++stats_.queue_pops;
+    rerun(r);
+  }
+  now_ = end;
+}
+
+void Engine::reuse_alloc(AllocNode* n) {
+  order_.erase(&n->stamp);
+  order_.insert_after(now_, &n->stamp, StampKind::Alloc);
+  now_ = &n->stamp;
+  ++stats_.alloc_reuses;
+}
+
+void Engine::link_alloc(AllocNode* n, std::size_t h) {
+  order_.insert_after(now_, &n->stamp, StampKind::Alloc);
+  now_ = &n->stamp;
+  ++stats_.events_created;
+  ++stats_.live_events;
+  if (n->ops->key_equal) allocs_.insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
+}
+
+void Engine::link_memo(MemoNode* n, std::size_t h) {
+  order_.insert_after(now_, &n->start, StampKind::MemoStart);
+  now_ = &n->start;
+  ++stats_.events_created;
+  ++stats_.live_events;
+  memos_.insert(n, h, [](const MemoNode* x) { return x->ops->hash(x); });
+}
+
+// ------------------------------------------------------------------ undo
+
+void Engine::undo_between(Stamp* a, Stamp* b) {
+  if (a->next() == b) return;
+  order_.erase_between(a, b, [this](Stamp* s) { undo(s); });
+}
+
+void Engine::undo(Stamp* s) {
+  switch (s->kind()) {
+    case StampKind::ReadStart: {
+      ReadNode* r = detail::read_of_start(s);
+      ++stats_.events_undone;
+      --stats_.live_events;
+      detach(r);
+      if (r->qpos != kNotQueued) {
+        queue_.remove(r);
+        ++stats_.queue_removes;
+      }
+      r->flags |= detail::kReadDead;
+      break;
+    }
+    case StampKind::ReadEnd: {
+      ReadNode* r = detail::read_of_end(s);
+      const detail::ReadOps* ops = r->ops;
+      ops->destroy(r);
+      deallocate(r, ops->size);
+      break;
+    }
+    case StampKind::Write: {
+      VersionBase* v = detail::version_of(s);
+      ++stats_.events_undone;
+      --stats_.live_events;
+      VersionBase** pp = &v->mod->newest_;
+      while (*pp != v) pp = &(*pp)->older;
+      *pp = v->older;
+      VersionBase* older = v->older;
+      if (v->readers) {
+        const bool same = older && v->ops->equal(v, older);
+        for (ReadNode* r = v->readers; r;) {
+          ReadNode* nx = r->rnext;
+          r->rpprev = nullptr;
+          r->rnext = nullptr;
+          if (older) attach(r, older);
+          if (!same) enqueue(r);
+          r = nx;
+        }
+      }
+      const detail::VersionOps* ops = v->ops;
+      ops->destroy(v);
+      deallocate(v, ops->size);
+      break;
+    }
+    case StampKind::Alloc: {
+      AllocNode* n = detail::alloc_of(s);
+      ++stats_.events_undone;
+      --stats_.live_events;
+      if (n->ops->key_equal) allocs_.erase(n, n->ops->hash(n));
+      deferred_.push_back(n);  // objects may still be referenced until propagate() ends
+      break;
+    }
+    case StampKind::MemoStart: {
+      MemoNode* n = detail::memo_of_start(s);
+      ++stats_.events_undone;
+      --stats_.live_events;
+      memos_.erase(n, n->ops->hash(n));
+      n->flags |= detail::kReadDead;
+      break;
+    }
+    case StampKind::MemoEnd: {
+      MemoNode* n = detail::memo_of_end(s);
+      const detail::MemoOps* ops = n->ops;
+      ops->destroy(n);
+      deallocate(n, ops->size);
+      break;
+    }
+    case StampKind::Sentinel:
+    case StampKind::User:
+      break;
+  }
+}
+
+void Engine::free_deferred() noexcept {
+  for (AllocNode* n : deferred_) {
+    const detail::AllocOps* ops = n->ops;
+    ops->destroy(n);
+    deallocate(n, ops->size);
+  }
+  deferred_.clear();
+}
+
+void Engine::destroy_all() noexcept {
+  // Tear-down without undo semantics: destroy every record once. Valid even when poisoned.
+  for (Stamp* s = order_.base()->next(); s;) {
+    Stamp* nx = s->next();
+    switch (s->kind()) {
+      case StampKind::ReadStart: {
+        ReadNode* r = detail::read_of_start(s);
+        if (!(r->flags & detail::kReadEndLinked)) {  // its body threw: no end stamp
+          const detail::ReadOps* ops = r->ops;
+          ops->destroy(r);
+          deallocate(r, ops->size);
+        }
+        break;
+      }
+      case StampKind::ReadEnd: {
+        ReadNode* r = detail::read_of_end(s);
+        const detail::ReadOps* ops = r->ops;
+        ops->destroy(r);
+        deallocate(r, ops->size);
+        break;
+      }
+      case StampKind::Write: {
+        VersionBase* v = detail::version_of(s);
+        const detail::VersionOps* ops = v->ops;
+        ops->destroy(v);
+        deallocate(v, ops->size);
+        break;
+      }
+      case StampKind::Alloc: {
+        AllocNode* n = detail::alloc_of(s);
+        const detail::AllocOps* ops = n->ops;
+        ops->destroy(n);
+        deallocate(n, ops->size);
+        break;
+      }
+      case StampKind::MemoStart: {
+        MemoNode* n = detail::memo_of_start(s);
+        if (!(n->flags & detail::kReadEndLinked)) {
+          const detail::MemoOps* ops = n->ops;
+          ops->destroy(n);
+          deallocate(n, ops->size);
+        }
+        break;
+      }
+      case StampKind::MemoEnd: {
+        MemoNode* n = detail::memo_of_end(s);
+        const detail::MemoOps* ops = n->ops;
+        ops->destroy(n);
+        deallocate(n, ops->size);
+        break;
+      }
+      default:
+        break;
+    }
+    s = nx;
+  }
+  free_deferred();
+  for (VersionBase* v : bases_) {
+    const detail::VersionOps* ops = v->ops;
+    ops->destroy(v);
+    deallocate(v, ops->size);
+  }
+  bases_.clear();
+}
+
+// ------------------------------------------------------------------ introspection
+
+std::size_t Engine::trace_bytes() const {
+  return pool_.live_bytes() + order_.memory_bytes() + queue_.memory_bytes() +
+         allocs_.memory_bytes() + memos_.memory_bytes() +
+         deferred_.capacity() * sizeof(AllocNode*) + bases_.capacity() * sizeof(VersionBase*);
+}
+
+void Engine::check_invariants() const {
+  if (in_computation_) throw UsageError("sac::Engine::check_invariants: not inside the computation");
+  auto fail = [](const std::string& what) { throw InvariantError("Engine trace: " + what); };
+  order_.check_invariants();
+  queue_.check_invariants();
+  if (!queue_.empty()) fail("queue not empty outside propagate()");
+  if (!deferred_.empty()) fail("deferred frees left after propagate()");
+
+  // Walk the trace: nesting, per-record checks, counts.
+  struct Open {
+    const Stamp* close;   // stamp that closes this interval
+    bool is_memo;
+  };
+  std::vector<Open> stack;
+  std::uint64_t events = 0;
+  std::size_t nkeyed = 0, nmemo = 0;
+  std::unordered_set<const ModBase*> mods;
+  for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
+    switch (s->kind()) {
+      case StampKind::ReadStart: {
+        const ReadNode* r = reinterpret_cast<const ReadNode*>(s);
+        ++events;
+        if (r->flags & detail::kReadDead) fail("dead read in the trace");
+        if (!(r->flags & detail::kReadEndLinked)) fail("read without end stamp");
+        if (!r->end.linked() || !order_.less(&r->start, &r->end)) fail("read end not after start");
+        // Attached to the version visible at its start.
+        const VersionBase* vis = visible(*r->mod, &r->start);
+        if (!vis) fail("read of a modifiable with no visible version");
+        bool found = false;
+        for (const ReadNode* x = vis->readers; x; x = x->rnext)
+          if (x == r) found = true;
+        if (!found) fail("read not attached to the version visible at its time");
+        if (r->qpos != kNotQueued) fail("read still queued");
+        stack.push_back({&r->end, false});
+        break;
+      }
+      case StampKind::ReadEnd: {
+        if (stack.empty() || stack.back().close != s || stack.back().is_memo)
+          fail("read intervals not well nested");
+        stack.pop_back();
+        break;
+      }
+      case StampKind::Write: {
+        const VersionBase* v = reinterpret_cast<const VersionBase*>(s);
+        ++events;
+        mods.insert(v->mod);
+        bool found = false;
+        for (const VersionBase* x = v->mod->newest_; x; x = x->older)
+          if (x == v) found = true;
+        if (!found) fail("write not in its modifiable's version list");
+        break;
+      }
+      case StampKind::Alloc: {
+        const AllocNode* n = reinterpret_cast<const AllocNode*>(s);
+        ++events;
+        if (n->ops->key_equal) ++nkeyed;
+        break;
+      }
+      case StampKind::MemoStart: {
+        const MemoNode* n = reinterpret_cast<const MemoNode*>(s);
+        ++events;
+        ++nmemo;
+        if (n->flags & detail::kReadDead) fail("dead memo entry in the trace");
+        if (!(n->flags & detail::kReadEndLinked) || !n->end.linked() ||
+            !order_.less(&n->start, &n->end))
+          fail("memo entry without a proper end stamp");
+        stack.push_back({&n->end, true});
+        break;
+      }
+      case StampKind::MemoEnd: {
+        if (stack.empty() || stack.back().close != s || !stack.back().is_memo)
+          fail("memo intervals not well nested");
+        stack.pop_back();
+        break;
+      }
+      default:
+        fail("unexpected stamp kind");
+    }
+  }
+  if (!stack.empty()) fail("unclosed intervals at the end of the trace");
+  if (events != stats_.live_events) fail("live event count mismatch");
+  if (nkeyed != allocs_.size()) fail("allocation table size mismatch");
+  if (nmemo != memos_.size()) fail("memo table size mismatch");
+
+  // Versions of every written modifiable: strictly decreasing time, base last, readers
+  // between this version and the next newer one.
+  for (const ModBase* m : mods) {
+    const VersionBase* newer = nullptr;
+    for (const VersionBase* v = m->newest_; v; v = v->older) {
+      if (v->is_base()) {
+        if (v->older) fail("base version is not the oldest");
+      } else {
+        if (!v->stamp.linked()) fail("version with unlinked stamp");
+        if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("versions out of order");
+      }
+      for (const ReadNode* r = v->readers; r; r = r->rnext) {
+        if (r->mod != m) fail("reader of another modifiable");
+        if (!v->is_base() && !order_.less(&v->stamp, &r->start)) fail("reader before its version");
+        if (newer && !order_.less(&r->start, &newer->stamp)) fail("reader after the next version");
+      }
+      newer = v;
+    }
+  }
+  allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops->hash(n); },
+                           [&](const AllocNode* n) {
+                             if (!n->stamp.linked()) fail("allocation table holds an undone record");
+                           });
+  memos_.check_invariants("memo table", [](const MemoNode* n) { return n->ops->hash(n); },
+                          [&](const MemoNode* n) {
+                            if (!n->start.linked()) fail("memo table holds an undone record");
+                          });
+}
+
+void Engine::dump_dot(std::ostream& os) const {
+  // Trace tree: reads and memo entries are interior nodes, writes and allocations leaves.
+  os << "digraph trace {\n  node [fontname=\"monospace\", fontsize=10];\n  root [label=\"run\"];\n";
+  std::vector<std::pair<std::string, const Stamp*>> stack{{"root", nullptr}};
+  std::unordered_map<const ModBase*, std::string> mod_names;
+  auto mod_name = [&](const ModBase* m) {
+    auto it = mod_names.find(m);
+    if (it != mod_names.end()) return it->second;
+    std::string n = "m" + std::to_string(mod_names.size());
+    mod_names.emplace(m, n);
+    os << "  " << n << " [shape=box, label=\"" << n << "\"];\n";
+    return n;
+  };
+  std::size_t id = 0;
+  for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
+    std::string name = "e" + std::to_string(id++);
+    const std::string& parent = stack.back().first;
+    switch (s->kind()) {
+      case StampKind::ReadStart: {
+        const ReadNode* r = reinterpret_cast<const ReadNode*>(s);
+        os << "  " << name << " [label=\"read\"];\n  " << parent << " -> " << name << ";\n  "
+           << mod_name(r->mod) << " -> " << name << " [style=dashed];\n";
+        stack.push_back({name, &r->end});
+        break;
+      }
+      case StampKind::ReadEnd:
+        break;
+      case StampKind::Write: {
+        const VersionBase* v = reinterpret_cast<const VersionBase*>(s);
+        os << "  " << name << " [shape=diamond, label=\"write\"];\n  " << parent << " -> " << name
+           << ";\n  " << name << " -> " << mod_name(v->mod) << " [style=dashed];\n";
+        break;
+      }
+      case StampKind::Alloc:
+        os << "  " << name << " [shape=note, label=\"alloc\"];\n  " << parent << " -> " << name << ";\n";
+        break;
+      case StampKind::MemoStart: {
+        const MemoNode* n = reinterpret_cast<const MemoNode*>(s);
+        os << "  " << name << " [shape=octagon, label=\"memo\"];\n  " << parent << " -> " << name << ";\n";
+        stack.push_back({name, &n->end});
+        break;
+      }
+      default:
+        break;
+    }
+    while (stack.size() > 1 && stack.back().second == s) stack.pop_back();
+  }
+  os << "}\n";
+}
+
+}  // namespace sac

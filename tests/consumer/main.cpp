@@ -1,0 +1,7 @@
+#include <sac/sac.hpp>
+
+int main() {
+  sac::Engine e;
+  (void)e;
+  return 0;
+}
