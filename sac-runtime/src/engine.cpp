@@ -35,6 +35,7 @@ void Engine::fail_not_in_computation(const char* what) const {
 }
 
 void Engine::poison() noexcept {
+  discard_pending();
   poisoned_ = true;
   in_computation_ = false;
   now_ = nullptr;
@@ -45,22 +46,26 @@ void Engine::poison() noexcept {
 
 VersionBase* Engine::visible(const ModBase& m, const Stamp* t) const {
   VersionBase* v = m.newest_;
-  while (v && !(v->is_base() || order_.less(&v->stamp, t))) v = v->older;
+  while (v && !(v->is_base() || order_.less(&v->stamp, t))) v = v->older();
   return v;
 }
 
-void Engine::link_write(VersionBase* v) {
+void Engine::link_write(ModBase& m, VersionBase* v) {
   order_.insert_after(now_, &v->stamp, StampKind::Write);
   now_ = &v->stamp;
   ++stats_.events_created;
   ++stats_.live_events;
-  ModBase& m = *v->mod;
-  VersionBase** pp = &m.newest_;
-  while (*pp && !((*pp)->is_base() || order_.less(&(*pp)->stamp, &v->stamp))) pp = &(*pp)->older;
-  VersionBase* older = *pp;
-  v->older = older;
+  VersionBase* newer = nullptr;
+  VersionBase* older = m.newest_;
+  while (older && !(older->is_base() || order_.less(&older->stamp, &v->stamp))) {
+    newer = older;
+    older = older->older();
+  }
+  if (older) v->set_older(older);
+  else v->set_oldest_of(&m);
   v->readers = nullptr;
-  *pp = v;
+  if (newer) newer->set_older(v);
+  else m.newest_ = v;
   // Readers of the older version that come after v now see v. When v is the last stamp of
   // the whole trace (every from-scratch write) none can.
   if (older && older->readers && v->stamp.next() != nullptr) {
@@ -79,9 +84,9 @@ void Engine::link_write(VersionBase* v) {
 
 void Engine::set_base(ModBase& m, VersionBase* fresh,
                       bool (*assign_if_changed)(VersionBase*, VersionBase*)) {
-  VersionBase** pp = &m.newest_;
-  while (*pp && !(*pp)->is_base()) pp = &(*pp)->older;
-  if (VersionBase* base = *pp) {
+  VersionBase* last = nullptr;
+  for (VersionBase* v = m.newest_; v; v = v->older()) last = v;
+  if (VersionBase* base = last && last->is_base() ? last : nullptr) {
     const bool changed = assign_if_changed(base, fresh);
     fresh->ops->destroy(fresh);
     deallocate(fresh, fresh->ops->size);
@@ -93,17 +98,19 @@ void Engine::set_base(ModBase& m, VersionBase* fresh,
   // (such a read would have failed), and no reader is affected.
   fresh->stamp.link = static_cast<std::uintptr_t>(StampKind::Sentinel);
   fresh->stamp.label = static_cast<std::uint32_t>(bases_.size());
-  fresh->older = nullptr;
+  fresh->set_oldest_of(&m);
   fresh->readers = nullptr;
   bases_.push_back(fresh);
-  *pp = fresh;
+  input_bytes_ += (fresh->ops->size + 7) & ~std::size_t{7};
+  if (last) last->set_older(fresh);
+  else m.newest_ = fresh;
 }
 
 void Engine::retire(ModBase& m) {
   require_mutator("retire");
   VersionBase* v = m.newest_;
   if (!v) return;
-  if (!v->is_base() || v->older)
+  if (!v->is_base() || v->older())
     throw UsageError("sac::Engine::retire: the modifiable has versions written by the computation");
   if (v->readers) throw UsageError("sac::Engine::retire: the modifiable is still read");
   const std::uint32_t i = v->stamp.label;
@@ -112,13 +119,31 @@ void Engine::retire(ModBase& m) {
   bases_.pop_back();
   m.newest_ = nullptr;
   const detail::VersionOps* ops = v->ops;
+  input_bytes_ -= (ops->size + 7) & ~std::size_t{7};
   ops->destroy(v);
   deallocate(v, ops->size);
 }
 
-// ------------------------------------------------------------------ reads
+// ------------------------------------------------------------------ the trampoline
 
-void Engine::run_read(ReadNode* r) {
+void Engine::flush() {
+  // A write/alloc/make follows calls this body issued: run them first, so that events keep
+  // program order.
+  const std::size_t floor = tasks_.size();
+  for (std::size_t i = issued_.size(); i-- > body_mark_;) tasks_.push_back(issued_[i]);
+  issued_.resize(body_mark_);
+  drain(floor);
+}
+
+void Engine::drain(std::size_t floor) {
+  while (tasks_.size() > floor) {
+    const Task t = tasks_.back();
+    tasks_.pop_back();
+    execute(t);
+  }
+}
+
+void Engine::exec_read(ReadNode* r) {
   order_.insert_after(now_, &r->start, StampKind::ReadStart);
   now_ = &r->start;
   ++stats_.events_created;
@@ -126,27 +151,124 @@ void Engine::run_read(ReadNode* r) {
   VersionBase* v = visible(*r->mod, &r->start);
   if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
   attach(r, v);
-  r->ops->invoke(*this, r, v);
-  order_.insert_after(now_, &r->end, StampKind::ReadEnd);
-  now_ = &r->end;
-  r->flags |= detail::kReadEndLinked;
+  tasks_.push_back(Task{TaskKind::CloseRead, r});
+  exec_body([&] { r->ops->invoke(*this, r, v); });
 }
 
-void Engine::rerun(ReadNode* r) {
-  Stamp* const saved_now = now_;
-  Stamp* const saved_end = window_end_;
-  now_ = &r->start;
-  window_end_ = &r->end;
-  ++stats_.reads_reexecuted;
-  ++stats_.last_reexecuted;
-  detach(r);
-  VersionBase* v = visible(*r->mod, &r->start);
-  if (!v) throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
-  attach(r, v);
-  r->ops->invoke(*this, r, v);
-  undo_between(now_, window_end_);
-  now_ = saved_now;
-  window_end_ = saved_end;
+void Engine::execute(const Task& t) {
+  switch (t.kind) {
+    case TaskKind::ExecRead:
+      exec_read(static_cast<ReadNode*>(t.node));
+      break;
+    case TaskKind::ExecMemoRead: {
+      auto* r = static_cast<ReadNode*>(t.node);
+      if (window_end_) {
+        if (ReadNode* hit = find_read_match(*r->mod, r->ops, closure_of(r))) {
+          const detail::ReadOps* ops = r->ops;
+          ops->destroy(r);
+          deallocate(r, ops->size);
+          memo_hit(&hit->start, &hit->end);
+          break;
+        }
+        ++stats_.memo_misses;
+      }
+      exec_read(r);
+      break;
+    }
+    case TaskKind::ExecMemo: {
+      auto* n = static_cast<MemoNode*>(t.node);
+      const std::size_t h = n->ops->hash(n);
+      if (window_end_) {
+        if (MemoNode* hit = find_memo_match(n->ops, h, reinterpret_cast<const MemoNode*>(n) + 1)) {
+          const detail::MemoOps* ops = n->ops;
+          ops->destroy(n);
+          deallocate(n, ops->size);
+          memo_hit(&hit->start, &hit->end);
+          break;
+        }
+        ++stats_.memo_misses;
+      }
+      link_memo(n, h);
+      tasks_.push_back(Task{TaskKind::CloseMemo, n});
+      exec_body([&] { n->invoke(*this, n); });
+      break;
+    }
+    case TaskKind::CloseRead: {
+      auto* r = static_cast<ReadNode*>(t.node);
+      order_.insert_after(now_, &r->end, StampKind::ReadEnd);
+      now_ = &r->end;
+      r->flags |= detail::kReadEndLinked;
+      break;
+    }
+    case TaskKind::CloseMemo: {
+      auto* n = static_cast<MemoNode*>(t.node);
+      order_.insert_after(now_, &n->end, StampKind::MemoEnd);
+      now_ = &n->end;
+      n->flags |= detail::kReadEndLinked;
+      break;
+    }
+    case TaskKind::Rerun: {
+      auto* r = static_cast<ReadNode*>(t.node);
+      reruns_.push_back(RerunContext{now_, window_end_});
+      tasks_.push_back(Task{TaskKind::FinishRerun, r});
+      now_ = &r->start;
+      window_end_ = &r->end;
+      ++stats_.reads_reexecuted;
+      ++stats_.last_reexecuted;
+      detach(r);
+      VersionBase* v = visible(*r->mod, &r->start);
+      if (!v)
+        throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
+      attach(r, v);
+      exec_body([&] { r->ops->invoke(*this, r, v); });
+      break;
+    }
+    case TaskKind::FinishRerun: {
+      auto* r = static_cast<ReadNode*>(t.node);
+      undo_between(now_, &r->end);  // what the old execution did and this one did not redo
+      now_ = reruns_.back().now;
+      window_end_ = reruns_.back().window_end;
+      reruns_.pop_back();
+      break;
+    }
+    case TaskKind::DrainUntil: {
+      // Affected reads inside a reused stretch are brought up to date, in time order, before
+      // execution continues after it.
+      auto* end = static_cast<Stamp*>(t.node);
+      if (!queue_.empty() && order_.less(&queue_.top()->start, end)) {
+        ReadNode* r = queue_.pop();
+        ++stats_.queue_pops;
+        tasks_.push_back(t);
+        tasks_.push_back(Task{TaskKind::Rerun, r});
+      } else {
+        now_ = end;
+      }
+      break;
+    }
+  }
+}
+
+void Engine::discard_pending() noexcept {
+  // Nodes of calls that were issued but never executed are not in the trace: free them here.
+  auto discard = [this](const Task& t) {
+    if (t.kind == TaskKind::ExecRead || t.kind == TaskKind::ExecMemoRead) {
+      auto* r = static_cast<ReadNode*>(t.node);
+      const detail::ReadOps* ops = r->ops;
+      ops->destroy(r);
+      deallocate(r, ops->size);
+    } else if (t.kind == TaskKind::ExecMemo) {
+      auto* n = static_cast<MemoNode*>(t.node);
+      const detail::MemoOps* ops = n->ops;
+      ops->destroy(n);
+      deallocate(n, ops->size);
+    }
+  };
+  for (const Task& t : tasks_) discard(t);
+  for (const Task& t : issued_) discard(t);
+  tasks_.clear();
+  issued_.clear();
+  reruns_.clear();
+  body_mark_ = 0;
 }
 
 void Engine::enqueue(ReadNode* r) {
@@ -166,7 +288,8 @@ void Engine::propagate() {
     while (!queue_.empty()) {
       ReadNode* r = queue_.pop();
       ++stats_.queue_pops;
-      rerun(r);
+      tasks_.push_back(Task{TaskKind::Rerun, r});
+      drain(0);
     }
   } catch (...) {
     poison();
@@ -185,7 +308,7 @@ void Engine::propagate() {
 ReadNode* Engine::find_read_match(const ModBase& m, const detail::ReadOps* ops,
                                   const void* closure) const {
   ReadNode* best = nullptr;
-  for (VersionBase* v = m.newest_; v; v = v->older)
+  for (VersionBase* v = m.newest_; v; v = v->older())
     for (ReadNode* r = v->readers; r; r = r->rnext)
       if (r->ops == ops && in_window(&r->start, &r->end) &&
           ops->equal(r, closure) && (!best || order_.less(&r->start, &best->start)))
@@ -216,14 +339,7 @@ MemoNode* Engine::find_memo_match(const detail::MemoOps* ops, std::size_t h,
 void Engine::memo_hit(Stamp* start, Stamp* end) {
   ++stats_.memo_hits;
   undo_between(now_, start);
-  // Affected reads inside the reused stretch are brought up to date before execution
-  // continues after it.
-  while (!queue_.empty() && order_.less(&queue_.top()->start, end)) {
-    ReadNode* r = queue_.pop();
-    ++stats_.queue_pops;
-    rerun(r);
-  }
-  now_ = end;
+  tasks_.push_back(Task{TaskKind::DrainUntil, end});
 }
 
 void Engine::reuse_alloc(AllocNode* n) {
@@ -281,10 +397,8 @@ void Engine::undo(Stamp* s) {
       VersionBase* v = detail::version_of(s);
       ++stats_.events_undone;
       --stats_.live_events;
-      VersionBase** pp = &v->mod->newest_;
-      while (*pp != v) pp = &(*pp)->older;
-      *pp = v->older;
-      VersionBase* older = v->older;
+      VersionBase* older = v->older();
+      unlink_version(v);
       if (v->readers) {
         const bool same = older && v->ops->equal(v, older);
         for (ReadNode* r = v->readers; r;) {
@@ -330,6 +444,17 @@ void Engine::undo(Stamp* s) {
   }
 }
 
+void Engine::unlink_version(VersionBase* v) {
+  ModBase* m = v->mod();
+  if (m->newest_ == v) {
+    m->newest_ = v->older();
+    return;
+  }
+  VersionBase* newer = m->newest_;
+  while (newer->older() != v) newer = newer->older();
+  newer->link = v->link;
+}
+
 void Engine::free_deferred() noexcept {
   for (AllocNode* n : deferred_) {
     const detail::AllocOps* ops = n->ops;
@@ -340,6 +465,7 @@ void Engine::free_deferred() noexcept {
 }
 
 void Engine::destroy_all() noexcept {
+  discard_pending();
   // Tear-down without undo semantics: destroy every record once. Valid even when poisoned.
   for (Stamp* s = order_.base()->next(); s;) {
     Stamp* nx = s->next();
@@ -402,14 +528,15 @@ void Engine::destroy_all() noexcept {
     deallocate(v, ops->size);
   }
   bases_.clear();
+  input_bytes_ = 0;
 }
 
 // ------------------------------------------------------------------ introspection
 
 std::size_t Engine::trace_bytes() const {
-  return pool_.live_bytes() + order_.memory_bytes() + queue_.memory_bytes() +
+  return record_bytes() + order_.memory_bytes() + queue_.memory_bytes() +
          allocs_.memory_bytes() + memos_.memory_bytes() +
-         deferred_.capacity() * sizeof(AllocNode*) + bases_.capacity() * sizeof(VersionBase*);
+         deferred_.capacity() * sizeof(AllocNode*);
 }
 
 void Engine::check_invariants() const {
@@ -457,9 +584,9 @@ void Engine::check_invariants() const {
       case StampKind::Write: {
         const VersionBase* v = reinterpret_cast<const VersionBase*>(s);
         ++events;
-        mods.insert(v->mod);
+        mods.insert(v->mod());
         bool found = false;
-        for (const VersionBase* x = v->mod->newest_; x; x = x->older)
+        for (const VersionBase* x = v->mod()->newest_; x; x = x->older())
           if (x == v) found = true;
         if (!found) fail("write not in its modifiable's version list");
         break;
@@ -500,9 +627,10 @@ void Engine::check_invariants() const {
   // between this version and the next newer one.
   for (const ModBase* m : mods) {
     const VersionBase* newer = nullptr;
-    for (const VersionBase* v = m->newest_; v; v = v->older) {
+    for (const VersionBase* v = m->newest_; v; v = v->older()) {
+      if (v->mod() != m) fail("version chain does not end at its modifiable");
       if (v->is_base()) {
-        if (v->older) fail("base version is not the oldest");
+        if (v->older()) fail("base version is not the oldest");
       } else {
         if (!v->stamp.linked()) fail("version with unlinked stamp");
         if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("versions out of order");
@@ -555,7 +683,7 @@ void Engine::dump_dot(std::ostream& os) const {
       case StampKind::Write: {
         const VersionBase* v = reinterpret_cast<const VersionBase*>(s);
         os << "  " << name << " [shape=diamond, label=\"write\"];\n  " << parent << " -> " << name
-           << ";\n  " << name << " -> " << mod_name(v->mod) << " [style=dashed];\n";
+           << ";\n  " << name << " -> " << mod_name(v->mod()) << " [style=dashed];\n";
         break;
       }
       case StampKind::Alloc:

@@ -17,6 +17,12 @@
 //                           propagated, execution jumps to its end).
 //   rt.memo_read(m, fn)     read(m, fn) memoized on (m, fn) with no extra record.
 //
+// Execution is trampolined, so deep recursion (a read chain a million long) never grows the
+// C++ stack: read/memo_read/memo calls are recorded when issued and run after the issuing
+// body returns, in issue order, each with its whole subtree — unless the body performs a
+// write, alloc or make first, in which case the pending calls run right then. Either way the
+// events happen in program order, exactly as if every call ran on the spot; a body simply
+// must not expect a read's body to have run when read() returns.
 // Bodies are stored in the trace and re-run later: they capture by value (or pointers to
 // modifiables and keyed objects), never references to the stack. They may take
 // (Engine&, const T&) or (const T&); memoized closures must be equality comparable and
@@ -176,8 +182,10 @@ class Engine {
   const Stats& stats() const { return stats_; }
   /// Bytes held by the trace: records, closures, versions, tables, order-list groups, queue.
   std::size_t trace_bytes() const;
+  /// Bytes of the base (input) versions set by the mutator; not part of the trace.
+  std::size_t input_bytes() const { return input_bytes_; }
   /// Bytes of live trace records only (exactly equal for equal traces; no table slack).
-  std::size_t record_bytes() const { return pool_.live_bytes(); }
+  std::size_t record_bytes() const { return pool_.live_bytes() - input_bytes_; }
   std::uint64_t live_events() const { return stats_.live_events; }
   bool in_computation() const { return in_computation_; }
   bool poisoned() const { return poisoned_; }
@@ -193,6 +201,19 @@ class Engine {
  private:
   using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits>;
 
+  // Work of the trampoline. Exec* carry a node that is not linked yet.
+  enum class TaskKind : std::uint8_t {
+    ExecRead, ExecMemoRead, ExecMemo, CloseRead, CloseMemo, Rerun, FinishRerun, DrainUntil
+  };
+  struct Task {
+    TaskKind kind;
+    void* node;   // the node, or for DrainUntil the stamp to drain up to
+  };
+  struct RerunContext {
+    Stamp* now;
+    Stamp* window_end;
+  };
+
   void require_mutator(const char* what) const;
   void require_computation(const char* what) const {
     if (!in_computation_) [[unlikely]]
@@ -205,9 +226,20 @@ class Engine {
   void deallocate(void* p, std::size_t n) noexcept { pool_.deallocate(p, n); }
 
   // Trace machinery (engine.cpp).
-  void run_read(detail::ReadNode* r);
-  void rerun(detail::ReadNode* r);
-  void link_write(detail::VersionBase* v);
+  void issue(TaskKind k, void* node) { issued_.push_back(Task{k, node}); }
+  void flush_if_pending() {
+    if (issued_.size() > body_mark_) [[unlikely]]
+      flush();
+  }
+  void flush();
+  template <class Body>
+  void exec_body(Body&& body);
+  void drain(std::size_t floor);
+  void execute(const Task& t);
+  void exec_read(detail::ReadNode* r);
+  void discard_pending() noexcept;
+  void link_write(ModBase& m, detail::VersionBase* v);
+  void unlink_version(detail::VersionBase* v);
   void link_alloc(detail::AllocNode* n, std::size_t h);
   void link_memo(detail::MemoNode* n, std::size_t h);
   void set_base(ModBase& m, detail::VersionBase* fresh,
@@ -220,6 +252,7 @@ class Engine {
                                     const void* closure) const;
   void reuse_alloc(detail::AllocNode* n);
   void memo_hit(Stamp* start, Stamp* end);
+  static void* closure_of(detail::ReadNode* r) { return static_cast<detail::ReadNode*>(r) + 1; }
   void undo_between(Stamp* a, Stamp* b);
   void undo(Stamp* s);
   void enqueue(detail::ReadNode* r);
@@ -251,6 +284,10 @@ class Engine {
   detail::IntrusiveHash<detail::MemoNode> memos_;
   std::vector<detail::AllocNode*> deferred_;   // undone allocations, freed by propagate()
   std::vector<detail::VersionBase*> bases_;    // base versions; index kept in stamp.label
+  std::vector<Task> tasks_;                    // the trampoline's stack
+  std::vector<RerunContext> reruns_;           // contexts saved by the running re-executions
+  std::vector<Task> issued_;                   // calls issued by the running bodies
+  std::size_t body_mark_ = 0;                  // issued_ entries below this belong to callers
 
   Stamp* now_ = nullptr;          // events are inserted after this stamp
   Stamp* window_end_ = nullptr;   // end of the re-execution window; null when running fresh
@@ -258,6 +295,7 @@ class Engine {
   bool in_computation_ = false;
   bool poisoned_ = false;
   Stats stats_;
+  std::size_t input_bytes_ = 0;
 };
 
 // ------------------------------------------------------------------ templates
@@ -275,7 +313,6 @@ void Engine::set(Mod<T>& m, U&& value) {
     throw;
   }
   v->ops = &detail::VersionOpsFor<T>::ops;
-  v->mod = &m;
   set_base(m, v, [](detail::VersionBase* old_base, detail::VersionBase* fresh) {
     auto* o = static_cast<V*>(old_base);
     auto* f = static_cast<V*>(fresh);
@@ -298,7 +335,8 @@ void Engine::run(F&& f) {
   now_ = tail_;
   window_end_ = nullptr;
   try {
-    detail::call_thunk(f, *this);
+    exec_body([&] { detail::call_thunk(f, *this); });
+    drain(0);
   } catch (...) {
     poison();
     throw;
@@ -325,7 +363,7 @@ void Engine::read(const Mod<T>& m, F&& body) {
   r->mod = &m;
   r->ops = &detail::ReadOpsFor<T, Fn>::ops;
   r->qpos = kNotQueued;
-  run_read(r);
+  issue(TaskKind::ExecRead, r);
 }
 
 template <class T, class F>
@@ -333,22 +371,15 @@ void Engine::memo_read(const Mod<T>& m, F&& body) {
   using Fn = std::decay_t<F>;
   static_assert(std::equality_comparable<Fn>,
                 "memo_read needs an equality-comparable closure: use sac::fn<f>(args...)");
-  require_computation("memo_read");
-  if (window_end_) {
-    const Fn& key = body;
-    if (detail::ReadNode* hit = find_read_match(m, &detail::ReadOpsFor<T, Fn>::ops, &key)) {
-      memo_hit(&hit->start, &hit->end);
-      return;
-    }
-    ++stats_.memo_misses;
-  }
   read(m, std::forward<F>(body));
+  issued_.back().kind = TaskKind::ExecMemoRead;  // matched against the old trace when run
 }
 
 template <class T, class U>
 void Engine::write(Mod<T>& m, U&& value) {
   using V = detail::Version<T>;
   require_computation("write");
+  flush_if_pending();
   void* mem = allocate(sizeof(V));
   V* v;
   try {
@@ -358,8 +389,7 @@ void Engine::write(Mod<T>& m, U&& value) {
     throw;
   }
   v->ops = &detail::VersionOpsFor<T>::ops;
-  v->mod = &m;
-  link_write(v);
+  link_write(m, v);
 }
 
 template <class T, class K, class... A>
@@ -369,6 +399,7 @@ T* Engine::alloc(const K& key, A&&... args) {
   using N = detail::AllocNodeT<T, K>;
   static_assert(alignof(N) <= detail::Pool::kGrain, "object over-aligned");
   require_computation("alloc");
+  flush_if_pending();
   const detail::AllocOps* ops = &detail::AllocOpsFor<T, K>::ops;
   const std::size_t h = Hash<K>{}(key);
   if (window_end_) {
@@ -395,6 +426,7 @@ T* Engine::make(A&&... args) {
   using N = detail::PlainAllocNodeT<T>;
   static_assert(alignof(N) <= detail::Pool::kGrain, "object over-aligned");
   require_computation("make");
+  flush_if_pending();
   void* mem = allocate(sizeof(N));
   N* n;
   try {
@@ -416,16 +448,6 @@ void Engine::memo(F&& f) {
                 "memo needs an equality-comparable, hashable closure: use sac::fn<f>(args...)");
   static_assert(alignof(N) <= detail::Pool::kGrain, "closure over-aligned");
   require_computation("memo");
-  const detail::MemoOps* ops = &detail::MemoOpsFor<Fn>::ops;
-  const std::size_t h = Hash<Fn>{}(f);
-  if (window_end_) {
-    const Fn& key = f;
-    if (detail::MemoNode* hit = find_memo_match(ops, h, &key)) {
-      memo_hit(&hit->start, &hit->end);
-      return;
-    }
-    ++stats_.memo_misses;
-  }
   void* mem = allocate(sizeof(N));
   N* n;
   try {
@@ -434,12 +456,21 @@ void Engine::memo(F&& f) {
     deallocate(mem, sizeof(N));
     throw;
   }
-  n->ops = ops;
-  link_memo(n, h);
-  detail::call_thunk(n->fn, *this);
-  order_.insert_after(now_, &n->end, StampKind::MemoEnd);
-  now_ = &n->end;
-  n->flags |= detail::kReadEndLinked;
+  n->ops = &detail::MemoOpsFor<Fn>::ops;
+  n->invoke = [](Engine& e, detail::MemoNode* x) { detail::call_thunk(static_cast<N*>(x)->fn, e); };
+  issue(TaskKind::ExecMemo, n);
+}
+
+template <class Body>
+void Engine::exec_body(Body&& body) {
+  // Calls issued by this body are queued above body_mark_ and handed to the trampoline in
+  // issue order once it returns.
+  const std::size_t saved = body_mark_;
+  body_mark_ = issued_.size();
+  body();
+  for (std::size_t i = issued_.size(); i-- > body_mark_;) tasks_.push_back(issued_[i]);
+  issued_.resize(body_mark_);
+  body_mark_ = saved;
 }
 
 }  // namespace sac

@@ -5,7 +5,8 @@
 // the table is one bucket array. Lookups return every record of a bucket; the engine filters
 // by ops, key and trace window.
 // Invariants: every record is in bucket hash(record) & mask; size() counts them;
-//             buckets.size() is a power of two >= size() / 1 (grows at load factor 1).
+//             buckets.size() is a power of two >= size() / 2 (grows at load factor 2:
+//             lookups happen only during re-execution, inserts on every keyed allocation).
 // Complexity: insert O(1) amortized, erase O(chain), lookup O(chain).
 #pragma once
 
@@ -22,7 +23,7 @@ class IntrusiveHash {
  public:
   template <class HashOf>
   void insert(N* n, std::size_t h, HashOf&& hash_of) {
-    if (size_ + 1 > buckets_.size()) grow(hash_of);
+    if (size_ + 1 > 2 * buckets_.size()) grow(hash_of);
     N*& b = buckets_[h & (buckets_.size() - 1)];
     n->hnext = b;
     b = n;

@@ -1,7 +1,9 @@
 // sac/detail/pool.hpp — size-class pool allocator for trace nodes, closures and versions.
 //
 // Purpose: the hot paths (reads, writes, allocations) must not call the general-purpose heap
-// once per event. Blocks are carved from 64 KiB chunks, one free list per 8-byte size class.
+// once per event. Blocks are carved from chunks that grow geometrically from 64 KiB to 2 MiB
+// (2 MiB chunks are 2 MiB-aligned and advised as transparent huge pages: a large trace then
+// costs one page fault per 2 MiB instead of one per 4 KiB), one free list per 8-byte size class.
 // Invariants: live_bytes() == sum of sizes of blocks handed out and not yet returned;
 //             a block is returned with the same size it was requested with.
 // Complexity: allocate/deallocate O(1); chunks are released only when the pool dies.
@@ -10,6 +12,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <new>
 #include <vector>
 
@@ -19,13 +22,14 @@ class Pool {
  public:
   static constexpr std::size_t kGrain = 8;
   static constexpr std::size_t kMaxSmall = 512;
-  static constexpr std::size_t kChunk = 64 * 1024;
+  static constexpr std::size_t kFirstChunk = 64 * 1024;
+  static constexpr std::size_t kHugeChunk = 2 * 1024 * 1024;
 
   Pool() = default;
   Pool(const Pool&) = delete;
   Pool& operator=(const Pool&) = delete;
   ~Pool() {
-    for (void* c : chunks_) ::operator delete(c);
+    for (void* c : chunks_) std::free(c);
   }
 
   void* allocate(std::size_t n) {
@@ -54,7 +58,7 @@ class Pool {
   }
 
   std::size_t live_bytes() const { return live_bytes_; }
-  std::size_t reserved_bytes() const { return chunks_.size() * kChunk; }
+  std::size_t reserved_bytes() const { return reserved_; }
 
  private:
   struct Free {
@@ -64,19 +68,17 @@ class Pool {
     return n < kGrain ? kGrain : (n + kGrain - 1) & ~(kGrain - 1);
   }
   void* carve(std::size_t n) {
-    if (static_cast<std::size_t>(end_ - cur_) < n) {
-      // The chunk tail is abandoned (at most kMaxSmall bytes per 64 KiB).
-      cur_ = static_cast<char*>(::operator new(kChunk));
-      chunks_.push_back(cur_);
-      end_ = cur_ + kChunk;
-    }
+    if (static_cast<std::size_t>(end_ - cur_) < n) new_chunk();  // the old tail is abandoned
     void* p = cur_;
     cur_ += n;
     return p;
   }
+  void new_chunk();  // pool.cpp
 
   Free* free_[kMaxSmall / kGrain + 1] = {};
   std::vector<void*> chunks_;
+  std::size_t next_chunk_ = kFirstChunk;
+  std::size_t reserved_ = 0;
   char* cur_ = nullptr;
   char* end_ = nullptr;
   std::size_t live_bytes_ = 0;

@@ -5,8 +5,8 @@
 // Pool; their type-specific behaviour (destroy, compare, hash, invoke) sits in a static ops
 // table per instantiated type, so a record costs one pointer for it and no vtable.
 //
-// Layout (bytes, 64-bit): VersionBase 48 + value; ReadNode 72 + closure; AllocNode 32 +
-// key + object; MemoNode 56 + closure.
+// Layout (bytes, 64-bit): VersionBase 40 + value; ReadNode 72 + closure; AllocNode 32 +
+// key + object; MemoNode 64 + closure.
 // Invariants: see Engine::check_invariants().
 #pragma once
 
@@ -39,11 +39,22 @@ struct VersionOps {
 struct VersionBase {
   Stamp stamp;
   const VersionOps* ops;
-  ModBase* mod;
-  VersionBase* older;    // next older version of the same modifiable
+  std::uintptr_t link;   // next older version, or (the modifiable | 1) after the oldest
   ReadNode* readers;     // the reads that see this version
 
   bool is_base() const { return stamp.kind() == StampKind::Sentinel; }
+  VersionBase* older() const {
+    return (link & 1) ? nullptr : reinterpret_cast<VersionBase*>(link);
+  }
+  /// The owning modifiable, found at the end of the (short) chain of older versions; this
+  /// saves a pointer in every version.
+  ModBase* mod() const {
+    const VersionBase* v = this;
+    while (!(v->link & 1)) v = reinterpret_cast<const VersionBase*>(v->link);
+    return reinterpret_cast<ModBase*>(v->link & ~std::uintptr_t{1});
+  }
+  void set_older(VersionBase* o) { link = reinterpret_cast<std::uintptr_t>(o); }
+  void set_oldest_of(ModBase* m) { link = reinterpret_cast<std::uintptr_t>(m) | 1; }
 };
 
 template <class T>
@@ -122,6 +133,7 @@ struct MemoNode {
   Stamp end;
   MemoNode* hnext;
   const MemoOps* ops;
+  void (*invoke)(Engine&, MemoNode*);
   std::uint64_t flags;   // kReadDead / kReadEndLinked, as for reads
 };
 

@@ -1,0 +1,136 @@
+// sac_suite — the classic self-adjusting benchmark suite (shared/FORMATS.md, "sac_suite").
+//
+// For each app: time the conventional twin (median of three runs) and the self-adjusting
+// from-scratch run on the same input, then at U positions spread over the input delete the
+// element and propagate, reinsert it and propagate; update_s is the mean over the 2U
+// propagations. Every output is verified against the conventional result after the
+// from-scratch run and after every propagation. Ratios come from one process run.
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "sacapps/app.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+template <class F>
+double seconds(F&& f) {
+  auto t0 = Clock::now();
+  f();
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+struct Row {
+  std::string app;
+  std::size_t n = 0;
+  double conv_s = 0, scratch_s = 0, overhead = 0, update_s = 0, speedup = 0;
+  std::size_t trace_bytes = 0;
+  double bytes_per_elem = 0;
+  bool verified = true;
+  double mean_distance = 0;
+};
+
+Row run_app(const std::string& name, std::size_t n, std::size_t updates, std::uint64_t seed) {
+  Row row;
+  row.app = name;
+  row.n = n;
+  auto app = sacapps::make_app(name);
+  app->generate(n, seed);
+
+  std::vector<double> conv;
+  for (int i = 0; i < 3; ++i) conv.push_back(seconds([&] { app->run_conventional(); }));
+  std::sort(conv.begin(), conv.end());
+  row.conv_s = conv[1];
+
+  row.scratch_s = seconds([&] { app->run_self_adjusting(); });
+  row.trace_bytes = app->engine().trace_bytes();
+  row.bytes_per_elem = n ? static_cast<double>(row.trace_bytes) / static_cast<double>(n) : 0.0;
+  row.verified = app->verify();
+
+  const std::size_t positions = app->positions();
+  const std::size_t u = std::min(updates, positions);
+  double total = 0;
+  std::uint64_t distance = 0;
+  std::size_t count = 0;
+  for (std::size_t k = 0; k < u; ++k) {
+    const std::size_t i = ((2 * k + 1) * positions) / (2 * u);
+    if (!app->present(i)) continue;
+    app->remove(i);
+    total += seconds([&] { app->engine().propagate(); });
+    distance += app->engine().stats().last_trace_distance;
+    row.verified = row.verified && app->verify();
+    app->reinsert(i);
+    total += seconds([&] { app->engine().propagate(); });
+    distance += app->engine().stats().last_trace_distance;
+    row.verified = row.verified && app->verify();
+    count += 2;
+  }
+  row.update_s = count ? total / static_cast<double>(count) : 0.0;
+  row.mean_distance = count ? static_cast<double>(distance) / static_cast<double>(count) : 0.0;
+  row.overhead = row.conv_s > 0 ? row.scratch_s / row.conv_s : 0.0;
+  row.speedup = row.update_s > 0 ? row.conv_s / row.update_s : 0.0;
+  return row;
+}
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App cli{"sac_suite: the classic self-adjusting computation benchmarks"};
+  std::string apps_arg;
+  std::size_t n = 100000;
+  std::size_t updates = 100;
+  std::uint64_t seed = 1;
+  bool csv = false;
+  cli.add_option("--apps", apps_arg, "comma-separated apps (default: all)");
+  cli.add_option("--n", n, "input size")->check(CLI::NonNegativeNumber);
+  cli.add_option("--updates", updates, "positions updated (delete+reinsert each)");
+  cli.add_option("--seed", seed, "input seed");
+  cli.add_flag("--csv", csv, "print CSV instead of a table");
+  CLI11_PARSE(cli, argc, argv);
+
+  std::vector<std::string> apps = apps_arg.empty() ? sacapps::app_names() : split(apps_arg);
+  for (const auto& a : apps)
+    if (!sacapps::make_app(a)) {
+      std::cerr << "sac_suite: unknown app '" << a << "'\n";
+      return 2;
+    }
+
+  if (csv)
+    std::printf("app,n,conv_s,scratch_s,overhead,update_s,speedup,trace_bytes,bytes_per_elem,verified\n");
+  else
+    std::printf("%-10s %9s %10s %10s %9s %11s %10s %12s %9s %9s %4s\n", "app", "n", "conv_s",
+                "scratch_s", "overhead", "update_s", "speedup", "trace_bytes", "B/elem",
+                "distance", "ok");
+  bool all_ok = true;
+  for (const auto& a : apps) {
+    Row r = run_app(a, n, updates, seed);
+    all_ok = all_ok && r.verified;
+    if (csv)
+      std::printf("%s,%zu,%.6g,%.6g,%.4g,%.6g,%.6g,%zu,%.4g,%d\n", r.app.c_str(), r.n, r.conv_s,
+                  r.scratch_s, r.overhead, r.update_s, r.speedup, r.trace_bytes,
+                  r.bytes_per_elem, r.verified ? 1 : 0);
+    else
+      std::printf("%-10s %9zu %10.4g %10.4g %9.3g %11.4g %10.4g %12zu %9.1f %9.1f %4s\n",
+                  r.app.c_str(), r.n, r.conv_s, r.scratch_s, r.overhead, r.update_s, r.speedup,
+                  r.trace_bytes, r.bytes_per_elem, r.mean_distance, r.verified ? "yes" : "NO");
+    std::fflush(stdout);
+  }
+  return all_ok ? 0 : 1;
+}
