@@ -151,8 +151,47 @@ void Engine::exec_read(ReadNode* r) {
   VersionBase* v = visible(*r->mod, &r->start);
   if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
   attach(r, v);
-  tasks_.push_back(Task{TaskKind::CloseRead, r});
+  push_close(&r->end, TaskKind::CloseRead, r);
   exec_body([&] { r->ops->invoke(*this, r, v); });
+}
+
+void Engine::push_close(Stamp* end, TaskKind kind, void* node) {
+  // A call that was the last one issued by its parent closes right before the parent does:
+  // chain it onto the parent's pending close (through the unlinked end stamp's link field)
+  // instead of stacking one task per level, so a chain of a million tail reads needs one task.
+  if (!tasks_.empty() && (tasks_.back().kind == TaskKind::CloseRead ||
+                          tasks_.back().kind == TaskKind::CloseMemo)) {
+    Task& top = tasks_.back();
+    end->link = reinterpret_cast<std::uintptr_t>(top.node) |
+                (top.kind == TaskKind::CloseMemo ? std::uintptr_t{1} : 0);
+    top = Task{kind, node};
+    return;
+  }
+  end->link = 0;
+  tasks_.push_back(Task{kind, node});
+}
+
+void Engine::close_chain(TaskKind kind, void* node) {
+  while (node) {
+    Stamp* end;
+    std::uint64_t* flags;
+    if (kind == TaskKind::CloseRead) {
+      auto* r = static_cast<ReadNode*>(node);
+      end = &r->end;
+      flags = nullptr;
+      r->flags |= detail::kReadEndLinked;
+    } else {
+      auto* n = static_cast<MemoNode*>(node);
+      end = &n->end;
+      flags = &n->flags;
+    }
+    const std::uintptr_t next = end->link;
+    order_.insert_after(now_, end, kind == TaskKind::CloseRead ? StampKind::ReadEnd : StampKind::MemoEnd);
+    now_ = end;
+    if (flags) *flags |= detail::kReadEndLinked;
+    kind = (next & 1) ? TaskKind::CloseMemo : TaskKind::CloseRead;
+    node = reinterpret_cast<void*>(next & ~std::uintptr_t{1});
+  }
 }
 
 void Engine::execute(const Task& t) {
@@ -189,24 +228,14 @@ void Engine::execute(const Task& t) {
         ++stats_.memo_misses;
       }
       link_memo(n, h);
-      tasks_.push_back(Task{TaskKind::CloseMemo, n});
+      push_close(&n->end, TaskKind::CloseMemo, n);
       exec_body([&] { n->invoke(*this, n); });
       break;
     }
-    case TaskKind::CloseRead: {
-      auto* r = static_cast<ReadNode*>(t.node);
-      order_.insert_after(now_, &r->end, StampKind::ReadEnd);
-      now_ = &r->end;
-      r->flags |= detail::kReadEndLinked;
+    case TaskKind::CloseRead:
+    case TaskKind::CloseMemo:
+      close_chain(t.kind, t.node);
       break;
-    }
-    case TaskKind::CloseMemo: {
-      auto* n = static_cast<MemoNode*>(t.node);
-      order_.insert_after(now_, &n->end, StampKind::MemoEnd);
-      now_ = &n->end;
-      n->flags |= detail::kReadEndLinked;
-      break;
-    }
     case TaskKind::Rerun: {
       auto* r = static_cast<ReadNode*>(t.node);
       reruns_.push_back(RerunContext{now_, window_end_});

@@ -1,22 +1,104 @@
-// Pool chunk acquisition (kept out of line: it is the cold path).
+// Pool chunk acquisition and release (the cold path).
 #include "sac/detail/pool.hpp"
 
 #include <sys/mman.h>
 
+#include <cstdlib>
+#include <mutex>
+#include <vector>
+
 namespace sac::detail {
+
+namespace {
+
+// Freed huge chunks are kept for later pools (as malloc keeps freed heap), up to a bound,
+// so that engines created one after another do not pay the kernel's first-touch zeroing
+// again. SAC_CHUNK_CACHE_MB sets the bound (default 1024; 0 disables the cache).
+class ChunkCache {
+ public:
+  static ChunkCache& instance() {
+    static ChunkCache* c = new ChunkCache;  // never destroyed: pools may die during exit
+    return *c;
+  }
+  void* take(std::size_t size) {
+    std::lock_guard<std::mutex> lock(mu_);
+    for (std::size_t i = 0; i < free_.size(); ++i)
+      if (free_[i].size == size) {
+        void* p = free_[i].base;
+        free_[i] = free_.back();
+        free_.pop_back();
+        held_ -= size;
+        return p;
+      }
+    return nullptr;
+  }
+  bool give(void* base, std::size_t size) {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (held_ + size > limit_) return false;
+    free_.push_back({base, size});
+    held_ += size;
+    return true;
+  }
+
+ private:
+  ChunkCache() {
+    std::size_t mb = 1024;
+    if (const char* e = std::getenv("SAC_CHUNK_CACHE_MB")) mb = std::strtoull(e, nullptr, 10);
+    limit_ = mb << 20;
+  }
+  struct Entry {
+    void* base;
+    std::size_t size;
+  };
+  std::mutex mu_;
+  std::vector<Entry> free_;
+  std::size_t held_ = 0;
+  std::size_t limit_ = 0;
+};
+
+void* map_huge(std::size_t size) {
+  // Over-map by one huge page and trim, so that the chunk is 2 MiB-aligned.
+  const std::size_t align = Pool::kHugeChunk;
+  void* raw = ::mmap(nullptr, size + align, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS,
+                     -1, 0);
+  if (raw == MAP_FAILED) throw std::bad_alloc();
+  const auto r = reinterpret_cast<std::uintptr_t>(raw);
+  const std::uintptr_t a = (r + align - 1) & ~(align - 1);
+  if (a > r) ::munmap(raw, a - r);
+  if (const std::uintptr_t tail = r + size + align - (a + size)) ::munmap(reinterpret_cast<void*>(a + size), tail);
+#ifdef MADV_HUGEPAGE
+  ::madvise(reinterpret_cast<void*>(a), size, MADV_HUGEPAGE);  // advisory
+#endif
+  return reinterpret_cast<void*>(a);
+}
+
+}  // namespace
 
 void Pool::new_chunk() {
   const std::size_t size = next_chunk_;
-  void* c = size >= kHugeChunk ? std::aligned_alloc(kHugeChunk, size) : std::malloc(size);
+  void* c = nullptr;
+  if (size >= kHugeChunk) {
+    c = ChunkCache::instance().take(size);
+    if (!c) c = map_huge(size);
+  } else {
+    c = std::malloc(size);
+  }
   if (!c) throw std::bad_alloc();
-#ifdef MADV_HUGEPAGE
-  if (size >= kHugeChunk) ::madvise(c, size, MADV_HUGEPAGE);  // advisory; failure is harmless
-#endif
-  chunks_.push_back(c);
+  chunks_.push_back(Chunk{c, size});
   reserved_ += size;
   cur_ = static_cast<char*>(c);
   end_ = cur_ + size;
-  if (next_chunk_ < kHugeChunk) next_chunk_ *= 2;
+  if (next_chunk_ < kMaxChunk) next_chunk_ *= 2;
+}
+
+void Pool::release() noexcept {
+  for (const Chunk& c : chunks_) {
+    if (c.size >= kHugeChunk) {
+      if (!ChunkCache::instance().give(c.base, c.size)) ::munmap(c.base, c.size);
+    }
+    else std::free(c.base);
+  }
+  chunks_.clear();
 }
 
 }  // namespace sac::detail

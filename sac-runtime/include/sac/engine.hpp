@@ -237,6 +237,8 @@ class Engine {
   void drain(std::size_t floor);
   void execute(const Task& t);
   void exec_read(detail::ReadNode* r);
+  void push_close(Stamp* end, TaskKind kind, void* node);
+  void close_chain(TaskKind kind, void* node);
   void discard_pending() noexcept;
   void link_write(ModBase& m, detail::VersionBase* v);
   void unlink_version(detail::VersionBase* v);
