@@ -298,6 +298,8 @@ void Engine::discard_pending() noexcept {
   issued_.clear();
   reruns_.clear();
   body_mark_ = 0;
+  pending_allocs_ = nullptr;  // still in the trace; destroy_all frees them from there
+  pending_count_ = 0;
 }
 
 void Engine::enqueue(ReadNode* r) {
@@ -383,7 +385,27 @@ void Engine::link_alloc(AllocNode* n, std::size_t h) {
   now_ = &n->stamp;
   ++stats_.events_created;
   ++stats_.live_events;
-  if (n->ops->key_equal) allocs_.insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
+  if (!n->ops->key_equal) return;
+  if (window_end_) {
+    allocs_.insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
+  } else {
+    n->hnext = pending_allocs_;
+    pending_allocs_ = n;
+    ++pending_count_;
+  }
+}
+
+void Engine::index_pending_allocs() {
+  auto hash_of = [](const AllocNode* x) { return x->ops->hash(x); };
+  allocs_.reserve(allocs_.size() + pending_count_, hash_of);
+  for (AllocNode* n = pending_allocs_; n;) {
+    AllocNode* nx = n->hnext;
+    if (nx) __builtin_prefetch(nx);
+    allocs_.insert(n, hash_of(n), hash_of);
+    n = nx;
+  }
+  pending_allocs_ = nullptr;
+  pending_count_ = 0;
 }
 
 void Engine::link_memo(MemoNode* n, std::size_t h) {

@@ -259,6 +259,7 @@ class Engine {
   void undo(Stamp* s);
   void enqueue(detail::ReadNode* r);
   void free_deferred() noexcept;
+  void index_pending_allocs();
   void destroy_all() noexcept;
 
   detail::VersionBase* visible(const ModBase& m, const Stamp* t) const;
@@ -285,6 +286,11 @@ class Engine {
   detail::IntrusiveHash<detail::AllocNode> allocs_;
   detail::IntrusiveHash<detail::MemoNode> memos_;
   std::vector<detail::AllocNode*> deferred_;   // undone allocations, freed by propagate()
+  // Keyed allocations of the running run(), chained through hnext: nothing can look them up
+  // before the run ends (there is no re-execution window), so they are indexed in one
+  // presized pass at its end instead of through log n table doublings over cold records.
+  detail::AllocNode* pending_allocs_ = nullptr;
+  std::size_t pending_count_ = 0;
   std::vector<detail::VersionBase*> bases_;    // base versions; index kept in stamp.label
   std::vector<Task> tasks_;                    // the trampoline's stack
   std::vector<RerunContext> reruns_;           // contexts saved by the running re-executions
@@ -343,6 +349,7 @@ void Engine::run(F&& f) {
     poison();
     throw;
   }
+  index_pending_allocs();
   tail_ = now_;
   now_ = nullptr;
   in_computation_ = false;

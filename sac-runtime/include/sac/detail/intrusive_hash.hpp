@@ -30,6 +30,14 @@ class IntrusiveHash {
     ++size_;
   }
 
+  /// Grows (once) so that `count` records fit without further growth.
+  template <class HashOf>
+  void reserve(std::size_t count, HashOf&& hash_of) {
+    std::size_t want = buckets_.empty() ? 64 : buckets_.size();
+    while (count > 2 * want) want *= 2;
+    if (want != buckets_.size()) rebucket(want, hash_of);
+  }
+
   void erase(N* n, std::size_t h) {
     N** pp = &buckets_[h & (buckets_.size() - 1)];
     while (*pp != n) pp = &(*pp)->hnext;
@@ -70,13 +78,16 @@ class IntrusiveHash {
 
  private:
   template <class HashOf>
-  void grow(HashOf& hash_of) {
-    // Records are long out of cache when the table doubles; prefetching the chains a few
-    // buckets ahead overlaps those misses (this walk dominated from-scratch keyed allocation).
+  void grow(HashOf& hash_of) { rebucket(buckets_.empty() ? 64 : buckets_.size() * 2, hash_of); }
+
+  template <class HashOf>
+  void rebucket(std::size_t nbuckets, HashOf& hash_of) {
+    // Records are long out of cache when the table grows; prefetching the chains a few
+    // buckets ahead overlaps those misses.
     constexpr std::size_t kAhead = 16;
     std::vector<N*> old;
     old.swap(buckets_);
-    buckets_.assign(old.empty() ? 64 : old.size() * 2, nullptr);
+    buckets_.assign(nbuckets, nullptr);
     const std::size_t mask = buckets_.size() - 1;
     for (std::size_t i = 0; i < old.size(); ++i) {
       if (i + kAhead < old.size() && old[i + kAhead]) __builtin_prefetch(old[i + kAhead]);
