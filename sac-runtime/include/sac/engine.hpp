@@ -97,7 +97,10 @@ struct ReadOpsFor {
   }
   static void destroy(ReadNode* r) noexcept { static_cast<ReadNodeT<F>*>(r)->~ReadNodeT<F>(); }
   static bool equal(const ReadNode* r, const void* c) {
-    return static_cast<const ReadNodeT<F>*>(r)->fn == *static_cast<const F*>(c);
+    if constexpr (std::equality_comparable<F>)
+      return static_cast<const ReadNodeT<F>*>(r)->fn == *static_cast<const F*>(c);
+    else
+      return false;  // plain read() with a lambda: never matched
   }
   static constexpr ReadOps ops{&invoke, &destroy,
                                std::equality_comparable<F> ? &equal : nullptr,
