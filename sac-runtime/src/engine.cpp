@@ -132,7 +132,12 @@ void Engine::flush() {
   const std::size_t floor = tasks_.size();
   for (std::size_t i = issued_.size(); i-- > body_mark_;) tasks_.push_back(issued_[i]);
   issued_.resize(body_mark_);
+  // The close below the floor belongs to the body that is still running: nothing flushed
+  // here may be chained onto it.
+  const std::size_t saved = close_floor_;
+  close_floor_ = floor;
   drain(floor);
+  close_floor_ = saved;
 }
 
 void Engine::drain(std::size_t floor) {
@@ -159,8 +164,8 @@ void Engine::push_close(Stamp* end, TaskKind kind, void* node) {
   // A call that was the last one issued by its parent closes right before the parent does:
   // chain it onto the parent's pending close (through the unlinked end stamp's link field)
   // instead of stacking one task per level, so a chain of a million tail reads needs one task.
-  if (!tasks_.empty() && (tasks_.back().kind == TaskKind::CloseRead ||
-                          tasks_.back().kind == TaskKind::CloseMemo)) {
+  if (tasks_.size() > close_floor_ && (tasks_.back().kind == TaskKind::CloseRead ||
+                                       tasks_.back().kind == TaskKind::CloseMemo)) {
     Task& top = tasks_.back();
     end->link = reinterpret_cast<std::uintptr_t>(top.node) |
                 (top.kind == TaskKind::CloseMemo ? std::uintptr_t{1} : 0);
@@ -298,6 +303,7 @@ void Engine::discard_pending() noexcept {
   issued_.clear();
   reruns_.clear();
   body_mark_ = 0;
+  close_floor_ = 0;
   pending_allocs_ = nullptr;  // still in the trace; destroy_all frees them from there
   pending_count_ = 0;
 }

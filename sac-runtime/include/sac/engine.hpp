@@ -299,6 +299,7 @@ class Engine {
   std::vector<RerunContext> reruns_;           // contexts saved by the running re-executions
   std::vector<Task> issued_;                   // calls issued by the running bodies
   std::size_t body_mark_ = 0;                  // issued_ entries below this belong to callers
+  std::size_t close_floor_ = 0;                // closes below this may not be chained onto
 
   Stamp* now_ = nullptr;          // events are inserted after this stamp
   Stamp* window_end_ = nullptr;   // end of the re-execution window; null when running fresh

@@ -1,0 +1,251 @@
+// Micro-benchmarks of the runtime's hot primitives (Google Benchmark; linked into sac_micro
+// with benchmark_main).
+//
+//   OrderList:  append insert, insert after a random existing stamp, less() on random pairs.
+//   StampQueue: push n elements in random order, then pop them all.
+//   Engine:     from-scratch run of n reads that each write (per element), a run of n writes,
+//               and change propagation of a memoized map over a list (one remove or reinsert
+//               per propagate; memo_read hits reuse the rest of the list).
+// Items processed = primitive operations, so the reported items/s invert to ns per operation.
+// Setup (building lists, engines, inputs) is excluded from timing; fixed seeds.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "sac/sac.hpp"
+
+namespace {
+
+using sac::Engine;
+using sac::Mod;
+using sac::OrderList;
+using sac::Stamp;
+using sac::StampKind;
+
+// ------------------------------------------------------------------------- OrderList
+
+void BM_OrderListAppend(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  std::vector<Stamp> stamps(n);
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto ol = std::make_unique<OrderList>();
+    for (Stamp& s : stamps) s = Stamp{};
+    state.ResumeTiming();
+    Stamp* pos = ol->base();
+    for (Stamp& s : stamps) {
+      ol->insert_after(pos, &s, StampKind::User);
+      pos = &s;
+    }
+    benchmark::DoNotOptimize(ol->size());
+    state.PauseTiming();
+    ol.reset();
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(n));
+}
+BENCHMARK(BM_OrderListAppend)->Arg(1 << 12)->Arg(1 << 20);
+
+/// Builds n stamps, each inserted right after a uniformly random earlier stamp (or the base).
+void build_random(OrderList& ol, std::vector<Stamp>& stamps, const std::vector<std::uint32_t>& where) {
+  for (std::size_t i = 0; i < stamps.size(); ++i) {
+    Stamp* pos = where[i] == 0 ? ol.base() : &stamps[where[i] - 1];
+    ol.insert_after(pos, &stamps[i], StampKind::User);
+  }
+}
+
+std::vector<std::uint32_t> random_positions(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::vector<std::uint32_t> where(n);
+  for (std::size_t i = 0; i < n; ++i) where[i] = static_cast<std::uint32_t>(rng() % (i + 1));
+  return where;
+}
+
+void BM_OrderListInsertRandom(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  std::vector<Stamp> stamps(n);
+  const std::vector<std::uint32_t> where = random_positions(n, 1);
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto ol = std::make_unique<OrderList>();
+    for (Stamp& s : stamps) s = Stamp{};
+    state.ResumeTiming();
+    build_random(*ol, stamps, where);
+    benchmark::DoNotOptimize(ol->size());
+    state.PauseTiming();
+    ol.reset();
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(n));
+}
+BENCHMARK(BM_OrderListInsertRandom)->Arg(1 << 12)->Arg(1 << 20);
+
+void BM_OrderListLess(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  std::vector<Stamp> stamps(n);
+  OrderList ol;
+  build_random(ol, stamps, random_positions(n, 2));
+  constexpr std::size_t kPairs = 4096;
+  std::mt19937_64 rng(3);
+  std::vector<std::pair<const Stamp*, const Stamp*>> pairs(kPairs);
+  for (auto& p : pairs) p = {&stamps[rng() % n], &stamps[rng() % n]};
+  for (auto _ : state) {
+    std::size_t count = 0;
+    for (const auto& p : pairs) count += ol.less(p.first, p.second) ? 1 : 0;
+    benchmark::DoNotOptimize(count);
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(kPairs));
+}
+BENCHMARK(BM_OrderListLess)->Arg(1 << 12)->Arg(1 << 20);
+
+// ------------------------------------------------------------------------- StampQueue
+
+struct QElem {
+  Stamp stamp;
+  std::uint32_t qpos = sac::kNotQueued;
+};
+struct QTraits {
+  static const Stamp* stamp(const QElem* e) { return &e->stamp; }
+  static std::uint32_t& pos(QElem* e) { return e->qpos; }
+  static std::uint32_t pos(const QElem* e) { return e->qpos; }
+};
+
+void BM_StampQueuePushPop(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  std::deque<QElem> elems(n);
+  OrderList ol;
+  Stamp* pos = ol.base();
+  for (QElem& e : elems) {
+    ol.insert_after(pos, &e.stamp, StampKind::User);
+    pos = &e.stamp;
+  }
+  std::vector<QElem*> order;
+  for (QElem& e : elems) order.push_back(&e);
+  std::shuffle(order.begin(), order.end(), std::mt19937_64(4));
+  sac::StampQueue<QElem, QTraits> q(ol);
+  for (auto _ : state) {
+    for (QElem* e : order) q.push(e);
+    while (!q.empty()) benchmark::DoNotOptimize(q.pop());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * 2 * static_cast<std::int64_t>(n));
+}
+BENCHMARK(BM_StampQueuePushPop)->Arg(1 << 10)->Arg(1 << 16);
+
+// ------------------------------------------------------------------------- Engine
+
+// Read bodies are comparable structs rather than lambdas (read() currently needs an
+// operator== on the closure; see tests/sac/engine_test.cpp, PlainLambdaReadBodies_Bug).
+struct AddOne {
+  Mod<int>* out;
+  void operator()(Engine& e, int v) const { e.write(*out, v + 1); }
+  bool operator==(const AddOne&) const = default;
+};
+
+/// Inputs and outputs of the flat benchmarks; fresh per engine (a Mod belongs to one engine).
+struct Flat {
+  std::vector<Mod<int>> in, out;
+  explicit Flat(std::size_t n) : in(n), out(n) {}
+};
+
+void BM_EngineReadWriteFromScratch(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto e = std::make_unique<Engine>();
+    auto f = std::make_unique<Flat>(n);
+    for (std::size_t i = 0; i < n; ++i) e->set(f->in[i], static_cast<int>(i));
+    state.ResumeTiming();
+    e->run([&](Engine& en) {
+      for (std::size_t i = 0; i < n; ++i) en.read(f->in[i], AddOne{&f->out[i]});
+    });
+    benchmark::DoNotOptimize(f->out[n - 1].get());
+    state.PauseTiming();
+    e.reset();
+    f.reset();
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(n));
+}
+BENCHMARK(BM_EngineReadWriteFromScratch)->Arg(1 << 10)->Arg(1 << 18);
+
+void BM_EngineWrite(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto e = std::make_unique<Engine>();
+    auto f = std::make_unique<Flat>(n);
+    state.ResumeTiming();
+    e->run([&](Engine& en) {
+      for (std::size_t i = 0; i < n; ++i) en.write(f->out[i], static_cast<int>(i));
+    });
+    benchmark::DoNotOptimize(f->out[n - 1].get());
+    state.PauseTiming();
+    e.reset();
+    f.reset();
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(n));
+}
+BENCHMARK(BM_EngineWrite)->Arg(1 << 10)->Arg(1 << 18);
+
+// Map over a modifiable list: output cells keyed by the input cell's id; the recursion is
+// memoized with memo_read, so one remove/reinsert re-runs one read and reuses the rest of the
+// list through a memo hit.
+struct Cell {
+  int value;
+  std::uint64_t id;
+  Mod<Cell*> next;
+  Cell(int v, std::uint64_t i) : value(v), id(i) {}
+};
+struct OutCell {
+  int value;
+  Mod<OutCell*> next;
+  explicit OutCell(int v) : value(v) {}
+};
+
+void map_step(Engine& e, Cell* c, Mod<OutCell*>* dst) {
+  if (!c) {
+    e.write(*dst, static_cast<OutCell*>(nullptr));
+    return;
+  }
+  OutCell* o = e.alloc<OutCell>(c->id, 2 * c->value);
+  e.write(*dst, o);
+  e.memo_read(c->next, sac::fn<map_step>(&o->next));
+}
+
+void BM_EngineMemoMapPropagate(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  Engine e;
+  Mod<Cell*> head;
+  Mod<OutCell*> out;
+  std::vector<std::unique_ptr<Cell>> cells;
+  for (std::size_t i = 0; i < n; ++i) cells.push_back(std::make_unique<Cell>(static_cast<int>(i), i));
+  for (std::size_t i = 0; i < n; ++i) e.set(cells[i]->next, i + 1 < n ? cells[i + 1].get() : nullptr);
+  e.set(head, cells[0].get());
+  e.run([&](Engine& en) { en.memo_read(head, sac::fn<map_step>(&out)); });
+  std::mt19937_64 rng(5);
+  const std::uint64_t hits0 = e.stats().memo_hits;
+  std::uint64_t propagations = 0;
+  for (auto _ : state) {
+    // Remove element i (1 <= i < n-1) and put it back: two propagations.
+    const std::size_t i = 1 + static_cast<std::size_t>(rng() % (n - 2));
+    Cell* c = cells[i].get();
+    e.set(cells[i - 1]->next, c->next.get());
+    e.propagate();
+    e.set(cells[i - 1]->next, c);
+    e.propagate();
+    propagations += 2;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(propagations));
+  state.counters["memo_hits_per_propagate"] =
+      propagations ? static_cast<double>(e.stats().memo_hits - hits0) / static_cast<double>(propagations) : 0.0;
+  state.counters["live_events"] = static_cast<double>(e.live_events());
+}
+BENCHMARK(BM_EngineMemoMapPropagate)->Arg(1 << 10)->Arg(1 << 16);
+
+}  // namespace
