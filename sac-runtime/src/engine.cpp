@@ -347,8 +347,8 @@ ReadNode* Engine::find_read_match(const ModBase& m, const detail::ReadOps* ops,
   ReadNode* best = nullptr;
   for (VersionBase* v = m.newest_; v; v = v->older())
     for (ReadNode* r = v->readers; r; r = r->rnext)
-      if (r->ops == ops && in_window(&r->start, &r->end) &&
-          ops->equal(r, closure) && (!best || order_.less(&r->start, &best->start)))
+      if (r->ops == ops && ops->equal(r, closure) && in_window(&r->start, &r->end) &&
+          (!best || order_.less(&r->start, &best->start)))
         best = r;
   return best;
 }
@@ -357,7 +357,7 @@ AllocNode* Engine::find_alloc_match(const detail::AllocOps* ops, std::size_t h,
                                     const void* key) const {
   AllocNode* best = nullptr;
   for (AllocNode* n = allocs_.bucket(h); n; n = n->hnext)
-    if (n->ops == ops && in_window(&n->stamp, &n->stamp) && ops->key_equal(n, key) &&
+    if (n->ops == ops && ops->key_equal(n, key) && in_window(&n->stamp, &n->stamp) &&
         (!best || order_.less(&n->stamp, &best->stamp)))
       best = n;
   return best;
@@ -367,7 +367,7 @@ MemoNode* Engine::find_memo_match(const detail::MemoOps* ops, std::size_t h,
                                   const void* closure) const {
   MemoNode* best = nullptr;
   for (MemoNode* n = memos_.bucket(h); n; n = n->hnext)
-    if (n->ops == ops && in_window(&n->start, &n->end) && ops->equal(n, closure) &&
+    if (n->ops == ops && ops->equal(n, closure) && in_window(&n->start, &n->end) &&
         (!best || order_.less(&n->start, &best->start)))
       best = n;
   return best;
