@@ -88,8 +88,7 @@ void Engine::set_base(ModBase& m, VersionBase* fresh,
   for (VersionBase* v = m.newest_; v; v = v->older()) last = v;
   if (VersionBase* base = last && last->is_base() ? last : nullptr) {
     const bool changed = assign_if_changed(base, fresh);
-    fresh->ops->destroy(fresh);
-    deallocate(fresh, fresh->ops->size);
+    destroy(fresh);
     if (changed)
       for (ReadNode* r = base->readers; r; r = r->rnext) enqueue(r);
     return;
@@ -118,10 +117,8 @@ void Engine::retire(ModBase& m) {
   bases_[i]->stamp.label = i;
   bases_.pop_back();
   m.newest_ = nullptr;
-  const detail::VersionOps* ops = v->ops;
-  input_bytes_ -= (ops->size + 7) & ~std::size_t{7};
-  ops->destroy(v);
-  deallocate(v, ops->size);
+  input_bytes_ -= (v->ops->size + 7) & ~std::size_t{7};
+  destroy(v);
 }
 
 // ------------------------------------------------------------------ the trampoline
@@ -208,9 +205,7 @@ void Engine::execute(const Task& t) {
       auto* r = static_cast<ReadNode*>(t.node);
       if (window_end_) {
         if (ReadNode* hit = find_read_match(*r->mod, r->ops, closure_of(r))) {
-          const detail::ReadOps* ops = r->ops;
-          ops->destroy(r);
-          deallocate(r, ops->size);
+          destroy(r);
           memo_hit(&hit->start, &hit->end);
           break;
         }
@@ -224,9 +219,7 @@ void Engine::execute(const Task& t) {
       const std::size_t h = n->ops->hash(n);
       if (window_end_) {
         if (MemoNode* hit = find_memo_match(n->ops, h, reinterpret_cast<const MemoNode*>(n) + 1)) {
-          const detail::MemoOps* ops = n->ops;
-          ops->destroy(n);
-          deallocate(n, ops->size);
+          destroy(n);
           memo_hit(&hit->start, &hit->end);
           break;
         }
@@ -287,14 +280,10 @@ void Engine::discard_pending() noexcept {
   auto discard = [this](const Task& t) {
     if (t.kind == TaskKind::ExecRead || t.kind == TaskKind::ExecMemoRead) {
       auto* r = static_cast<ReadNode*>(t.node);
-      const detail::ReadOps* ops = r->ops;
-      ops->destroy(r);
-      deallocate(r, ops->size);
+      destroy(r);
     } else if (t.kind == TaskKind::ExecMemo) {
       auto* n = static_cast<MemoNode*>(t.node);
-      const detail::MemoOps* ops = n->ops;
-      ops->destroy(n);
-      deallocate(n, ops->size);
+      destroy(n);
     }
   };
   for (const Task& t : tasks_) discard(t);
@@ -445,9 +434,7 @@ void Engine::undo(Stamp* s) {
     }
     case StampKind::ReadEnd: {
       ReadNode* r = detail::read_of_end(s);
-      const detail::ReadOps* ops = r->ops;
-      ops->destroy(r);
-      deallocate(r, ops->size);
+      destroy(r);
       break;
     }
     case StampKind::Write: {
@@ -467,9 +454,7 @@ void Engine::undo(Stamp* s) {
           r = nx;
         }
       }
-      const detail::VersionOps* ops = v->ops;
-      ops->destroy(v);
-      deallocate(v, ops->size);
+      destroy(v);
       break;
     }
     case StampKind::Alloc: {
@@ -490,9 +475,7 @@ void Engine::undo(Stamp* s) {
     }
     case StampKind::MemoEnd: {
       MemoNode* n = detail::memo_of_end(s);
-      const detail::MemoOps* ops = n->ops;
-      ops->destroy(n);
-      deallocate(n, ops->size);
+      destroy(n);
       break;
     }
     case StampKind::Sentinel:
@@ -514,9 +497,7 @@ void Engine::unlink_version(VersionBase* v) {
 
 void Engine::free_deferred() noexcept {
   for (AllocNode* n : deferred_) {
-    const detail::AllocOps* ops = n->ops;
-    ops->destroy(n);
-    deallocate(n, ops->size);
+    destroy(n);
   }
   deferred_.clear();
 }
@@ -530,47 +511,35 @@ void Engine::destroy_all() noexcept {
       case StampKind::ReadStart: {
         ReadNode* r = detail::read_of_start(s);
         if (!(r->flags & detail::kReadEndLinked)) {  // its body threw: no end stamp
-          const detail::ReadOps* ops = r->ops;
-          ops->destroy(r);
-          deallocate(r, ops->size);
+          destroy(r);
         }
         break;
       }
       case StampKind::ReadEnd: {
         ReadNode* r = detail::read_of_end(s);
-        const detail::ReadOps* ops = r->ops;
-        ops->destroy(r);
-        deallocate(r, ops->size);
+        destroy(r);
         break;
       }
       case StampKind::Write: {
         VersionBase* v = detail::version_of(s);
-        const detail::VersionOps* ops = v->ops;
-        ops->destroy(v);
-        deallocate(v, ops->size);
+        destroy(v);
         break;
       }
       case StampKind::Alloc: {
         AllocNode* n = detail::alloc_of(s);
-        const detail::AllocOps* ops = n->ops;
-        ops->destroy(n);
-        deallocate(n, ops->size);
+        destroy(n);
         break;
       }
       case StampKind::MemoStart: {
         MemoNode* n = detail::memo_of_start(s);
         if (!(n->flags & detail::kReadEndLinked)) {
-          const detail::MemoOps* ops = n->ops;
-          ops->destroy(n);
-          deallocate(n, ops->size);
+          destroy(n);
         }
         break;
       }
       case StampKind::MemoEnd: {
         MemoNode* n = detail::memo_of_end(s);
-        const detail::MemoOps* ops = n->ops;
-        ops->destroy(n);
-        deallocate(n, ops->size);
+        destroy(n);
         break;
       }
       default:
@@ -580,9 +549,7 @@ void Engine::destroy_all() noexcept {
   }
   free_deferred();
   for (VersionBase* v : bases_) {
-    const detail::VersionOps* ops = v->ops;
-    ops->destroy(v);
-    deallocate(v, ops->size);
+    destroy(v);
   }
   bases_.clear();
   input_bytes_ = 0;

@@ -227,6 +227,25 @@ class Engine {
 
   void* allocate(std::size_t n) { return pool_.allocate(n); }
   void deallocate(void* p, std::size_t n) noexcept { pool_.deallocate(p, n); }
+  /// A record of type N from the pool; the memory goes back if the constructor throws.
+  template <class N, class... A>
+  N* construct(A&&... args) {
+    static_assert(alignof(N) <= detail::Pool::kGrain, "record over-aligned");
+    void* mem = allocate(sizeof(N));
+    try {
+      return new (mem) N(std::forward<A>(args)...);
+    } catch (...) {
+      deallocate(mem, sizeof(N));
+      throw;
+    }
+  }
+  /// Destroys a record through its ops table and returns its memory.
+  template <class Rec>
+  void destroy(Rec* r) noexcept {
+    const auto* ops = r->ops;
+    ops->destroy(r);
+    deallocate(r, ops->size);
+  }
 
   // Trace machinery (engine.cpp).
   void issue(TaskKind k, void* node) { issued_.push_back(Task{k, node}); }
@@ -316,14 +335,7 @@ template <class T, class U>
 void Engine::set(Mod<T>& m, U&& value) {
   require_mutator("set");
   using V = detail::Version<T>;
-  void* mem = allocate(sizeof(V));
-  V* v;
-  try {
-    v = new (mem) V(std::forward<U>(value));
-  } catch (...) {
-    deallocate(mem, sizeof(V));
-    throw;
-  }
+  V* v = construct<V>(std::forward<U>(value));
   v->ops = &detail::VersionOpsFor<T>::ops;
   set_base(m, v, [](detail::VersionBase* old_base, detail::VersionBase* fresh) {
     auto* o = static_cast<V*>(old_base);
@@ -363,16 +375,8 @@ template <class T, class F>
 void Engine::read(const Mod<T>& m, F&& body) {
   using Fn = std::decay_t<F>;
   using N = detail::ReadNodeT<Fn>;
-  static_assert(alignof(N) <= detail::Pool::kGrain, "closure over-aligned");
   require_computation("read");
-  void* mem = allocate(sizeof(N));
-  N* r;
-  try {
-    r = new (mem) N(std::forward<F>(body));
-  } catch (...) {
-    deallocate(mem, sizeof(N));
-    throw;
-  }
+  N* r = construct<N>(std::forward<F>(body));
   r->mod = &m;
   r->ops = &detail::ReadOpsFor<T, Fn>::ops;
   r->qpos = kNotQueued;
@@ -393,14 +397,7 @@ void Engine::write(Mod<T>& m, U&& value) {
   using V = detail::Version<T>;
   require_computation("write");
   flush_if_pending();
-  void* mem = allocate(sizeof(V));
-  V* v;
-  try {
-    v = new (mem) V(std::forward<U>(value));
-  } catch (...) {
-    deallocate(mem, sizeof(V));
-    throw;
-  }
+  V* v = construct<V>(std::forward<U>(value));
   v->ops = &detail::VersionOpsFor<T>::ops;
   link_write(m, v);
 }
@@ -410,7 +407,6 @@ T* Engine::alloc(const K& key, A&&... args) {
   static_assert(Hashable<K> && std::equality_comparable<K>,
                 "alloc keys must be hashable (sac::Hash) and equality comparable");
   using N = detail::AllocNodeT<T, K>;
-  static_assert(alignof(N) <= detail::Pool::kGrain, "object over-aligned");
   require_computation("alloc");
   flush_if_pending();
   const detail::AllocOps* ops = &detail::AllocOpsFor<T, K>::ops;
@@ -421,14 +417,7 @@ T* Engine::alloc(const K& key, A&&... args) {
       return &static_cast<N*>(hit)->object;
     }
   }
-  void* mem = allocate(sizeof(N));
-  N* n;
-  try {
-    n = new (mem) N(key, std::forward<A>(args)...);
-  } catch (...) {
-    deallocate(mem, sizeof(N));
-    throw;
-  }
+  N* n = construct<N>(key, std::forward<A>(args)...);
   n->ops = ops;
   link_alloc(n, h);
   return &n->object;
@@ -437,17 +426,9 @@ T* Engine::alloc(const K& key, A&&... args) {
 template <class T, class... A>
 T* Engine::make(A&&... args) {
   using N = detail::PlainAllocNodeT<T>;
-  static_assert(alignof(N) <= detail::Pool::kGrain, "object over-aligned");
   require_computation("make");
   flush_if_pending();
-  void* mem = allocate(sizeof(N));
-  N* n;
-  try {
-    n = new (mem) N(std::forward<A>(args)...);
-  } catch (...) {
-    deallocate(mem, sizeof(N));
-    throw;
-  }
+  N* n = construct<N>(std::forward<A>(args)...);
   n->ops = &detail::PlainAllocOpsFor<T>::ops;
   link_alloc(n, 0);
   return &n->object;
@@ -459,16 +440,8 @@ void Engine::memo(F&& f) {
   using N = detail::MemoNodeT<Fn>;
   static_assert(std::equality_comparable<Fn> && Hashable<Fn>,
                 "memo needs an equality-comparable, hashable closure: use sac::fn<f>(args...)");
-  static_assert(alignof(N) <= detail::Pool::kGrain, "closure over-aligned");
   require_computation("memo");
-  void* mem = allocate(sizeof(N));
-  N* n;
-  try {
-    n = new (mem) N(std::forward<F>(f));
-  } catch (...) {
-    deallocate(mem, sizeof(N));
-    throw;
-  }
+  N* n = construct<N>(std::forward<F>(f));
   n->ops = &detail::MemoOpsFor<Fn>::ops;
   n->invoke = [](Engine& e, detail::MemoNode* x) { detail::call_thunk(static_cast<N*>(x)->fn, e); };
   issue(TaskKind::ExecMemo, n);
