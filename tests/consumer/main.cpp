@@ -1,7 +1,21 @@
+// Builds against the installed sac and dynmesh packages and uses one thing from each.
+#include <array>
+#include <vector>
+
+#include <dynmesh/static_quadtree.hpp>
 #include <sac/sac.hpp>
 
 int main() {
   sac::Engine e;
-  (void)e;
-  return 0;
+  sac::Mod<int> in, out;
+  e.set(in, 1);
+  e.run([&](sac::Engine& rt) { rt.read(in, [po = &out](sac::Engine& r, int v) { r.write(*po, v + 1); }); });
+  e.set(in, 41);
+  e.propagate();
+  if (out.get() != 42) return 1;
+
+  const std::vector<dynmesh::Point<2>> pts{{{0.0, 0.0}}, {{1.0, 1.0}}};
+  const auto box = dynmesh::derive_box<2>(pts);
+  const auto tree = dynmesh::StaticQuadtree<2>::from_points(box, pts);
+  return tree.leaves().empty() ? 1 : 0;
 }

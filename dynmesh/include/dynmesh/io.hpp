@@ -1,0 +1,118 @@
+// dynmesh/io.hpp — reading point files and edit scripts, writing and reading `.cells`.
+//
+// Purpose: the file formats of FORMATS.md, exactly:
+//   * `.node` (Triangle 2D / TetGen 3D): header `<#vertices> <dim> <#attributes> <#markers>`
+//     (trailing header fields may be omitted as Triangle allows: dim defaults to the
+//     requested d, the others to 0), then `<vertex#> <x> <y> [<z>] [attributes] [marker]`.
+//     Numbering starts at 0 or 1 (decided by the first vertex) and must run consecutively.
+//     `#` starts a comment anywhere on a line; blank lines are skipped. Attributes and the
+//     marker, when present, must be numbers and are otherwise ignored; further fields are
+//     ignored.
+//   * plain text (any other name): one point per non-blank line, whitespace-separated; the
+//     first d fields are the coordinates and further columns are ignored (not parsed). `#`
+//     comments are allowed here too.
+//   * edit scripts: `+ x y [z]` / `- x y [z]`, exactly d coordinates, blank lines and `#`
+//     comments ignored. The sign must be a token of its own.
+//   * `.cells`: "# dynmesh cells v1", "# dim D", "# box o1 o2 [o3] L" (numbers printed as
+//     %.17g in the C locale), then one line `level i j [k] npoints` per leaf, sorted by
+//     (level, i, j, k); '\n' line ends.
+// Numbers are read with std::from_chars (locale-independent, correctly rounded): decimal or
+// scientific notation with an optional leading '+' or '-'; hexadecimal floats are not
+// accepted. A decimal overflow (1e999) is an infinity and an error; a decimal underflow
+// (1e-999) is the correctly rounded signed zero.
+// Every error is an InputError whose message names the file and the 1-based line:
+// Malformed (bad number or line shape), NotFinite (NaN, infinity), Count (too few or too many
+// fields or vertices), Duplicate (two points with equal located q, see locate_points),
+// OutsideBox, Io (cannot open or read).
+//
+// Invariants: PointFile::lines[i] is the line of points[i]; points keep file order. A
+// successful read never returns a NaN or infinite coordinate.
+// Complexity: linear in the file size; locate_points O(n log n).
+// Paper: none (formats of this project; Triangle and TetGen for `.node`).
+#pragma once
+
+#include <cstddef>
+#include <iosfwd>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/point.hpp"
+#include "dynmesh/static_quadtree.hpp"
+
+namespace dynmesh {
+
+template <std::size_t d>
+  requires SupportedDim<d>
+struct PointFile {
+  std::string name;                // as used in error messages
+  std::vector<Point<d>> points;    // in file order
+  std::vector<std::size_t> lines;  // lines[i]: the 1-based line of points[i]
+};
+
+enum class PointFormat { Auto, Node, Plain };
+
+/// Node for names ending in ".node" (any letter case), Plain otherwise.
+PointFormat format_for_path(std::string_view path) noexcept;
+
+template <std::size_t d>
+PointFile<d> read_node(std::istream& in, const std::string& name);
+template <std::size_t d>
+PointFile<d> read_plain(std::istream& in, const std::string& name);
+/// Opens `path` and reads it as `format` (Auto: by extension).
+template <std::size_t d>
+PointFile<d> read_points_file(const std::string& path, PointFormat format = PointFormat::Auto);
+
+/// The dimension announced by a `.node` file's header (2 when the field is omitted, as in
+/// Triangle). Throws InputError naming the file and line for a malformed header.
+int node_file_dimension(const std::string& path);
+
+/// Locates every point in `box`, in file order. Throws InputError(OutsideBox) naming the
+/// line of the first point outside the box, or InputError(Duplicate) naming the line of the
+/// first point (in file order) whose located q equals that of an earlier point, and that
+/// earlier line. The exception's point_indices() are the indices into file.points.
+template <std::size_t d>
+std::vector<Position<d>> locate_points(const PointFile<d>& file, const Box<d>& box);
+
+enum class EditOp { Insert, Delete };
+
+template <std::size_t d>
+  requires SupportedDim<d>
+struct Edit {
+  EditOp op;
+  Point<d> point;
+  std::size_t line;  // 1-based line in the script
+};
+
+template <std::size_t d>
+std::vector<Edit<d>> read_edits(std::istream& in, const std::string& name);
+template <std::size_t d>
+std::vector<Edit<d>> read_edits_file(const std::string& path);
+
+/// Writes the `.cells` format; the leaves are sorted by (level, i, j, k) on the way out.
+template <std::size_t d>
+void write_cells(std::ostream& out, const Box<d>& box, std::span<const Leaf<d>> leaves);
+/// The `.cells` text as a string (what write_cells writes).
+template <std::size_t d>
+std::string format_cells(const Box<d>& box, std::span<const Leaf<d>> leaves);
+/// Writes to `path`; InputError(Io) when the file cannot be written.
+template <std::size_t d>
+void write_cells_file(const std::string& path, const Box<d>& box, std::span<const Leaf<d>> leaves);
+
+template <std::size_t d>
+  requires SupportedDim<d>
+struct CellsFile {
+  Box<d> box;
+  std::vector<Leaf<d>> leaves;  // in file order (which a valid file has sorted)
+};
+
+/// Reads a `.cells` file strictly: the three header lines, then leaves with valid levels
+/// and indices, sorted strictly ascending. Tiling is not checked here (see check_tree).
+template <std::size_t d>
+CellsFile<d> read_cells(std::istream& in, const std::string& name);
+template <std::size_t d>
+CellsFile<d> read_cells_file(const std::string& path);
+
+}  // namespace dynmesh

@@ -1,0 +1,513 @@
+// io.cpp — point files, edit scripts and `.cells` (see dynmesh/io.hpp for the formats).
+#include "dynmesh/io.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <istream>
+#include <limits>
+#include <numeric>
+#include <ostream>
+#include <sstream>
+#include <system_error>
+
+#include "dynmesh/errors.hpp"
+
+namespace dynmesh {
+namespace {
+
+using Kind = InputError::Kind;
+
+std::string quoted(std::string_view tok) {
+  std::string s = "'";
+  s += tok;
+  s += '\'';
+  return s;
+}
+
+/// Reads a file line by line, strips comments ('#' to the end of the line) and splits the
+/// rest on whitespace. Keeps the current 1-based line number for error messages.
+class LineReader {
+ public:
+  LineReader(std::istream& in, const std::string& name) : in_(in), name_(name) {}
+
+  /// The fields of the next line that has any (blank and comment-only lines are skipped).
+  /// With comments = false, '#' is an ordinary character and blank lines are returned too
+  /// (used for the strict `.cells` reader). False at the end of the input.
+  bool next(std::vector<std::string_view>& fields, bool comments = true) {
+    while (std::getline(in_, buf_)) {
+      ++line_;
+      if (!buf_.empty() && buf_.back() == '\r') buf_.pop_back();  // CRLF files
+      std::string_view text = buf_;
+      if (comments) {
+        if (const auto hash = text.find('#'); hash != std::string_view::npos) text = text.substr(0, hash);
+      }
+      split(text, fields);
+      if (!fields.empty() || !comments) return true;
+    }
+    if (in_.bad()) fail(Kind::Io, "read error");
+    return false;
+  }
+
+  const std::string& raw_line() const noexcept { return buf_; }
+  std::size_t line() const noexcept { return line_; }
+  const std::string& name() const noexcept { return name_; }
+
+  [[noreturn]] void fail(Kind kind, const std::string& text) const { throw InputError(kind, text, name_, line_); }
+  [[noreturn]] void fail_at(Kind kind, const std::string& text, std::size_t line) const {
+    throw InputError(kind, text, name_, line);
+  }
+
+  /// A coordinate: a finite decimal number.
+  double coordinate(std::string_view tok) const {
+    const double v = number(tok);
+    if (!std::isfinite(v)) fail(Kind::NotFinite, "NaN or infinite coordinate " + quoted(tok));
+    return v;
+  }
+
+  /// Any decimal number (NaN and infinity allowed: attributes are ignored anyway).
+  double number(std::string_view tok) const {
+    std::string_view t = tok;
+    if (!t.empty() && t.front() == '+') {
+      t.remove_prefix(1);
+      if (!t.empty() && (t.front() == '+' || t.front() == '-')) fail(Kind::Malformed, "malformed number " + quoted(tok));
+    }
+    double v = 0;
+    const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v, std::chars_format::general);
+    if (ec == std::errc::invalid_argument || ptr != t.data() + t.size())
+      fail(Kind::Malformed, "malformed number " + quoted(tok));
+    if (ec == std::errc::result_out_of_range) {
+      if (overflows(t)) fail(Kind::NotFinite, "number " + quoted(tok) + " is infinite in double precision");
+      v = t.front() == '-' ? -0.0 : 0.0;  // underflow: the correctly rounded value is ±0
+    }
+    return v;
+  }
+
+  long long integer(std::string_view tok) const {
+    std::string_view t = tok;
+    if (!t.empty() && t.front() == '+') {
+      t.remove_prefix(1);
+      if (t.empty() || t.front() == '+' || t.front() == '-') fail(Kind::Malformed, "malformed integer " + quoted(tok));
+    }
+    long long v = 0;
+    const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (ec != std::errc{} || ptr != t.data() + t.size()) fail(Kind::Malformed, "malformed integer " + quoted(tok));
+    return v;
+  }
+
+ private:
+  static void split(std::string_view text, std::vector<std::string_view>& fields) {
+    fields.clear();
+    constexpr std::string_view ws = " \t\r\v\f";
+    std::size_t i = 0;
+    while (true) {
+      i = text.find_first_not_of(ws, i);
+      if (i == std::string_view::npos) break;
+      std::size_t j = text.find_first_of(ws, i);
+      if (j == std::string_view::npos) j = text.size();
+      fields.push_back(text.substr(i, j - i));
+      i = j;
+    }
+  }
+
+  /// For a syntactically valid decimal that from_chars found out of range: is its magnitude
+  /// ≥ 1 (overflow) rather than < 1 (underflow)? Value = 0.DDD × 10^(P + E).
+  static bool overflows(std::string_view t) {
+    if (!t.empty() && (t.front() == '-' || t.front() == '+')) t.remove_prefix(1);
+    long long p = 0;
+    bool nonzero = false, after_point = false;
+    std::size_t i = 0;
+    for (; i < t.size() && t[i] != 'e' && t[i] != 'E'; ++i) {
+      const char c = t[i];
+      if (c == '.') {
+        after_point = true;
+      } else if (!nonzero) {
+        if (c != '0') {
+          nonzero = true;
+          if (!after_point) p = 1;
+        } else if (after_point) {
+          --p;
+        }
+      } else if (!after_point) {
+        ++p;
+      }
+    }
+    long long e = 0;
+    if (i < t.size()) {
+      ++i;
+      bool neg = false;
+      if (i < t.size() && (t[i] == '+' || t[i] == '-')) neg = t[i++] == '-';
+      for (; i < t.size(); ++i) e = std::min<long long>(e * 10 + (t[i] - '0'), 1'000'000'000);
+      if (neg) e = -e;
+    }
+    return p + e > 0;
+  }
+
+  std::istream& in_;
+  const std::string& name_;
+  std::string buf_;
+  std::size_t line_ = 0;
+};
+
+std::ifstream open_input(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(Kind::Io, std::string("cannot open file: ") + std::strerror(errno), path);
+  return in;
+}
+
+void append_int(std::string& s, std::uint64_t v) {
+  char buf[24];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  s.append(buf, r.ptr);
+}
+
+template <std::size_t d>
+std::string box_string(const Box<d>& box) {
+  std::string s = "origin (";
+  for (std::size_t a = 0; a < d; ++a) {
+    if (a) s += ", ";
+    s += format_exact(box.origin[a]);
+  }
+  return s + "), side " + format_exact(box.side);
+}
+
+}  // namespace
+
+PointFormat format_for_path(std::string_view path) noexcept {
+  constexpr std::string_view ext = ".node";
+  if (path.size() < ext.size()) return PointFormat::Plain;
+  const std::string_view tail = path.substr(path.size() - ext.size());
+  for (std::size_t i = 0; i < ext.size(); ++i) {
+    char c = tail[i];
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    if (c != ext[i]) return PointFormat::Plain;
+  }
+  return PointFormat::Node;
+}
+
+// ---------------------------------------------------------------------------------------
+// .node
+
+namespace {
+
+struct NodeHeader {
+  long long count = 0;
+  long long dim = 0;  // 0: omitted
+  long long attributes = 0;
+  long long markers = 0;
+  std::size_t line = 0;
+};
+
+NodeHeader read_node_header(LineReader& r) {
+  std::vector<std::string_view> f;
+  if (!r.next(f)) r.fail(Kind::Malformed, "empty .node file: the header line is missing");
+  if (f.size() > 4)
+    r.fail(Kind::Malformed, ".node header has " + std::to_string(f.size()) +
+                                " fields; expected <#vertices> <dimension> <#attributes> <#boundary markers>");
+  NodeHeader h;
+  h.line = r.line();
+  h.count = r.integer(f[0]);
+  if (h.count < 0) r.fail(Kind::Malformed, "negative vertex count " + quoted(f[0]));
+  if (f.size() > 1) {
+    h.dim = r.integer(f[1]);
+    if (h.dim != 2 && h.dim != 3) r.fail(Kind::Malformed, "dimension must be 2 or 3, got " + quoted(f[1]));
+  }
+  if (f.size() > 2) {
+    h.attributes = r.integer(f[2]);
+    if (h.attributes < 0) r.fail(Kind::Malformed, "negative number of attributes " + quoted(f[2]));
+  }
+  if (f.size() > 3) {
+    h.markers = r.integer(f[3]);
+    if (h.markers != 0 && h.markers != 1)
+      r.fail(Kind::Malformed, "number of boundary markers must be 0 or 1, got " + quoted(f[3]));
+  }
+  return h;
+}
+
+}  // namespace
+
+int node_file_dimension(const std::string& path) {
+  std::ifstream in = open_input(path);
+  LineReader r(in, path);
+  return static_cast<int>(read_node_header(r).dim);
+}
+
+template <std::size_t d>
+PointFile<d> read_node(std::istream& in, const std::string& name) {
+  LineReader r(in, name);
+  const NodeHeader h = read_node_header(r);
+  if (h.dim != 0 && static_cast<std::size_t>(h.dim) != d)
+    r.fail(Kind::Malformed, ".node header announces dimension " + std::to_string(h.dim) + " but " +
+                                std::to_string(d) + "-dimensional points were requested");
+  PointFile<d> out;
+  out.name = name;
+  const auto reserve = static_cast<std::size_t>(std::min<long long>(h.count, 1 << 20));
+  out.points.reserve(reserve);
+  out.lines.reserve(reserve);
+  const auto count = static_cast<std::size_t>(h.count);
+  long long base = 0;
+  std::vector<std::string_view> f;
+  while (r.next(f)) {
+    const std::size_t k = out.points.size();
+    if (k == count)
+      r.fail(Kind::Count, "more vertices than the " + std::to_string(count) + " announced in the header (line " +
+                              std::to_string(h.line) + ")");
+    if (f.size() < 1 + d)
+      r.fail(Kind::Count, "vertex line has " + std::to_string(f.size()) + " field(s); expected <vertex#> and " +
+                              std::to_string(d) + " coordinates");
+    const long long id = r.integer(f[0]);
+    if (k == 0) {
+      if (id != 0 && id != 1) r.fail(Kind::Malformed, "vertex numbering must start at 0 or 1, got " + quoted(f[0]));
+      base = id;
+    } else if (id != base + static_cast<long long>(k)) {
+      r.fail(Kind::Malformed, "vertex number " + quoted(f[0]) + " out of sequence; expected " +
+                                  std::to_string(base + static_cast<long long>(k)));
+    }
+    Point<d> p;
+    for (std::size_t a = 0; a < d; ++a) p[a] = r.coordinate(f[1 + a]);
+    // Attributes and the marker are read (they must be numbers) and ignored.
+    const std::size_t extra = static_cast<std::size_t>(h.attributes);
+    for (std::size_t j = 0; j < extra && 1 + d + j < f.size(); ++j) (void)r.number(f[1 + d + j]);
+    if (h.markers == 1 && 1 + d + extra < f.size()) (void)r.integer(f[1 + d + extra]);
+    out.points.push_back(p);
+    out.lines.push_back(r.line());
+  }
+  if (out.points.size() != count)
+    r.fail_at(Kind::Count, "the header announces " + std::to_string(count) + " vertices but the file has " +
+                               std::to_string(out.points.size()),
+              h.line);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// plain text
+
+template <std::size_t d>
+PointFile<d> read_plain(std::istream& in, const std::string& name) {
+  LineReader r(in, name);
+  PointFile<d> out;
+  out.name = name;
+  std::vector<std::string_view> f;
+  while (r.next(f)) {
+    if (f.size() < d)
+      r.fail(Kind::Count, "expected " + std::to_string(d) + " coordinates, found " + std::to_string(f.size()));
+    Point<d> p;
+    for (std::size_t a = 0; a < d; ++a) p[a] = r.coordinate(f[a]);
+    out.points.push_back(p);
+    out.lines.push_back(r.line());
+  }
+  return out;
+}
+
+template <std::size_t d>
+PointFile<d> read_points_file(const std::string& path, PointFormat format) {
+  std::ifstream in = open_input(path);
+  if (format == PointFormat::Auto) format = format_for_path(path);
+  return format == PointFormat::Node ? read_node<d>(in, path) : read_plain<d>(in, path);
+}
+
+template <std::size_t d>
+std::vector<Position<d>> locate_points(const PointFile<d>& file, const Box<d>& box) {
+  validate_box(box);
+  const std::size_t n = file.points.size();
+  auto line_of = [&](std::size_t i) { return i < file.lines.size() ? file.lines[i] : 0; };
+  std::vector<Position<d>> q(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point<d>& p = file.points[i];
+    for (std::size_t a = 0; a < d; ++a)
+      if (!std::isfinite(p[a]))
+        throw InputError(Kind::NotFinite, "NaN or infinite coordinate in point " + to_string<d>(p), file.name,
+                         line_of(i))
+            .with_points({i});
+    const auto located = try_locate(box, p);
+    if (!located)
+      throw InputError(Kind::OutsideBox,
+                       "point " + to_string<d>(p) + " is outside the domain box (" + box_string(box) + ")",
+                       file.name, line_of(i))
+          .with_points({i});
+    q[i] = *located;
+  }
+  // Duplicates: equal located positions. Report the first point, in file order, that repeats
+  // an earlier one.
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return q[a] != q[b] ? q[a] < q[b] : a < b;
+  });
+  std::size_t dup = n, orig = n;
+  for (std::size_t k = 1; k < n; ++k) {
+    const std::size_t cur = order[k], prev = order[k - 1];
+    if (q[cur] != q[prev]) continue;
+    // cur repeats the first member of its group (the group's smallest index).
+    std::size_t first = k - 1;
+    while (first > 0 && q[order[first - 1]] == q[cur]) --first;
+    if (cur < dup) {
+      dup = cur;
+      orig = order[first];
+    }
+  }
+  if (dup != n)
+    throw InputError(Kind::Duplicate,
+                     "duplicate point " + to_string<d>(file.points[dup]) +
+                         ": it has the same located position as the point on line " + std::to_string(line_of(orig)) +
+                         " " + to_string<d>(file.points[orig]),
+                     file.name, line_of(dup))
+        .with_points({orig, dup});
+  return q;
+}
+
+// ---------------------------------------------------------------------------------------
+// edit scripts
+
+template <std::size_t d>
+std::vector<Edit<d>> read_edits(std::istream& in, const std::string& name) {
+  LineReader r(in, name);
+  std::vector<Edit<d>> out;
+  std::vector<std::string_view> f;
+  while (r.next(f)) {
+    EditOp op;
+    if (f[0] == "+")
+      op = EditOp::Insert;
+    else if (f[0] == "-")
+      op = EditOp::Delete;
+    else
+      r.fail(Kind::Malformed, "an edit starts with '+' or '-' as a field of its own, got " + quoted(f[0]));
+    if (f.size() != 1 + d)
+      r.fail(Kind::Count, "an edit needs exactly " + std::to_string(d) + " coordinates, found " +
+                              std::to_string(f.size() - 1));
+    Edit<d> e{op, {}, r.line()};
+    for (std::size_t a = 0; a < d; ++a) e.point[a] = r.coordinate(f[1 + a]);
+    out.push_back(e);
+  }
+  return out;
+}
+
+template <std::size_t d>
+std::vector<Edit<d>> read_edits_file(const std::string& path) {
+  std::ifstream in = open_input(path);
+  return read_edits<d>(in, path);
+}
+
+// ---------------------------------------------------------------------------------------
+// .cells
+
+template <std::size_t d>
+std::string format_cells(const Box<d>& box, std::span<const Leaf<d>> leaves) {
+  std::vector<Leaf<d>> sorted(leaves.begin(), leaves.end());
+  std::sort(sorted.begin(), sorted.end(), [](const Leaf<d>& a, const Leaf<d>& b) { return a.cell < b.cell; });
+  std::string s = "# dynmesh cells v1\n# dim ";
+  append_int(s, d);
+  s += "\n# box";
+  for (std::size_t a = 0; a < d; ++a) {
+    s += ' ';
+    s += format_exact(box.origin[a]);
+  }
+  s += ' ';
+  s += format_exact(box.side);
+  s += '\n';
+  s.reserve(s.size() + sorted.size() * (8 + 14 * d));
+  for (const Leaf<d>& leaf : sorted) {
+    append_int(s, static_cast<std::uint64_t>(leaf.cell.level));
+    for (std::size_t a = 0; a < d; ++a) {
+      s += ' ';
+      append_int(s, leaf.cell.index[a]);
+    }
+    s += ' ';
+    append_int(s, leaf.npoints);
+    s += '\n';
+  }
+  return s;
+}
+
+template <std::size_t d>
+void write_cells(std::ostream& out, const Box<d>& box, std::span<const Leaf<d>> leaves) {
+  const std::string s = format_cells<d>(box, leaves);
+  out.write(s.data(), static_cast<std::streamsize>(s.size()));
+}
+
+template <std::size_t d>
+void write_cells_file(const std::string& path, const Box<d>& box, std::span<const Leaf<d>> leaves) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw InputError(Kind::Io, std::string("cannot open file for writing: ") + std::strerror(errno), path);
+  write_cells<d>(out, box, leaves);
+  out.flush();
+  if (!out) throw InputError(Kind::Io, "write error", path);
+}
+
+template <std::size_t d>
+CellsFile<d> read_cells(std::istream& in, const std::string& name) {
+  LineReader r(in, name);
+  std::vector<std::string_view> f;
+  auto header = [&](std::string_view what) {
+    if (!r.next(f, false)) r.fail(Kind::Malformed, "missing header line " + quoted(what));
+  };
+  header("# dynmesh cells v1");
+  if (r.raw_line() != "# dynmesh cells v1") r.fail(Kind::Malformed, "expected '# dynmesh cells v1'");
+  header("# dim D");
+  if (f.size() != 3 || f[0] != "#" || f[1] != "dim") r.fail(Kind::Malformed, "expected '# dim D'");
+  if (r.integer(f[2]) != static_cast<long long>(d))
+    r.fail(Kind::Malformed, "file has dimension " + std::string(f[2]) + ", expected " + std::to_string(d));
+  header("# box ...");
+  if (f.size() != d + 3 || f[0] != "#" || f[1] != "box")
+    r.fail(Kind::Malformed, "expected '# box' followed by " + std::to_string(d + 1) + " numbers");
+  CellsFile<d> out;
+  for (std::size_t a = 0; a < d; ++a) out.box.origin[a] = r.coordinate(f[2 + a]);
+  out.box.side = r.coordinate(f[2 + d]);
+  try {
+    validate_box(out.box);
+  } catch (const InputError& e) {
+    r.fail(e.kind(), e.text());
+  }
+  while (r.next(f, false)) {
+    if (f.size() != d + 2)
+      r.fail(Kind::Count, "a leaf line has " + std::to_string(d + 2) + " integers, found " + std::to_string(f.size()) +
+                              " fields");
+    Leaf<d> leaf;
+    const long long level = r.integer(f[0]);
+    if (level < 0 || level > kMaxLevel) r.fail(Kind::Malformed, "level " + quoted(f[0]) + " outside [0, 52]");
+    leaf.cell.level = static_cast<int>(level);
+    for (std::size_t a = 0; a < d; ++a) {
+      const long long i = r.integer(f[1 + a]);
+      if (i < 0 || static_cast<std::uint64_t>(i) >= cells_per_axis(leaf.cell.level))
+        r.fail(Kind::Malformed, "index " + quoted(f[1 + a]) + " outside [0, 2^level)");
+      leaf.cell.index[a] = static_cast<std::uint64_t>(i);
+    }
+    const long long np = r.integer(f[1 + d]);
+    if (np < 0 || np > std::numeric_limits<std::uint32_t>::max())
+      r.fail(Kind::Malformed, "bad point count " + quoted(f[1 + d]));
+    leaf.npoints = static_cast<std::uint32_t>(np);
+    if (!out.leaves.empty() && !(out.leaves.back().cell < leaf.cell))
+      r.fail(Kind::Malformed, "leaves are not sorted strictly by (level, i, j, k)");
+    out.leaves.push_back(leaf);
+  }
+  return out;
+}
+
+template <std::size_t d>
+CellsFile<d> read_cells_file(const std::string& path) {
+  std::ifstream in = open_input(path);
+  return read_cells<d>(in, path);
+}
+
+#define DYNMESH_INSTANTIATE_IO(D)                                                                    \
+  template PointFile<D> read_node<D>(std::istream&, const std::string&);                             \
+  template PointFile<D> read_plain<D>(std::istream&, const std::string&);                            \
+  template PointFile<D> read_points_file<D>(const std::string&, PointFormat);                        \
+  template std::vector<Position<D>> locate_points<D>(const PointFile<D>&, const Box<D>&);            \
+  template std::vector<Edit<D>> read_edits<D>(std::istream&, const std::string&);                    \
+  template std::vector<Edit<D>> read_edits_file<D>(const std::string&);                              \
+  template std::string format_cells<D>(const Box<D>&, std::span<const Leaf<D>>);                     \
+  template void write_cells<D>(std::ostream&, const Box<D>&, std::span<const Leaf<D>>);              \
+  template void write_cells_file<D>(const std::string&, const Box<D>&, std::span<const Leaf<D>>);    \
+  template CellsFile<D> read_cells<D>(std::istream&, const std::string&);                            \
+  template CellsFile<D> read_cells_file<D>(const std::string&);
+
+DYNMESH_INSTANTIATE_IO(2)
+DYNMESH_INSTANTIATE_IO(3)
+
+#undef DYNMESH_INSTANTIATE_IO
+
+}  // namespace dynmesh

@@ -1,0 +1,327 @@
+// io_test.cpp — point files, edit scripts, `.cells`.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/errors.hpp"
+#include "dynmesh/io.hpp"
+#include "dynmesh/static_quadtree.hpp"
+
+namespace {
+
+using namespace dynmesh;
+using Kind = InputError::Kind;
+
+template <std::size_t d>
+PointFile<d> node(const std::string& text, const std::string& name = "in.node") {
+  std::istringstream in(text);
+  return read_node<d>(in, name);
+}
+
+template <std::size_t d>
+PointFile<d> plain(const std::string& text, const std::string& name = "in.xyz") {
+  std::istringstream in(text);
+  return read_plain<d>(in, name);
+}
+
+template <std::size_t d>
+std::vector<Edit<d>> edits(const std::string& text, const std::string& name = "edits.txt") {
+  std::istringstream in(text);
+  return read_edits<d>(in, name);
+}
+
+/// Runs f, expects an InputError of `kind` naming `file` and `line` (0: no line) in both its
+/// fields and its message.
+template <class F>
+void expect_error(F&& f, Kind kind, const std::string& file, std::size_t line, const std::string& fragment = {}) {
+  try {
+    f();
+    ADD_FAILURE() << "no error; expected one at " << file << ":" << line;
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.kind(), kind) << what;
+    EXPECT_EQ(e.file(), file) << what;
+    EXPECT_EQ(e.line(), line) << what;
+    const std::string prefix = line ? file + ":" + std::to_string(line) + ": " : file + ": ";
+    EXPECT_EQ(what.rfind(prefix, 0), 0u) << what;
+    if (!fragment.empty()) {
+      EXPECT_NE(what.find(fragment), std::string::npos) << what;
+    }
+  }
+}
+
+// --- .node ---------------------------------------------------------------------------------
+
+TEST(ReadNode, TriangleFileNumberedFromOne) {
+  const auto f = node<2>(
+      "# a comment line\n"
+      "4 2 1 1   # header: 4 vertices, 2D, one attribute, markers\n"
+      "\n"
+      "1 0.0 0.0 7.5 1\n"
+      "2 1.0 0.0 7.5 1 # trailing comment\n"
+      "   # an indented comment\n"
+      "3 1.0 1.0 7.5 0\n"
+      "4 -2.5e-1 +1e0 3 1\n");
+  ASSERT_EQ(f.points.size(), 4u);
+  EXPECT_EQ(f.points[0], (Point<2>{0.0, 0.0}));
+  EXPECT_EQ(f.points[3], (Point<2>{-0.25, 1.0}));
+  EXPECT_EQ(f.lines, (std::vector<std::size_t>{4, 5, 7, 8}));
+  EXPECT_EQ(f.name, "in.node");
+}
+
+TEST(ReadNode, TetGenFileNumberedFromZeroWithCrLf) {
+  const auto f = node<3>("3 3 0 0\r\n0 1 2 3\r\n1 4 5 6\r\n2 0.5 0.25 0.125\r\n");
+  ASSERT_EQ(f.points.size(), 3u);
+  EXPECT_EQ(f.points[2], (Point<3>{0.5, 0.25, 0.125}));
+}
+
+TEST(ReadNode, ShortHeaderAndExtraFields) {
+  // Triangle allows trailing header fields to be omitted; fields beyond the announced
+  // attributes and marker are ignored.
+  const auto f = node<2>("2\n1 0 0 whatever\n2 1 1\n");
+  ASSERT_EQ(f.points.size(), 2u);
+  const auto g = node<2>("0 2 0 0\n");
+  EXPECT_TRUE(g.points.empty());
+}
+
+TEST(ReadNode, Errors) {
+  const std::string n = "bad.node";
+  expect_error([&] { node<2>("", n); }, Kind::Malformed, n, 0, "header");
+  expect_error([&] { node<2>("# only a comment\n", n); }, Kind::Malformed, n, 1, "header");
+  expect_error([&] { node<2>("two 2 0 0\n", n); }, Kind::Malformed, n, 1, "'two'");
+  expect_error([&] { node<2>("2 4 0 0\n", n); }, Kind::Malformed, n, 1, "dimension");
+  expect_error([&] { node<2>("1 3 0 0\n1 0 0 0\n", n); }, Kind::Malformed, n, 1, "dimension 3");
+  expect_error([&] { node<2>("1 2 0 2\n1 0 0\n", n); }, Kind::Malformed, n, 1, "markers");
+  expect_error([&] { node<2>("1 2 0 0 9\n", n); }, Kind::Malformed, n, 1);
+  expect_error([&] { node<2>("-1 2 0 0\n", n); }, Kind::Malformed, n, 1);
+  // A malformed number.
+  expect_error([&] { node<2>("2 2 0 0\n1 0 0\n\n2 0.5x 1\n", n); }, Kind::Malformed, n, 4, "'0.5x'");
+  expect_error([&] { node<2>("1 2 0 0\n1 0x1p3 1\n", n); }, Kind::Malformed, n, 2, "'0x1p3'");
+  expect_error([&] { node<2>("1 2 0 0\n1 ++1 1\n", n); }, Kind::Malformed, n, 2);
+  expect_error([&] { node<2>("1 2 0 0\n1 +-1 1\n", n); }, Kind::Malformed, n, 2);
+  expect_error([&] { node<2>("1 2 0 0\n1 1e 1\n", n); }, Kind::Malformed, n, 2);
+  expect_error([&] { node<2>("1 2 1 0\n1 0 0 attr\n", n); }, Kind::Malformed, n, 2, "'attr'");
+  expect_error([&] { node<2>("1 2 0 1\n1 0 0 1.5\n", n); }, Kind::Malformed, n, 2, "'1.5'");
+  // NaN and infinity, including a decimal overflow.
+  expect_error([&] { node<2>("2 2 0 0\n1 0 0\n2 nan 1\n", n); }, Kind::NotFinite, n, 3, "'nan'");
+  expect_error([&] { node<2>("1 2 0 0\n1 0 -inf\n", n); }, Kind::NotFinite, n, 2, "'-inf'");
+  expect_error([&] { node<2>("1 2 0 0\n1 0 Infinity\n", n); }, Kind::NotFinite, n, 2);
+  expect_error([&] { node<2>("1 2 0 0\n1 1e999 0\n", n); }, Kind::NotFinite, n, 2, "'1e999'");
+  expect_error([&] { node<2>("1 2 0 0\n1 -123.4e307 0\n", n); }, Kind::NotFinite, n, 2);
+  // Wrong counts: too few fields, more or fewer vertices than announced.
+  expect_error([&] { node<2>("2 2 0 0\n1 0 0\n2 5\n", n); }, Kind::Count, n, 3, "field");
+  expect_error([&] { node<3>("1 3 0 0\n1 0 0\n", n); }, Kind::Count, n, 2);
+  expect_error([&] { node<2>("1 2 0 0\n1 0 0\n2 1 1\n", n); }, Kind::Count, n, 3, "more vertices");
+  expect_error([&] { node<2>("# c\n3 2 0 0\n1 0 0\n2 1 1\n", n); }, Kind::Count, n, 2, "announces 3");
+  // Numbering.
+  expect_error([&] { node<2>("2 2 0 0\n2 0 0\n3 1 1\n", n); }, Kind::Malformed, n, 2, "start at 0 or 1");
+  expect_error([&] { node<2>("3 2 0 0\n0 0 0\n1 1 1\n3 2 2\n", n); }, Kind::Malformed, n, 4, "out of sequence");
+  expect_error([&] { node<2>("2 2 0 0\n1 0 0\n1.0 1 1\n", n); }, Kind::Malformed, n, 3);
+}
+
+TEST(ReadNode, UnderflowIsTheRoundedZero) {
+  const auto f = node<2>("1 2 0 0\n1 1e-999 -1e-400\n");
+  EXPECT_EQ(f.points[0][0], 0.0);
+  EXPECT_EQ(f.points[0][1], 0.0);
+  EXPECT_TRUE(std::signbit(f.points[0][1]));
+  const auto g = node<2>("1 2 0 0\n1 4.9e-324 0.000001e-320\n");
+  EXPECT_EQ(g.points[0][0], std::numeric_limits<double>::denorm_min());
+  EXPECT_EQ(g.points[0][1], 0.0);
+}
+
+// --- plain text ------------------------------------------------------------------------------
+
+TEST(ReadPlain, FirstDimNumbersAndIgnoredColumns) {
+  const auto f = plain<3>("1 2 3 0.1 0.2 0.3 red\n\n# comment\n  4\t5 6\n7 8 9 # note\n");
+  ASSERT_EQ(f.points.size(), 3u);
+  EXPECT_EQ(f.points[1], (Point<3>{4, 5, 6}));
+  EXPECT_EQ(f.lines, (std::vector<std::size_t>{1, 4, 5}));
+  const auto g = plain<2>("1 2 3\n4 5 6\n");
+  EXPECT_EQ(g.points[1], (Point<2>{4, 5}));
+}
+
+TEST(ReadPlain, Errors) {
+  const std::string n = "pts.xyz";
+  expect_error([&] { plain<2>("1 2\n3\n", n); }, Kind::Count, n, 2, "expected 2 coordinates, found 1");
+  expect_error([&] { plain<3>("1 2 3\n\n1 2\n", n); }, Kind::Count, n, 3);
+  expect_error([&] { plain<2>("1 2\n1,5 2\n", n); }, Kind::Malformed, n, 2, "'1,5'");
+  expect_error([&] { plain<2>("x y\n", n); }, Kind::Malformed, n, 1);
+  expect_error([&] { plain<2>("1 2\n3 4\nNaN 1\n", n); }, Kind::NotFinite, n, 3);
+  expect_error([&] { plain<2>("1 inf\n", n); }, Kind::NotFinite, n, 1);
+}
+
+// --- files, boxes and duplicates -------------------------------------------------------------
+
+class TempDir : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           ("dynmesh_io_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) {
+    const auto p = (dir_ / name).string();
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(TempDir, ReadPointsFileChoosesTheFormatByExtension) {
+  const auto a = write("a.node", "2 2 0 0\n1 0 0\n2 1 1\n");
+  const auto b = write("b.NODE", "1 2\n");
+  const auto c = write("c.xyz", "2 2 0 0\n");
+  EXPECT_EQ(read_points_file<2>(a).points.size(), 2u);
+  EXPECT_EQ(format_for_path(b), PointFormat::Node);
+  EXPECT_EQ(read_points_file<2>(c).points.size(), 1u);  // plain: "2 2 0 0" is the point (2, 2)
+  EXPECT_EQ(read_points_file<2>(c).points[0], (Point<2>{2, 2}));
+  EXPECT_EQ(read_points_file<2>(a, PointFormat::Plain).points.size(), 3u);
+  EXPECT_EQ(node_file_dimension(a), 2);
+  EXPECT_EQ(node_file_dimension(write("d.node", "5\n")), 0);
+  expect_error([&] { read_points_file<2>(write("e.node", "1 2 0 0\n1 0 nan\n")); }, Kind::NotFinite,
+               (dir_ / "e.node").string(), 2);
+  const std::string missing = (dir_ / "missing.node").string();
+  expect_error([&] { read_points_file<2>(missing); }, Kind::Io, missing, 0, "cannot open");
+}
+
+TEST(LocatePoints, DuplicatesAreEqualLocatedPositions) {
+  // 0 and 1e-20 differ as doubles but have the same located q in the box o = −1, L = 3
+  // (x − o rounds to 1 for both): the fourth point is a duplicate of the first.
+  const auto f = plain<2>("0 0\n1 1\n# c\n0.5 0.5\n1e-20 0\n", "dup.txt");
+  const Box<2> box = derive_box<2>(f.points);
+  try {
+    (void)locate_points(f, box);
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.kind(), Kind::Duplicate);
+    EXPECT_EQ(e.file(), "dup.txt");
+    EXPECT_EQ(e.line(), 5u);
+    EXPECT_NE(std::string(e.what()).find("line 1"), std::string::npos) << e.what();
+    EXPECT_EQ(e.point_indices(), (std::vector<std::size_t>{0, 3}));
+  }
+  // Exact repeats too; the first repeat in file order is reported.
+  const auto g = plain<2>("0 0\n5 5\n1 1\n1 1\n5 5\n", "dup2.txt");
+  expect_error([&] { (void)locate_points(g, derive_box<2>(g.points)); }, Kind::Duplicate, "dup2.txt", 4);
+  const auto ok = plain<2>("0 0\n1 1\n");
+  EXPECT_EQ(locate_points(ok, derive_box<2>(ok.points)).size(), 2u);
+}
+
+TEST(LocatePoints, OutsideTheGivenBox) {
+  const auto f = plain<3>("0 0 0\n0.5 0.5 0.5\n1 0.5 0.5\n", "box.txt");
+  const Box<3> box{{0, 0, 0}, 1};
+  expect_error([&] { (void)locate_points(f, box); }, Kind::OutsideBox, "box.txt", 3, "outside the domain box");
+}
+
+// --- edit scripts ----------------------------------------------------------------------------
+
+TEST(ReadEdits, Basic) {
+  const auto e = edits<2>("# script\n+ 0.5 0.25\n\n- 1 2 # delete\n  +\t3 4\n");
+  ASSERT_EQ(e.size(), 3u);
+  EXPECT_EQ(e[0].op, EditOp::Insert);
+  EXPECT_EQ(e[0].point, (Point<2>{0.5, 0.25}));
+  EXPECT_EQ(e[0].line, 2u);
+  EXPECT_EQ(e[1].op, EditOp::Delete);
+  EXPECT_EQ(e[1].line, 4u);
+  EXPECT_EQ(e[2].point, (Point<2>{3, 4}));
+  const auto e3 = edits<3>("- 1 2 3\n");
+  EXPECT_EQ(e3[0].point, (Point<3>{1, 2, 3}));
+}
+
+TEST(ReadEdits, Errors) {
+  const std::string n = "ed.txt";
+  expect_error([&] { edits<2>("+ 1 2\n* 1 2\n", n); }, Kind::Malformed, n, 2, "'*'");
+  expect_error([&] { edits<2>("+1 2\n", n); }, Kind::Malformed, n, 1);
+  expect_error([&] { edits<2>("+ 1\n", n); }, Kind::Count, n, 1, "exactly 2");
+  expect_error([&] { edits<2>("\n\n- 1 2 3\n", n); }, Kind::Count, n, 3);
+  expect_error([&] { edits<3>("+ 1 2\n", n); }, Kind::Count, n, 1);
+  expect_error([&] { edits<2>("+ 1 two\n", n); }, Kind::Malformed, n, 1, "'two'");
+  expect_error([&] { edits<2>("- nan 2\n", n); }, Kind::NotFinite, n, 1);
+}
+
+// --- .cells ----------------------------------------------------------------------------------
+
+TEST(Cells, WriterIsByteExact) {
+  // Two points two level-1 cells apart (the grading cascade with m = 1), box derived from
+  // three points with ugly coordinates (%.17g must print all digits).
+  const std::vector<Point<2>> pts = {{0.1, 0.2}, {0.4, 0.8}, {0.35, 0.75}};
+  const Box<2> box = derive_box<2>(pts);
+  const std::vector<Position<2>> q = {{0, 0}, {std::uint64_t{1} << 51, 0}};
+  const StaticQuadtree<2> tree(q);
+  std::vector<Leaf<2>> leaves(tree.leaves().begin(), tree.leaves().end());
+  std::reverse(leaves.begin(), leaves.end());  // the writer sorts
+  std::ostringstream out;
+  write_cells<2>(out, box, leaves);
+  EXPECT_EQ(out.str(),
+            "# dynmesh cells v1\n"
+            "# dim 2\n"
+            "# box -0.65000000000000013 -0.40000000000000013 1.8000000000000003\n"
+            "1 0 1 0\n"
+            "1 1 1 0\n"
+            "2 0 0 1\n"
+            "2 0 1 0\n"
+            "2 1 0 0\n"
+            "2 1 1 0\n"
+            "2 2 0 1\n"
+            "2 2 1 0\n"
+            "2 3 0 0\n"
+            "2 3 1 0\n");
+}
+
+TEST(Cells, WriterThreeDAndNumberFormats) {
+  const Box<3> box{{-1, 1e-300, -0.0}, 123456789012345680000.0};
+  const std::vector<Leaf<3>> leaves = {{{1, {1, 0, 0}}, 0}, {{0, {0, 0, 0}}, 3}, {{1, {0, 1, 1}}, 1}};
+  EXPECT_EQ(format_cells<3>(box, leaves),
+            "# dynmesh cells v1\n"
+            "# dim 3\n"
+            "# box -1 1e-300 -0 1.2345678901234568e+20\n"
+            "0 0 0 0 3\n"
+            "1 0 1 1 1\n"
+            "1 1 0 0 0\n");
+}
+
+TEST_F(TempDir, CellsRoundTrip) {
+  const auto pts = generate<3>(Distribution::Clusters, 300, 5);
+  const Box<3> box = derive_box<3>(pts);
+  const auto tree = StaticQuadtree<3>::from_points(box, pts);
+  const std::string path = (dir_ / "t.cells").string();
+  write_cells_file<3>(path, box, tree.leaves());
+  const CellsFile<3> back = read_cells_file<3>(path);
+  EXPECT_EQ(back.box, box);
+  EXPECT_TRUE(std::equal(back.leaves.begin(), back.leaves.end(), tree.leaves().begin(), tree.leaves().end()));
+  std::vector<Position<3>> q;
+  for (const auto& p : pts) q.push_back(locate(box, p));
+  EXPECT_TRUE(check_tree<3>(q, back.leaves).ok());
+}
+
+TEST(Cells, ReaderErrors) {
+  const std::string n = "x.cells";
+  auto rd = [&](const std::string& text) {
+    std::istringstream in(text);
+    return read_cells<2>(in, n);
+  };
+  const std::string head = "# dynmesh cells v1\n# dim 2\n# box 0 0 1\n";
+  EXPECT_EQ(rd(head + "0 0 0 0\n").leaves.size(), 1u);
+  expect_error([&] { rd("# dynmesh cells v2\n"); }, Kind::Malformed, n, 1);
+  expect_error([&] { rd("# dynmesh cells v1\n# dim 3\n"); }, Kind::Malformed, n, 2);
+  expect_error([&] { rd("# dynmesh cells v1\n# dim 2\n# box 0 0\n"); }, Kind::Malformed, n, 3);
+  expect_error([&] { rd("# dynmesh cells v1\n# dim 2\n# box 0 0 -1\n"); }, Kind::OutsideBox, n, 3);
+  expect_error([&] { rd(head + "1 0 0 0\n1 0 1 0 7\n"); }, Kind::Count, n, 5);
+  expect_error([&] { rd(head + "1 2 0 0\n"); }, Kind::Malformed, n, 4, "index");
+  expect_error([&] { rd(head + "53 0 0 0\n"); }, Kind::Malformed, n, 4, "level");
+  expect_error([&] { rd(head + "1 1 0 0\n1 0 1 0\n"); }, Kind::Malformed, n, 5, "sorted");
+  expect_error([&] { rd(head + "1 0 0 0\n\n"); }, Kind::Count, n, 5);
+}
+
+}  // namespace
