@@ -369,7 +369,7 @@ void Engine::memo_hit(Stamp* start, Stamp* end) {
 }
 
 void Engine::reuse_alloc(AllocNode* n) {
-  order_.erase(&n->stamp);
+  order_.erase(&n->stamp, now_);  // n lies in the window, usually a few stamps after now
   order_.insert_after(now_, &n->stamp, StampKind::Alloc);
   now_ = &n->stamp;
   ++stats_.alloc_reuses;

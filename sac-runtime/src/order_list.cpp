@@ -184,17 +184,23 @@ void OrderList::relabel_top(std::uint32_t gi) {
   throw std::length_error("sac::OrderList: label space exhausted");
 }
 
-void OrderList::erase(Stamp* s) {
+void OrderList::erase(Stamp* s, Stamp* hint) {
   if (s == &base_) throw UsageError("sac::OrderList::erase: the base stamp cannot be erased");
-  Group& g = groups_[s->group];
-  Stamp* pred;
-  if (g.first == s) {
-    // The predecessor ends the previous group (base_ guarantees there is one).
-    std::uint32_t pg = g.prev;
-    pred = groups_[pg].first;
-    while (pred->next() != s) pred = pred->next();
-  } else {
-    pred = g.first;
+  // A short walk from the hint touches a few nearby records instead of up to kGroupCap cold
+  // ones from the start of the group.
+  constexpr int kHintSteps = 8;
+  Stamp* pred = nullptr;
+  Stamp* x = hint;
+  for (int i = 0; x && i < kHintSteps; ++i, x = x->next())
+    if (x->next() == s) {
+      pred = x;
+      break;
+    }
+  if (!pred) {
+    // Walk the group; when s opens its group, its predecessor ends the previous one (base_
+    // guarantees there is one).
+    const Group& g = groups_[s->group];
+    pred = g.first == s ? groups_[g.prev].first : g.first;
     while (pred->next() != s) pred = pred->next();
   }
   Stamp* nx = s->next();

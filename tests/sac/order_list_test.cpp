@@ -77,6 +77,11 @@ class Model {
     ol.erase(stamp(id));
     forget(id);
   }
+  /// Erase with a hint stamp `hint` (-1 = base) that may or may not lie shortly before id.
+  void erase_with_hint(int id, int hint) {
+    ol.erase(stamp(id), stamp(hint));
+    forget(id);
+  }
 
   /// Removes id from the reference after the order list erased it.
   void forget(int id) {
@@ -313,6 +318,41 @@ TEST(OrderList, EraseSingleStampsEverywhere) {
   // The emptied list is fully usable again (freed groups are recycled).
   last = -1;
   for (int i = 0; i < 3000; ++i) last = m.insert_new_after(rng() % 2 ? last : m.random_pos(rng));
+  ASSERT_NO_FATAL_FAILURE(m.verify(rng));
+}
+
+TEST(OrderList, EraseWithHintsNearFarAfterOrNone) {
+  // The hint only shortens the predecessor search: near hints (1-8 stamps before), far hints,
+  // hints after the stamp and the base must all give the same list as a plain erase.
+  std::mt19937_64 rng(22);
+  Model m;
+  int last = -1;
+  for (int i = 0; i < 3000; ++i) last = m.insert_new_after(rng() % 3 ? last : m.random_pos(rng));
+  for (int round = 0; round < 2500; ++round) {
+    const std::vector<int>& ids = m.ids();
+    const std::size_t k = rng() % ids.size();
+    const int id = ids[k];
+    int hint = -1;
+    switch (rng() % 4) {
+      case 0:  // near: up to 8 stamps before
+        hint = k >= 1 + rng() % 8 ? ids[k - 1 - rng() % std::min<std::size_t>(k, 8)] : -1;
+        break;
+      case 1:  // far or anywhere
+        hint = m.random_pos(rng);
+        if (hint == id) hint = -1;
+        break;
+      case 2:  // right before
+        hint = k > 0 ? ids[k - 1] : -1;
+        break;
+      default:  // base
+        break;
+    }
+    m.erase_with_hint(id, hint);
+    if (rng() % 2) m.insert_new_after(m.random_pos(rng));
+    if (round % 250 == 0) {
+      ASSERT_NO_FATAL_FAILURE(m.verify(rng, 200));
+    }
+  }
   ASSERT_NO_FATAL_FAILURE(m.verify(rng));
 }
 

@@ -100,8 +100,9 @@ class OrderList {
     insert_slow(pos, s);
   }
 
-  /// Unlinks a single stamp (not base()). O(kGroupCap).
-  void erase(Stamp* s);
+  /// Unlinks a single stamp (not base()). O(kGroupCap). `hint`, if given, is a stamp that
+  /// may precede s closely: the predecessor is first looked for in the few stamps after it.
+  void erase(Stamp* s, Stamp* hint = nullptr);
 
   /// Unlinks every stamp strictly between a and b (b == nullptr: to the end), in order,
   /// calling on_erase(stamp) after each is unlinked. on_erase may free the stamp's memory but
