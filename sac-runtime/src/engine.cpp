@@ -293,8 +293,7 @@ void Engine::discard_pending() noexcept {
   reruns_.clear();
   body_mark_ = 0;
   close_floor_ = 0;
-  pending_allocs_ = nullptr;  // still in the trace; destroy_all frees them from there
-  pending_count_ = 0;
+  pending_allocs_.clear();  // still in the trace; destroy_all frees them from there
 }
 
 void Engine::enqueue(ReadNode* r) {
@@ -384,23 +383,16 @@ void Engine::link_alloc(AllocNode* n, std::size_t h) {
   if (window_end_) {
     allocs_.insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
   } else {
-    n->hnext = pending_allocs_;
-    pending_allocs_ = n;
-    ++pending_count_;
+    pending_allocs_.push_back(PendingAlloc{n, h});
   }
 }
 
 void Engine::index_pending_allocs() {
-  auto hash_of = [](const AllocNode* x) { return x->ops->hash(x); };
-  allocs_.reserve(allocs_.size() + pending_count_, hash_of);
-  for (AllocNode* n = pending_allocs_; n;) {
-    AllocNode* nx = n->hnext;
-    if (nx) __builtin_prefetch(nx);
-    allocs_.insert(n, hash_of(n), hash_of);
-    n = nx;
-  }
-  pending_allocs_ = nullptr;
-  pending_count_ = 0;
+  if (pending_allocs_.empty()) return;
+  allocs_.reserve(allocs_.size() + pending_allocs_.size(),
+                  [](const AllocNode* x) { return x->ops->hash(x); });
+  for (const PendingAlloc& p : pending_allocs_) allocs_.insert_reserved(p.node, p.hash);
+  std::vector<PendingAlloc>().swap(pending_allocs_);  // transient: give the memory back
 }
 
 void Engine::link_memo(MemoNode* n, std::size_t h) {

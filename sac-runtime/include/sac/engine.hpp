@@ -308,11 +308,15 @@ class Engine {
   detail::IntrusiveHash<detail::AllocNode> allocs_;
   detail::IntrusiveHash<detail::MemoNode> memos_;
   std::vector<detail::AllocNode*> deferred_;   // undone allocations, freed by propagate()
-  // Keyed allocations of the running run(), chained through hnext: nothing can look them up
+  // Keyed allocations of the running run() with their hashes: nothing can look them up
   // before the run ends (there is no re-execution window), so they are indexed in one
-  // presized pass at its end instead of through log n table doublings over cold records.
-  detail::AllocNode* pending_allocs_ = nullptr;
-  std::size_t pending_count_ = 0;
+  // presized pass at its end, reading this array sequentially and only storing into the
+  // (cold) records, instead of through log n table doublings that reload every record.
+  struct PendingAlloc {
+    detail::AllocNode* node;
+    std::size_t hash;
+  };
+  std::vector<PendingAlloc> pending_allocs_;
   std::vector<detail::VersionBase*> bases_;    // base versions; index kept in stamp.label
   std::vector<Task> tasks_;                    // the trampoline's stack
   std::vector<RerunContext> reruns_;           // contexts saved by the running re-executions

@@ -30,6 +30,14 @@ class IntrusiveHash {
     ++size_;
   }
 
+  /// Inserts with no growth check: only after reserve() made room.
+  void insert_reserved(N* n, std::size_t h) {
+    N*& b = buckets_[h & (buckets_.size() - 1)];
+    n->hnext = b;
+    b = n;
+    ++size_;
+  }
+
   /// Grows (once) so that `count` records fit without further growth.
   template <class HashOf>
   void reserve(std::size_t count, HashOf&& hash_of) {
