@@ -19,12 +19,16 @@
 
 #include <sac/sac.hpp>
 
+#include "app_test_support.hpp"
 #include "sacapps/app.hpp"
 #include "sacapps/exptrees.hpp"
 #include "sacapps/filter.hpp"
 #include "sacapps/list.hpp"
 
 namespace {
+
+using app_test::expect_consistent;
+using app_test::pick;
 
 #if defined(__SANITIZE_ADDRESS__)
 constexpr bool kSanitized = true;
@@ -47,30 +51,6 @@ std::unique_ptr<sacapps::App> make(const std::string& name) {
   auto app = sacapps::make_app(name);
   if (!app) ADD_FAILURE() << "unknown app " << name;
   return app;
-}
-
-/// After a propagate: the output is right, the engine is sound, and the live trace has the
-/// size of a from-scratch run's on the current input.
-void expect_consistent(sacapps::App& app) {
-  EXPECT_TRUE(app.verify());
-  EXPECT_NO_THROW(app.engine().check_invariants());
-  auto fresh = app.clone_current();
-  fresh->run_self_adjusting();
-  EXPECT_TRUE(fresh->verify());
-  EXPECT_EQ(app.engine().live_events(), fresh->engine().live_events());
-  EXPECT_EQ(app.engine().record_bytes(), fresh->engine().record_bytes());
-}
-
-/// A position in the wanted state (present or absent), or positions() if there is none.
-std::size_t pick(sacapps::App& app, bool want_present, std::mt19937_64& rng) {
-  const std::size_t n = app.positions();
-  if (n == 0) return 0;
-  const std::size_t start = rng() % n;
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t i = (start + k) % n;
-    if (app.present(i) == want_present) return i;
-  }
-  return n;
 }
 
 /// One random mutator change; false if none of the drawn kind was possible.

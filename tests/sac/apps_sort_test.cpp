@@ -22,6 +22,7 @@
 
 #include <sac/sac.hpp>
 
+#include "app_test_support.hpp"
 #include "sacapps/app.hpp"
 #include "sacapps/diameter.hpp"
 #include "sacapps/mergesort.hpp"
@@ -29,6 +30,9 @@
 #include "sacapps/quicksort.hpp"
 
 namespace {
+
+using app_test::expect_consistent;
+using app_test::pick;
 
 using sacapps::Point;
 using sacapps::Site;
@@ -76,30 +80,6 @@ const std::vector<Variant> kDiameterVariants{
 };
 
 // ------------------------------------------------------------------ helpers
-
-/// After a propagate: the output is right, the engine is sound, and the live trace equals a
-/// from-scratch run's on the current input.
-void expect_consistent(sacapps::App& app) {
-  EXPECT_TRUE(app.verify());
-  EXPECT_NO_THROW(app.engine().check_invariants());
-  auto fresh = app.clone_current();
-  fresh->run_self_adjusting();
-  EXPECT_TRUE(fresh->verify());
-  EXPECT_EQ(app.engine().live_events(), fresh->engine().live_events());
-  EXPECT_EQ(app.engine().record_bytes(), fresh->engine().record_bytes());
-}
-
-/// A random position in the wanted state, or positions() if there is none.
-std::size_t pick(const sacapps::App& app, bool want_present, std::mt19937_64& rng) {
-  const std::size_t n = app.positions();
-  if (n == 0) return 0;
-  const std::size_t start = rng() % n;
-  for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t i = (start + k) % n;
-    if (app.present(i) == want_present) return i;
-  }
-  return n;
-}
 
 /// One random mutator change (remove, reinsert or modify); false if none was possible.
 bool random_change(sacapps::App& app, std::mt19937_64& rng) {

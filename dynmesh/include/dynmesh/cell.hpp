@@ -30,6 +30,8 @@
 #include <cstdint>
 #include <string>
 
+#include <sac/hash.hpp>
+
 #include "dynmesh/point.hpp"
 
 namespace dynmesh {
@@ -239,14 +241,7 @@ struct CellHash {
     for (std::size_t a = 0; a < d; ++a) h = mix(h ^ (c.index[a] + 0x632be59bd9b4e019ULL * static_cast<std::uint64_t>(a + 1)));
     return static_cast<std::size_t>(h);
   }
-  static constexpr std::uint64_t mix(std::uint64_t x) noexcept {  // splitmix64 finaliser
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ULL;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebULL;
-    x ^= x >> 31;
-    return x;
-  }
+  static constexpr std::uint64_t mix(std::uint64_t x) noexcept { return sac::mix64(x); }
 };
 
 /// "level:(i,j[,k])", for messages.
