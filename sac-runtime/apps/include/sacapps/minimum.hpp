@@ -2,7 +2,7 @@
 //
 // Purpose: result = the minimum of a modifiable list of integers (INT64_MAX for the empty
 // list), kept up to date under insertions, deletions and replacements. It is the randomized
-// list contraction of sacapps/reduce.hpp instantiated with (min, INT64_MAX); see there for
+// list contraction of sacapps/contraction.hpp instantiated with (min, INT64_MAX); see there for
 // how the rounds are built and why an update touches O(1) cells per round.
 // Follows Acar's thesis (CMU 2005) and the CEAL benchmark "minimum" of Hammer, Acar and
 // Chen, "CEAL: a C-based language for self-adjusting computation", PLDI 2009.
@@ -18,7 +18,7 @@
 
 #include "sacapps/list.hpp"
 #include "sacapps/heap_list.hpp"
-#include "sacapps/reduce.hpp"
+#include "sacapps/contraction.hpp"
 
 namespace sacapps::minimum {
 
@@ -26,18 +26,21 @@ using Value = std::int64_t;
 
 struct Min {
   using value_type = Value;
-  static constexpr Value identity() { return std::numeric_limits<Value>::max(); }
-  static constexpr Value combine(Value a, Value b) { return std::min(a, b); }
+  Value identity() const { return std::numeric_limits<Value>::max(); }
+  Value leaf(const Cell<Value>& c) const { return c.value; }
+  Value combine(Value a, Value b) const { return std::min(a, b); }
+  bool operator==(const Min&) const = default;
+  std::size_t hash() const { return 0x6d696eu; }
 };
 
 /// Self-adjusting minimum (call inside the computation): writes min(in) into *result.
 inline void minimum_list(sac::Engine& rt, const List<Value>& in, sac::Mod<Value>* result) {
-  reduce::reduce_list<Min>(rt, in, result);
+  lists::reduce(rt, in, Min{}, result);
 }
 
 /// Conventional twin: one walk over a plain linked list.
 inline Value minimum_conventional(const heap::Cell<Value>* in) {
-  Value m = Min::identity();
+  Value m = Min{}.identity();
   for (; in; in = in->next) m = std::min(m, in->value);
   return m;
 }

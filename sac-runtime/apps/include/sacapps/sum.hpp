@@ -2,7 +2,7 @@
 //
 // Purpose: result = the sum of a modifiable list of integers (0 for the empty list), kept up
 // to date under insertions, deletions and replacements. It is the randomized list
-// contraction of sacapps/reduce.hpp instantiated with (+, 0); see there for how the rounds
+// contraction of sacapps/contraction.hpp instantiated with (+, 0); see there for how the rounds
 // are built and why an update touches O(1) cells per round. Integer addition is exact and
 // associative, so the contraction's result equals the conventional left fold bit for bit
 // (the benchmark's values are below 2^31, far from overflow).
@@ -18,7 +18,7 @@
 
 #include "sacapps/list.hpp"
 #include "sacapps/heap_list.hpp"
-#include "sacapps/reduce.hpp"
+#include "sacapps/contraction.hpp"
 
 namespace sacapps::sum {
 
@@ -26,13 +26,16 @@ using Value = std::int64_t;
 
 struct Plus {
   using value_type = Value;
-  static constexpr Value identity() { return 0; }
-  static constexpr Value combine(Value a, Value b) { return a + b; }
+  Value identity() const { return 0; }
+  Value leaf(const Cell<Value>& c) const { return c.value; }
+  Value combine(Value a, Value b) const { return a + b; }
+  bool operator==(const Plus&) const = default;
+  std::size_t hash() const { return 0x73756du; }
 };
 
 /// Self-adjusting sum (call inside the computation): writes sum(in) into *result.
 inline void sum_list(sac::Engine& rt, const List<Value>& in, sac::Mod<Value>* result) {
-  reduce::reduce_list<Plus>(rt, in, result);
+  lists::reduce(rt, in, Plus{}, result);
 }
 
 /// Conventional twin: one walk over a plain linked list.
