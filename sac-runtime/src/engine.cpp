@@ -293,7 +293,7 @@ void Engine::discard_pending() noexcept {
   reruns_.clear();
   body_mark_ = 0;
   close_floor_ = 0;
-  pending_allocs_.clear();  // still in the trace; destroy_all frees them from there
+  release_pending();  // the allocations are in the trace; destroy_all frees them there
 }
 
 void Engine::enqueue(ReadNode* r) {
@@ -383,16 +383,29 @@ void Engine::link_alloc(AllocNode* n, std::size_t h) {
   if (window_end_) {
     allocs_.insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
   } else {
-    pending_allocs_.push_back(PendingAlloc{n, h});
+    const std::size_t i = pending_count_ % kPendingPerSegment;
+    if (i == 0)
+      pending_segments_.push_back(static_cast<PendingAlloc*>(detail::Pool::acquire_huge_chunk()));
+    pending_segments_.back()[i] = PendingAlloc{n, h};
+    ++pending_count_;
   }
 }
 
+void Engine::release_pending() noexcept {
+  for (PendingAlloc* seg : pending_segments_) detail::Pool::release_huge_chunk(seg);
+  pending_segments_.clear();
+  pending_count_ = 0;
+}
+
 void Engine::index_pending_allocs() {
-  if (pending_allocs_.empty()) return;
-  allocs_.reserve(allocs_.size() + pending_allocs_.size(),
+  if (pending_count_ == 0) return;
+  allocs_.reserve(allocs_.size() + pending_count_,
                   [](const AllocNode* x) { return x->ops->hash(x); });
-  for (const PendingAlloc& p : pending_allocs_) allocs_.insert_reserved(p.node, p.hash);
-  std::vector<PendingAlloc>().swap(pending_allocs_);  // transient: give the memory back
+  for (std::size_t i = 0; i < pending_count_; ++i) {
+    const PendingAlloc& p = pending_segments_[i / kPendingPerSegment][i % kPendingPerSegment];
+    allocs_.insert_reserved(p.node, p.hash);
+  }
+  release_pending();
 }
 
 void Engine::link_memo(MemoNode* n, std::size_t h) {

@@ -91,6 +91,15 @@ void Pool::new_chunk() {
   if (next_chunk_ < kMaxChunk) next_chunk_ *= 2;
 }
 
+void* Pool::acquire_huge_chunk() {
+  if (void* c = ChunkCache::instance().take(kHugeChunk)) return c;
+  return map_huge(kHugeChunk);
+}
+
+void Pool::release_huge_chunk(void* p) noexcept {
+  if (!ChunkCache::instance().give(p, kHugeChunk)) ::munmap(p, kHugeChunk);
+}
+
 void Pool::release() noexcept {
   for (const Chunk& c : chunks_) {
     if (c.size >= kHugeChunk) {

@@ -311,12 +311,17 @@ class Engine {
   // Keyed allocations of the running run() with their hashes: nothing can look them up
   // before the run ends (there is no re-execution window), so they are indexed in one
   // presized pass at its end, reading this array sequentially and only storing into the
-  // (cold) records, instead of through log n table doublings that reload every record.
+  // (cold) records, instead of through log n table doublings that reload every record. The
+  // array lives in 2 MiB huge-page segments from the pool's chunk cache, so a warm run does
+  // not fault in fresh pages for it.
   struct PendingAlloc {
     detail::AllocNode* node;
     std::size_t hash;
   };
-  std::vector<PendingAlloc> pending_allocs_;
+  static constexpr std::size_t kPendingPerSegment = detail::Pool::kHugeChunk / sizeof(PendingAlloc);
+  std::vector<PendingAlloc*> pending_segments_;
+  std::size_t pending_count_ = 0;
+  void release_pending() noexcept;
   std::vector<detail::VersionBase*> bases_;    // base versions; index kept in stamp.label
   std::vector<Task> tasks_;                    // the trampoline's stack
   std::vector<RerunContext> reruns_;           // contexts saved by the running re-executions

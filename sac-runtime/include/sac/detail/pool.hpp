@@ -57,6 +57,11 @@ class Pool {
     free_[n / kGrain] = b;
   }
 
+  /// A 2 MiB-aligned huge-page chunk of kHugeChunk bytes for scratch buffers, from the
+  /// process-wide cache of freed chunks when one is there (then already faulted in).
+  static void* acquire_huge_chunk();
+  static void release_huge_chunk(void* p) noexcept;
+
   std::size_t live_bytes() const { return live_bytes_; }
   std::size_t reserved_bytes() const { return reserved_; }
 
