@@ -30,17 +30,7 @@ namespace {
 using app_test::expect_consistent;
 using app_test::pick;
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
+using app_test::kSanitized;
 
 // Large sizes of the work tests (kept modest under the sanitizers, which run at -O0).
 constexpr std::size_t kLargeN = kSanitized ? 20000 : 100000;

@@ -42,17 +42,7 @@ using sacapps::quickhull::Distribution;
 using sacapps::quickhull::QuickhullApp;
 using sacapps::quicksort::QuicksortApp;
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
+using app_test::kSanitized;
 
 // ------------------------------------------------------------------ the apps under test
 
