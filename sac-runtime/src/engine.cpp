@@ -105,6 +105,11 @@ void Engine::set_base(ModBase& m, VersionBase* fresh,
   else m.newest_ = fresh;
 }
 
+bool Engine::unused(const ModBase& m) const noexcept {
+  const VersionBase* v = m.newest_;
+  return !v || (v->is_base() && !v->older() && !v->readers);
+}
+
 void Engine::retire(ModBase& m) {
   require_mutator("retire");
   VersionBase* v = m.newest_;

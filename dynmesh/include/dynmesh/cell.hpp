@@ -51,6 +51,13 @@ struct CellId {
     return true;
   }
   /// (level, i, j, k) lexicographic: the order of `.cells` files.
+  /// For sac::Hash, so that a cell can key a keyed allocation or a memoized call.
+  constexpr std::size_t hash() const noexcept {
+    std::uint64_t h = sac::mix64(static_cast<std::uint64_t>(level) + 0x9e3779b97f4a7c15ULL);
+    for (std::size_t k = 0; k < d; ++k) h = sac::mix64(h ^ index[k]);
+    return static_cast<std::size_t>(h);
+  }
+
   friend constexpr std::strong_ordering operator<=>(const CellId& a, const CellId& b) noexcept {
     if (a.level != b.level) return a.level <=> b.level;
     for (std::size_t k = 0; k < d; ++k)

@@ -155,6 +155,17 @@ class Engine {
   /// and no versions written by the computation.
   void retire(ModBase& m);
 
+  /// Gives a never-written m a base value, as set() before the first run would. Unlike
+  /// set() it may also be called inside the computation: it serves modifiables that are
+  /// named lazily outside the trace (a directory keyed by name), which every run, fresh or
+  /// re-executing, would find with the same default. UsageError if m is already written.
+  template <class T, class U>
+  void init(Mod<T>& m, U&& value);
+
+  /// True when nothing in the trace refers to m: it has no version written by the
+  /// computation and no reader (it may then be retired).
+  bool unused(const ModBase& m) const noexcept;
+
   /// Runs f(Engine&) (or f()) from scratch, appending its trace after earlier runs.
   template <class F>
   void run(F&& f);
@@ -359,6 +370,15 @@ void Engine::set(Mod<T>& m, U&& value) {
     }
     return true;
   });
+}
+
+template <class T, class U>
+void Engine::init(Mod<T>& m, U&& value) {
+  if (m.written()) throw UsageError("sac::Engine::init: the modifiable is already written");
+  using V = detail::Version<T>;
+  V* v = construct<V>(std::forward<U>(value));
+  v->ops = &detail::VersionOpsFor<T>::ops;
+  set_base(m, v, nullptr);  // no base yet, so nothing to compare with
 }
 
 template <class F>

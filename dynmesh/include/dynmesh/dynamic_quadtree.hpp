@@ -1,0 +1,142 @@
+// dynmesh/dynamic_quadtree.hpp — the well-graded quadtree/octree T*, kept up to date under
+// point insertions and deletions by self-adjusting computation.
+//
+// Purpose: the public dynamic API. QuadTreeRefine (Acar & Hudson, Figure 2) is written as
+// ordinary static code on sac-runtime (dynmesh/src/quadtree_refine.hpp); this class owns the
+// engine, the input point list and the cell directory, runs the program once, and after
+// each insert / erase / batch calls propagate(), which leaves exactly the tree a
+// from-scratch run on the current point set would build (DESIGN.md, "The quadtree
+// contract"), in O(lg L/s) trace distance per single-point update.
+//
+// Invariants (check_invariants()):
+//   * the engine's own invariants (order list, queue, trace, tables);
+//   * leaves() are exactly the leaves of T* of the current points (check_tree: tiling,
+//     occupancy, separation, grading, crowding, minimality), and every point lies in the
+//     leaf that holds it;
+//   * the position index, the id index and the input list hold the same points;
+//   * every directory slot that the trace does not reference is reclaimable (compact()).
+// Failure atomicity: every mutator call validates its whole input before changing anything,
+// so a call that throws InputError leaves the tree, the ids and the engine as they were.
+// Determinism: results depend only on the point set; ids never enter the computation, and
+// nothing depends on pointer values or hash iteration order.
+// Complexity: construction O(n·h + |T*|) trace events (h = mean depth at which a point is
+// isolated, O(lg L/s)); insert/erase O(lg L/s) expected trace distance (the stability
+// experiments measure it); leaves() O(|T*| lg |T*|); locate O(depth); neighbours O(3^d·2^d).
+// Paper: Acar & Hudson, "Optimal-time dynamic mesh refinement", Section 2 (QuadTreeRefine),
+// Section 4 (dynamization, keyed work-queue entries, monotonicity).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include <sac/stats.hpp>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/cell.hpp"
+#include "dynmesh/io.hpp"
+#include "dynmesh/point.hpp"
+#include "dynmesh/static_quadtree.hpp"
+
+namespace dynmesh {
+
+/// Stable identity of an input point (never reused within one tree).
+using PointId = std::uint64_t;
+
+/// A leaf and the ids of the points in it (at most one in T*).
+template <std::size_t d>
+  requires SupportedDim<d>
+struct LeafPoints {
+  CellId<d> cell;
+  std::vector<PointId> points;
+};
+
+/// Figures of the last update (insert, erase or batch).
+struct UpdateStats {
+  std::uint64_t trace_distance = 0;  // trace events created + undone by its propagation
+  std::uint64_t reexecuted = 0;      // reads re-executed
+  double seconds = 0.0;              // wall time of propagate()
+};
+
+namespace detail {
+template <std::size_t d>
+struct DynamicState;
+}
+
+template <std::size_t d>
+  requires SupportedDim<d>
+class DynamicQuadtree {
+ public:
+  /// Builds T* of `points` in `box` from scratch. Throws InputError (NotFinite, OutsideBox,
+  /// Duplicate, Resolution) naming the point index; ids are 0..n−1 in input order.
+  explicit DynamicQuadtree(const Box<d>& box, std::span<const Point<d>> points = {});
+  ~DynamicQuadtree();
+  DynamicQuadtree(DynamicQuadtree&&) noexcept;
+  DynamicQuadtree& operator=(DynamicQuadtree&&) noexcept;
+
+  /// Inserts p and returns its id. InputError: NotFinite, OutsideBox, Duplicate (same
+  /// located position as a present point), Resolution (another point within one grid
+  /// unit: a level-52 cell would have to split).
+  PointId insert(const Point<d>& p);
+  /// Erases the point with this id; InputError(Absent) if there is none.
+  void erase(PointId id);
+  /// Erases the point with exactly these coordinates; InputError(Absent) if there is none.
+  void erase(const Point<d>& p);
+  /// Applies the edits in order and propagates once. Validated as a whole first: on error
+  /// (naming the edit's script line when it has one, else its index) nothing changes.
+  /// Returns the ids of the inserted points in edit order.
+  std::vector<PointId> apply(std::span<const Edit<d>> edits);
+
+  const Box<d>& box() const noexcept;
+  std::size_t size() const noexcept;
+  bool contains(PointId id) const noexcept;
+  std::optional<PointId> find(const Point<d>& p) const noexcept;
+  /// The coordinates of a present point; InputError(Absent) otherwise.
+  const Point<d>& point(PointId id) const;
+  /// The present points with their ids, in the order of the input list.
+  std::vector<std::pair<PointId, Point<d>>> points() const;
+  /// The located positions of the present points (input-list order).
+  std::vector<Position<d>> positions() const;
+
+  /// The leaves of T*, sorted by (level, i, j, k), with point counts (the `.cells` order).
+  std::vector<Leaf<d>> leaves() const;
+  /// The leaves with the ids of their points, same order.
+  std::vector<LeafPoints<d>> leaves_with_points() const;
+  /// The leaf containing p (any point of the box). InputError for NaN or outside the box.
+  CellId<d> locate(const Point<d>& p) const;
+  /// The leaves touching leaf c (closed boxes intersect), sorted, c excluded.
+  /// std::invalid_argument if c is not a leaf.
+  std::vector<CellId<d>> neighbours(const CellId<d>& leaf) const;
+  /// Number of split cells and of leaves.
+  std::size_t num_split() const;
+  std::size_t num_leaves() const { return num_split() * (kChildren<d> - 1) + 1; }
+
+  const UpdateStats& last_update() const noexcept;
+  const sac::Stats& engine_stats() const noexcept;
+  /// Live trace memory (records, closures, tables), input list and directory included.
+  std::size_t trace_bytes() const;
+  /// Live trace records only (equal for equal traces).
+  std::size_t record_bytes() const;
+  std::uint64_t live_events() const;
+  /// Directory slots held (cells the computation has named).
+  std::size_t directory_size() const noexcept;
+
+  /// Releases directory slots that no trace event references. Runs automatically when the
+  /// directory has doubled since the last compaction, so memory stays proportional to the
+  /// live trace; call it before comparing memory with a from-scratch run.
+  void compact();
+
+  /// See the header comment; throws InvariantError (or sac::InvariantError) on failure.
+  void check_invariants() const;
+
+ private:
+  std::unique_ptr<detail::DynamicState<d>> s_;
+};
+
+extern template class DynamicQuadtree<2>;
+extern template class DynamicQuadtree<3>;
+
+}  // namespace dynmesh
