@@ -120,7 +120,8 @@ struct DynamicState {
 
   Box<d> box;
   StablePool<Node> inputs;
-  Node* first = nullptr;
+  Node* first = nullptr;  // the input list, mirrored for the mutator
+  Node* tail = nullptr;
   std::unordered_map<Position<d>, Node*, PositionHash<d>> by_pos;
   std::unordered_map<PointId, Node*> by_id;
   PointId next_id = 0;
@@ -162,13 +163,17 @@ struct DynamicState {
   }
 
   // ------------------------------------------------------------------ list edits
+  /// Appends a point to the input list. Appending, not prepending, keeps every cell's list
+  /// head unchanged unless the cell held fewer than two points, and the crowding tests read
+  /// only list heads.
   Node* link_new(const Position<d>& q, const Point<d>& x) {
     Node* n = inputs.create(q, x, next_id++);
-    rt.set(n->next, static_cast<PNode<d>*>(first));
-    rt.set(head, static_cast<PNode<d>*>(n));
-    n->succ = first;
-    if (first) first->prev = n;
-    first = n;
+    rt.set(n->next, static_cast<PNode<d>*>(nullptr));
+    rt.set(tail ? tail->next : head, static_cast<PNode<d>*>(n));
+    n->prev = tail;
+    if (tail) tail->succ = n;
+    else first = n;
+    tail = n;
     by_pos.emplace(q, n);
     by_id.emplace(n->id, n);
     return n;
@@ -180,6 +185,7 @@ struct DynamicState {
     if (n->prev) n->prev->succ = n->succ;
     else first = n->succ;
     if (n->succ) n->succ->prev = n->prev;
+    else tail = n->prev;
     by_pos.erase(n->q);
     by_id.erase(n->id);
   }
@@ -291,16 +297,11 @@ DynamicQuadtree<d>::DynamicQuadtree(const Box<d>& box, std::span<const Point<d>>
       throw InputError(e.kind(), "point " + std::to_string(i) + ": " + e.text()).with_points({i});
     }
   }
-  // The list holds the points in input order (link_new prepends, so go backwards); ids
-  // are the input indices.
+  // The list holds the points in input order; ids are the input indices.
   s.by_pos.reserve(points.size());
   s.by_id.reserve(points.size());
   s.rt.set(s.head, static_cast<detail::PNode<d>*>(nullptr));
-  for (std::size_t i = points.size(); i-- > 0;) {
-    s.next_id = i;
-    s.link_new(qs[i], points[i]);
-  }
-  s.next_id = points.size();
+  for (std::size_t i = 0; i < points.size(); ++i) s.link_new(qs[i], points[i]);
   s.program.dir = &s.dir;
   s.program.input = &s.head;
   auto* program = &s.program;
