@@ -1132,6 +1132,59 @@ TEST(EngineMisuse, RetireRules) {
   expect_healthy(e);
 }
 
+// init() names a modifiable lazily, inside the computation, with a default that every run
+// would see; a later write before an earlier reader re-runs that reader.
+TEST(EngineInit, LazilyNamedDefaultsBehaveLikeInputs) {
+  Engine e;
+  Mod<int> flag, lazy, out, src;
+  e.set(src, 0);
+  e.set(flag, 0);
+  e.run([&](Engine& en) {
+    // The reader of `lazy` comes first; the write (when src is 1) comes after it.
+    en.read(flag, body([pl = &lazy, po = &out](Engine& x, int) {
+      if (!pl->written()) x.init(*pl, 7);
+      x.read(*pl, body([po](Engine& y, int v) { y.write(*po, v); }));
+    }));
+    en.read(src, body([pl = &lazy](Engine& x, int v) {
+      if (!pl->written()) x.init(*pl, 7);
+      if (v) x.write(*pl, 9);
+    }));
+  });
+  EXPECT_EQ(out.get(), 7);
+  EXPECT_FALSE(e.unused(lazy)) << "it is read";
+  EXPECT_THROW(e.init(lazy, 1), sac::UsageError) << "already written";
+  e.set(src, 1);
+  e.propagate();
+  EXPECT_EQ(out.get(), 7) << "the write comes after the read";
+  EXPECT_EQ(lazy.get(), 9);
+  expect_healthy(e);
+}
+
+TEST(EngineInit, UnusedOnceNothingInTheTraceRefersToIt) {
+  Engine e;
+  Mod<int> sel, a, b, out;
+  e.set(sel, 0);
+  e.run([&](Engine& en) {
+    en.read(sel, body([pa = &a, pb = &b, po = &out](Engine& x, int v) {
+      Mod<int>* m = v ? pb : pa;
+      if (!m->written()) x.init(*m, v ? 20 : 10);
+      x.read(*m, body([po](Engine& y, int w) { y.write(*po, w); }));
+    }));
+  });
+  EXPECT_EQ(out.get(), 10);
+  EXPECT_FALSE(e.unused(a));
+  EXPECT_TRUE(e.unused(b)) << "never named";
+  e.set(sel, 1);
+  e.propagate();
+  EXPECT_EQ(out.get(), 20);
+  EXPECT_TRUE(e.unused(a)) << "its only reader was undone";
+  EXPECT_FALSE(e.unused(b));
+  EXPECT_FALSE(e.unused(out)) << "written by the computation";
+  e.retire(a);
+  EXPECT_FALSE(a.written());
+  expect_healthy(e);
+}
+
 void maybe_throw(Engine& e, Mod<int>* src, int bad) {
   e.make<std::string>(std::string(100, 'm'));
   e.read(*src, body([bad, s = std::string(64, 'q')](Engine& x, int v) {
