@@ -1,0 +1,185 @@
+// dynmesh_bench — from-scratch overhead, update time, speedup and memory of the
+// self-adjusting quadtree (DynamicQuadtree) against the plain static oracle
+// (StaticQuadtree), for the figures of bench/RESULTS.md.
+//
+// Method (as sac_suite): for each n, the static build is the median of three; the
+// self-adjusting build follows one untimed warm-up build (so that both sides run on memory
+// the process has already touched: first-touch page zeroing on these VMs costs more than
+// the computation) and is the median of `--reps` timed builds. Then U updates alternate a
+// deletion of a random present point and an insertion of a fresh point of the same
+// distribution; each update's propagate() time and trace distance are recorded, and the
+// mean and median of each kind are reported. After the updates the tree is compared with a
+// static build on the final point set (verified = 1 when equal). All ratios come from one
+// process run. Output: a table, or CSV with --csv:
+//   dim,dist,n,static_s,scratch_s,overhead,insert_us,delete_us,update_us,median_update_us,
+//   speedup,mean_distance,trace_bytes,bytes_per_point,verified
+// speedup = scratch_s / mean update time (the runtime's own from-scratch run, as the issue
+// asks); overhead = scratch_s / static_s.
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/dynamic_quadtree.hpp"
+#include "dynmesh/static_quadtree.hpp"
+
+namespace {
+
+using namespace dynmesh;
+using Clock = std::chrono::steady_clock;
+
+template <class F>
+double seconds(F&& f) {
+  const auto t0 = Clock::now();
+  f();
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
+}
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / static_cast<double>(v.size());
+}
+
+struct Row {
+  int dim = 2;
+  std::string dist;
+  std::size_t n = 0;
+  double static_s = 0, scratch_s = 0, insert_us = 0, delete_us = 0, update_us = 0,
+         median_update_us = 0, mean_distance = 0;
+  std::size_t trace_bytes = 0;
+  bool verified = false;
+};
+
+template <std::size_t d>
+Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std::uint64_t seed) {
+  Row row;
+  row.dim = static_cast<int>(d);
+  row.dist = std::string(distribution_name(dist));
+  row.n = n;
+  const auto pool = generate<d>(dist, n + updates, seed);
+  const std::vector<Point<d>> initial(pool.begin(), pool.begin() + static_cast<std::ptrdiff_t>(n));
+  const Box<d> box = derive_box<d>(pool);
+
+  std::vector<double> st;
+  for (int i = 0; i < 3; ++i)
+    st.push_back(seconds([&] { auto t = StaticQuadtree<d>::from_points(box, initial); (void)t; }));
+  row.static_s = median(st);
+
+  { DynamicQuadtree<d> warm(box, initial); }
+  std::vector<double> sc;
+  std::optional<DynamicQuadtree<d>> tree;
+  for (int i = 0; i < reps; ++i) {
+    tree.reset();
+    sc.push_back(seconds([&] { tree.emplace(box, initial); }));
+  }
+  row.scratch_s = median(sc);
+  row.trace_bytes = tree->trace_bytes();
+
+  Rng rng(seed ^ 0x5eed);
+  std::vector<PointId> ids;
+  for (const auto& [id, p] : tree->points()) ids.push_back(id);
+  std::vector<double> ins, del, all, dist_all;
+  std::size_t next = n;
+  for (std::size_t u = 0; u < updates; ++u) {
+    if (u % 2 == 0 && !ids.empty()) {
+      const std::size_t k = static_cast<std::size_t>(rng.below(ids.size()));
+      tree->erase(ids[k]);
+      ids[k] = ids.back();
+      ids.pop_back();
+      del.push_back(tree->last_update().seconds);
+    } else {
+      bool done = false;
+      while (!done && next < pool.size()) {
+        try {
+          ids.push_back(tree->insert(pool[next++]));
+          done = true;
+        } catch (const InputError&) {  // a duplicate or a too-close point: take the next one
+        }
+      }
+      if (!done) continue;
+      ins.push_back(tree->last_update().seconds);
+    }
+    all.push_back(tree->last_update().seconds);
+    dist_all.push_back(static_cast<double>(tree->last_update().trace_distance));
+  }
+  row.insert_us = mean(ins) * 1e6;
+  row.delete_us = mean(del) * 1e6;
+  row.update_us = mean(all) * 1e6;
+  row.median_update_us = median(all) * 1e6;
+  row.mean_distance = mean(dist_all);
+
+  const auto oracle = StaticQuadtree<d>::from_points(box, [&] {
+    std::vector<Point<d>> cur;
+    for (const auto& [id, p] : tree->points()) cur.push_back(p);
+    return cur;
+  }());
+  const auto leaves = tree->leaves();
+  row.verified = std::equal(leaves.begin(), leaves.end(), oracle.leaves().begin(), oracle.leaves().end());
+  return row;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"dynmesh_bench: self-adjusting quadtree vs the static oracle"};
+  int dim = 2;
+  std::string dist_name = "uniform";
+  std::vector<std::size_t> sizes{1000, 10000, 100000};
+  std::size_t updates = 1000;
+  int reps = 3;
+  std::uint64_t seed = 1;
+  bool csv = false;
+  app.add_option("--dim", dim, "2 or 3")->check(CLI::IsMember({2, 3}));
+  app.add_option("--dist", dist_name, "point distribution");
+  app.add_option("--n", sizes, "sizes (several allowed)")->delimiter(',');
+  app.add_option("--updates", updates, "updates measured per size");
+  app.add_option("--reps", reps, "timed from-scratch builds (median)")->check(CLI::PositiveNumber);
+  app.add_option("--seed", seed, "seed");
+  app.add_flag("--csv", csv, "CSV output");
+  CLI11_PARSE(app, argc, argv);
+  const auto dist = parse_distribution(dist_name);
+  if (!dist) {
+    std::fprintf(stderr, "dynmesh_bench: unknown distribution '%s'\n", dist_name.c_str());
+    return 1;
+  }
+  if (csv)
+    std::printf("dim,dist,n,static_s,scratch_s,overhead,insert_us,delete_us,update_us,"
+                "median_update_us,speedup,mean_distance,trace_bytes,bytes_per_point,verified\n");
+  else
+    std::printf("%3s %-9s %8s %9s %9s %8s %9s %9s %9s %9s %9s %8s %11s %8s\n", "dim", "dist", "n",
+                "static_s", "scratch_s", "overhead", "insert_us", "delete_us", "update_us",
+                "median_us", "speedup", "distance", "bytes/point", "verified");
+  for (std::size_t n : sizes) {
+    const Row r = dim == 2 ? measure<2>(*dist, n, updates, reps, seed)
+                           : measure<3>(*dist, n, updates, reps, seed);
+    const double overhead = r.scratch_s / r.static_s;
+    const double speedup = r.scratch_s / (r.update_us * 1e-6);
+    const double bpp = static_cast<double>(r.trace_bytes) / static_cast<double>(r.n);
+    if (csv)
+      std::printf("%d,%s,%zu,%.6f,%.6f,%.3f,%.2f,%.2f,%.2f,%.2f,%.1f,%.1f,%zu,%.1f,%d\n", r.dim,
+                  r.dist.c_str(), r.n, r.static_s, r.scratch_s, overhead, r.insert_us, r.delete_us,
+                  r.update_us, r.median_update_us, speedup, r.mean_distance, r.trace_bytes, bpp,
+                  r.verified ? 1 : 0);
+    else
+      std::printf("%3d %-9s %8zu %9.4f %9.4f %8.2f %9.1f %9.1f %9.1f %9.1f %9.0f %8.1f %11.0f %8d\n",
+                  r.dim, r.dist.c_str(), r.n, r.static_s, r.scratch_s, overhead, r.insert_us,
+                  r.delete_us, r.update_us, r.median_update_us, speedup, r.mean_distance, bpp,
+                  r.verified ? 1 : 0);
+    std::fflush(stdout);
+    if (!r.verified) return 1;
+  }
+  return 0;
+}
