@@ -32,9 +32,10 @@ void OrderList::insert_slow(Stamp* pos, Stamp* s) {
     std::uint32_t gi = pos->group;
     Stamp* n = pos->next();
     bool n_same = n && n->group == gi;
-    if (groups_[gi].count >= kGroupCap) {
+    if (groups_[gi].count >= kGroupCap || (!n && groups_[gi].count >= kAppendFill)) {
       if (!n_same) {
-        // pos ends a full group: open a fresh group for s (the common append case).
+        // pos ends a full group, or the list at the append fill: open a fresh group for s
+        // (the common append case).
         std::uint32_t g2 = new_group_after(gi);
         Group& G2 = groups_[g2];
         G2.first = s;

@@ -208,8 +208,9 @@ TEST(OrderList, LongAppendRun) {
   }
   ASSERT_NO_FATAL_FAILURE(m.verify(rng));
   EXPECT_EQ(m.ol.size(), static_cast<std::size_t>(n));
-  // Groups are filled to capacity by appends.
-  EXPECT_LE(m.ol.group_count(), static_cast<std::size_t>(n) / OrderList::kGroupCap + 2);
+  // Appends fill groups to kAppendFill, leaving room for later insertions.
+  EXPECT_LE(m.ol.group_count(), static_cast<std::size_t>(n) / OrderList::kAppendFill + 2);
+  EXPECT_GE(m.ol.group_count(), static_cast<std::size_t>(n) / OrderList::kAppendFill);
 }
 
 TEST(OrderList, ClusteredInsertsSplitGroupsAndRelabelTheTop) {

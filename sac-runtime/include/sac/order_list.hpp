@@ -61,6 +61,10 @@ static_assert(sizeof(Stamp) == 16);
 class OrderList {
  public:
   static constexpr std::uint32_t kGroupCap = 64;
+  /// Appends at the very end of the list (every from-scratch run) start a new group once a
+  /// group holds this many, leaving room for later insertions: inserting into a full group
+  /// splits it, which walks and relabels its (cold) stamps.
+  static constexpr std::uint32_t kAppendFill = 48;
 
   OrderList();
   OrderList(const OrderList&) = delete;
@@ -82,7 +86,7 @@ class OrderList {
     Group& g = groups_[pos->group];
     Stamp* n = pos->next();
     // Fast path: room in the group and between the labels (appends step by kAppendStep).
-    if (g.count < kGroupCap) {
+    if (g.count < kGroupCap && (n || g.count < kAppendFill)) {
       std::uint64_t lo = pos->label;
       std::uint64_t hi = (n && n->group == pos->group) ? n->label : kBottomRange;
       if (hi - lo >= 2) {
