@@ -40,12 +40,13 @@ has_opt() {
 }
 
 # ==== MAIN JOB: what `bash dev.sh run` runs. =============================================
-# Switch this to the dynmesh demo once dynmesh lands. Arguments override the defaults.
+# The dynmesh demo on its embedded input (20000 clustered points, 2000 updates): prints the
+# figures and `verified: yes`, and draws the final tree to build/dynmesh-demo.svg (inside the
+# ignored build/ tree). Arguments pass through (e.g. --n 100000 --updates 500 --svg tree.svg).
 main_job() {
   local args=("$@")
-  has_opt --n "$@" || args+=(--n 100000)
-  has_opt --updates "$@" || args+=(--updates 100)
-  build/release/bin/sac_suite "${args[@]}"
+  has_opt --svg "$@" || args+=(--svg build/dynmesh-demo.svg)
+  build/release/bin/dynmesh demo "${args[@]}"
 }
 # ==========================================================================================
 
@@ -83,7 +84,7 @@ usage() {
   cat >&2 <<'USAGE'
 usage: bash dev.sh COMMAND [args]
   deps         install missing Debian packages (apt-get; sudo when not root)
-  run [args]   Release build into build/release, then the main job (sac_suite --n 100000 --updates 100)
+  run [args]   Release build into build/release, then the main job (dynmesh demo [args])
   test         RelWithDebInfo build (asserts on, -Werror) into build/debug, then every ctest test
   asan         Debug build with ASan+UBSan (clang++ if present) into build/asan, then ctest
   bench        Release build, then sac_suite at the README sizes

@@ -1,0 +1,59 @@
+// dynmesh/tools/commands.hpp — the subcommands of the `dynmesh` program (private to the tool).
+//
+// Purpose: one options struct and one entry point per subcommand; main.cpp parses the
+// command line into these with CLI11 and calls the entry point. The contracts are
+// shared/FORMATS.md's `dynmesh quadtree` and `dynmesh stability`; `demo` is the README's
+// main job.
+// Invariants: an entry point returns the exit status (0 success, 1 failure) or throws; every
+// exception becomes one line `dynmesh: <message>` on stderr in main.cpp, so the commands
+// never print errors themselves.
+// Complexity: see each command's source file.
+// Paper: Acar & Hudson, "Optimal-time dynamic mesh refinement" (the quadtree; the stability
+// bound O(lg L/s) that `stability` measures).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dynmesh::tool {
+
+struct QuadtreeOptions {
+  std::string points;       // POINTS: .node or plain text
+  int dim = 2;              // --dim
+  bool dim_given = false;   // --dim appeared (else a .node header decides)
+  std::vector<double> box;  // --box o1 o2 [o3] L (empty: derive from the initial points)
+  std::string edits;        // --edits FILE
+  std::size_t batch = 0;    // --batch K (0: one propagation per edit)
+  std::string cells;        // --cells OUT
+  bool check = false;       // --check
+  std::string svg;          // --svg OUT.svg (2D)
+};
+
+struct StabilityOptions {
+  int dim = 2;
+  std::string dist;
+  std::size_t n = 0;
+  double spread = 0x1p20;
+  std::size_t updates = 1000;
+  std::uint64_t seed = 1;
+  std::string csv;
+  std::string plot;  // --plot OUT.svg (empty: no plot)
+};
+
+struct DemoOptions {
+  std::size_t n = 20000;
+  std::size_t updates = 2000;
+  std::uint64_t seed = 1;
+  std::string svg = "dynmesh-demo.svg";
+};
+
+int run_quadtree(const QuadtreeOptions& options);
+int run_stability(const StabilityOptions& options);
+int run_demo(const DemoOptions& options);
+
+/// Plots a stability CSV (all its rows, earlier runs included) to `svg_path` with gnuplot.
+void plot_stability_csv(const std::string& csv_path, const std::string& svg_path);
+
+}  // namespace dynmesh::tool

@@ -1,0 +1,96 @@
+// dynmesh — the command-line tool of the dynmesh library (shared/FORMATS.md):
+//   dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--edits FILE] [--batch K]
+//                   --cells OUT [--check] [--svg OUT.svg]
+//   dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]
+//                     --csv OUT.csv [--plot OUT.svg]
+//   dynmesh demo [--n N] [--updates U] [--seed X] [--svg OUT.svg]
+// Exit status: 0 on success; 1 with exactly one line `dynmesh: <message>` on stderr on any
+// error; 2 for a command line CLI11 rejects (also one line).
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+#include "verify.hpp"
+
+int main(int argc, char** argv) {
+  using namespace dynmesh::tool;
+  CLI::App app{"dynmesh: dynamic well-graded quadtrees (and, later, meshes) of changing point sets"};
+  app.require_subcommand(1);
+
+  const CLI::Validator at_least_one(
+      [](std::string& value) -> std::string {
+        const bool digits = value.find_first_not_of("0123456789") == std::string::npos;
+        const bool nonzero = value.find_first_not_of('0') != std::string::npos;
+        return digits && nonzero ? std::string{} : "must be a whole number of at least 1, got '" + value + "'";
+      },
+      "K>=1");
+
+  QuadtreeOptions q;
+  CLI::App* quadtree = app.add_subcommand(
+      "quadtree", "Build the quadtree T* of a point file, apply an edit script dynamically, write the leaves");
+  quadtree->add_option("POINTS", q.points, "point file: .node (Triangle/TetGen) or plain text (x y [z] per line)")
+      ->required();
+  CLI::Option* dim_opt =
+      quadtree->add_option("--dim", q.dim, "dimension of plain-text points (a .node header decides when omitted)")
+          ->check(CLI::IsMember({2, 3}));
+  quadtree->add_option("--box", q.box, "domain box: origin and side length (default: derived from the initial points)")
+      ->expected(3, 4)
+      ->type_name("o1 o2 [o3] L");
+  quadtree->add_option("--edits", q.edits, "edit script: '+ x y [z]' inserts, '- x y [z]' deletes, one per line");
+  quadtree->add_option("--batch", q.batch, "propagate K consecutive edits together (default: each edit alone)")
+      ->check(at_least_one);
+  quadtree->add_option("--cells", q.cells, "output: the final leaves as .cells")->required();
+  quadtree->add_flag("--check", q.check, "also rebuild from scratch on the final points and fail if the trees differ");
+  quadtree->add_option("--svg", q.svg, "also draw the final tree and points (2D only)");
+
+  StabilityOptions s;
+  CLI::App* stability = app.add_subcommand(
+      "stability",
+      "Measure the trace distance of single-point updates (alternating deletions and insertions) and append "
+      "one CSV row per update: dist,dim,n,log2_spread,op,trace_distance,seconds. log2_spread is log2(L/s) of "
+      "the point set after that update, exact for every row (the closest-pair distance is maintained)");
+  stability->add_option("--dim", s.dim, "dimension")->required()->check(CLI::IsMember({2, 3}));
+  stability
+      ->add_option("--dist", s.dist, "distribution: uniform, clusters, spiral, shrinking, grid, collinear, boundary")
+      ->required();
+  stability->add_option("--n", s.n, "number of points the tree is built on")->required();
+  stability->add_option("--spread", s.spread, "target spread L/s of the 'shrinking' distribution")
+      ->capture_default_str();
+  stability->add_option("--updates", s.updates, "updates measured")->capture_default_str();
+  stability->add_option("--seed", s.seed, "random seed")->capture_default_str();
+  stability->add_option("--csv", s.csv, "output CSV (appended to; header written when new or empty)")->required();
+  stability->add_option("--plot", s.plot, "also plot every row of the CSV with gnuplot (SVG)");
+
+  DemoOptions m;
+  CLI::App* demo = app.add_subcommand(
+      "demo", "Build the quadtree on an embedded clustered point set, time single-point updates, verify, draw");
+  demo->add_option("--n", m.n, "number of points")->capture_default_str();
+  demo->add_option("--updates", m.updates, "updates (alternating deletions and insertions)")->capture_default_str();
+  demo->add_option("--seed", m.seed, "random seed of the point set and of the updates")->capture_default_str();
+  demo->add_option("--svg", m.svg, "picture of the final tree (empty: none)")->capture_default_str();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    std::fprintf(stderr, "dynmesh: %s (see dynmesh --help)\n", one_line(e.what()).c_str());
+    return 2;
+  }
+
+  try {
+    if (*quadtree) {
+      q.dim_given = dim_opt->count() > 0;
+      return run_quadtree(q);
+    }
+    if (*stability) return run_stability(s);
+    if (*demo) return run_demo(m);
+  } catch (const std::exception& e) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "dynmesh: %s\n", one_line(e.what()).c_str());
+    return 1;
+  }
+  return 0;
+}

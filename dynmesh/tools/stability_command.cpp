@@ -1,0 +1,126 @@
+// `dynmesh stability`: the trace-distance experiment of shared/FORMATS.md. Builds the tree on
+// N points of a distribution, then measures U single-point updates (alternating deletions of
+// a present point and insertions of a new point of the same distribution, one propagation
+// each) and appends one CSV row per update.
+//
+// The N initial points and the insertion pool come from one call generate(dist, N + U, seed,
+// spread): the generators return their points in a seeded random order, so the first N are
+// a sample of the distribution and the rest are fresh points of the same distribution,
+// distinct from them. log2_spread is exact for every row (UpdateDriver keeps the closest-pair
+// distance up to date; see update_driver.hpp).
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "dynmesh/box.hpp"
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/dynamic_quadtree.hpp"
+#include "dynmesh/errors.hpp"
+#include "progress.hpp"
+#include "update_driver.hpp"
+
+namespace dynmesh::tool {
+namespace {
+
+using Kind = InputError::Kind;
+
+constexpr const char* kCsvHeader = "dist,dim,n,log2_spread,op,trace_distance,seconds";
+
+std::string known_distributions() {
+  std::string s;
+  for (const Distribution dist : all_distributions()) {
+    if (!s.empty()) s += ", ";
+    s += distribution_name(dist);
+  }
+  return s;
+}
+
+// Opens the CSV for appending; writes the header when the file is new or empty, and refuses
+// a non-empty file whose first line is not the header (it is some other file).
+std::ofstream open_csv(const std::string& path) {
+  bool fresh = true;
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && std::filesystem::file_size(path, ec) > 0 && !ec) {
+    fresh = false;
+    std::ifstream in(path);
+    std::string first;
+    std::getline(in, first);
+    if (!first.empty() && first.back() == '\r') first.pop_back();
+    if (first != kCsvHeader)
+      throw InputError(Kind::Malformed, "exists and is not a stability CSV (its first line is not '" +
+                                            std::string(kCsvHeader) + "'); not appending to it",
+                       path, 1);
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::app);
+  if (!out) throw InputError(Kind::Io, "cannot open file for writing", path);
+  if (fresh) out << kCsvHeader << '\n';
+  return out;
+}
+
+template <std::size_t d>
+int run(const StabilityOptions& o, Distribution dist) {
+  std::vector<Point<d>> all = generate<d>(dist, o.n + o.updates, o.seed, o.spread);
+  std::vector<Point<d>> pool(all.begin() + static_cast<std::ptrdiff_t>(o.n), all.end());
+  all.resize(o.n);
+  const Box<d> box = derive_box<d>(all);
+  DynamicQuadtree<d> tree(box, std::span<const Point<d>>(all));
+  UpdateDriver<d> driver(tree, std::move(pool), o.seed);
+  const double initial_spread = driver.log2_spread();
+
+  const std::string prefix =
+      std::string(distribution_name(dist)) + ',' + std::to_string(d) + ',' + std::to_string(o.n) + ',';
+  std::string rows;
+  std::uint64_t total_distance = 0;
+  {
+    Progress progress("updates", o.updates);
+    for (std::size_t u = 0; u < o.updates; ++u) {
+      const auto step = driver.step();
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%.4f,%s,%llu,%.9g\n", step.log2_spread,
+                    step.op == EditOp::Insert ? "insert" : "delete",
+                    static_cast<unsigned long long>(step.stats.trace_distance), step.stats.seconds);
+      rows += prefix;
+      rows += buf;
+      total_distance += step.stats.trace_distance;
+      progress.tick(u + 1);
+    }
+  }
+  std::ofstream csv = open_csv(o.csv);
+  csv << rows;
+  csv.flush();
+  if (!csv) throw InputError(Kind::Io, "write error", o.csv);
+  csv.close();
+
+  std::printf("stability: %s %zuD, n = %zu, log2(L/s) = %.2f, %zu updates, mean trace distance %.1f; "
+              "rows appended to %s\n",
+              std::string(distribution_name(dist)).c_str(), d, o.n, initial_spread, o.updates,
+              o.updates ? static_cast<double>(total_distance) / static_cast<double>(o.updates) : 0.0,
+              o.csv.c_str());
+  if (!o.plot.empty()) {
+    plot_stability_csv(o.csv, o.plot);
+    std::printf("plot: %s\n", o.plot.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int run_stability(const StabilityOptions& o) {
+  const auto dist = parse_distribution(o.dist);
+  if (!dist)
+    throw InputError(Kind::Malformed, "unknown distribution '" + o.dist + "' (known: " + known_distributions() + ")");
+  if (o.n < 2) throw InputError(Kind::Count, "--n must be at least 2 (the spread needs a closest pair)");
+  if (!(std::isfinite(o.spread) && o.spread >= 2))
+    throw InputError(Kind::Malformed, "--spread must be a finite number >= 2");
+  return o.dim == 3 ? run<3>(o, *dist) : run<2>(o, *dist);
+}
+
+}  // namespace dynmesh::tool

@@ -1,0 +1,98 @@
+// dynmesh/tools/verify.hpp — checking a dynamic tree against a from-scratch static build.
+//
+// Purpose: `quadtree --check` and `demo` verify the dynamic tree after its updates:
+//   1. the static oracle StaticQuadtree::from_points on the tree's final points, in the
+//      same box, must give the same `.cells` text (format_cells, byte for byte);
+//   2. check_tree on the dynamic leaves and the located points must pass
+//      (require_valid_tree: tiling, occupancy, separation, grading, crowding, minimality);
+//   3. the tree's own check_invariants() (engine, indexes, directory) must pass.
+// The first failure is reported as one line (multi-line checker summaries are folded).
+// Invariants: verify() does not modify the tree.
+// Complexity: one static build and one check_tree on the final points, plus
+// check_invariants(): O(n lg n + |T*| lg |T*|) expected, plus the size of the trace.
+// Paper: DESIGN.md "Correctness contract" (after propagate(), outputs equal a from-scratch
+// run on the current input).
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include <sac/errors.hpp>
+
+#include "dynmesh/dynamic_quadtree.hpp"
+#include "dynmesh/errors.hpp"
+#include "dynmesh/io.hpp"
+#include "dynmesh/static_quadtree.hpp"
+
+namespace dynmesh::tool {
+
+/// The message folded onto one line ("a\nb" -> "a; b"), trailing newlines dropped.
+inline std::string one_line(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+  std::string out;
+  out.reserve(s.size());
+  for (char c : s) {
+    if (c == '\n')
+      out += "; ";
+    else if (c != '\r')
+      out += c;
+  }
+  return out;
+}
+
+struct Verification {
+  bool ok = false;
+  std::string problem;          // why not, one line (empty when ok)
+  double static_seconds = 0.0;  // time of the static from-scratch build
+};
+
+template <std::size_t d>
+Verification verify(const DynamicQuadtree<d>& tree) {
+  Verification v;
+  const std::vector<Leaf<d>> leaves = tree.leaves();
+  std::vector<Point<d>> pts;
+  for (const auto& entry : tree.points()) pts.push_back(entry.second);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const StaticQuadtree<d> oracle = StaticQuadtree<d>::from_points(tree.box(), pts);
+  v.static_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  const std::string dynamic_text = format_cells<d>(tree.box(), leaves);
+  const std::string static_text = format_cells<d>(tree.box(), oracle.leaves());
+  if (dynamic_text != static_text) {
+    // Name the first differing line of the two `.cells` texts.
+    std::size_t line = 1, pos = 0;
+    while (pos < dynamic_text.size() && pos < static_text.size() && dynamic_text[pos] == static_text[pos]) {
+      if (dynamic_text[pos] == '\n') ++line;
+      ++pos;
+    }
+    auto line_at = [](const std::string& text, std::size_t at) {
+      const std::size_t begin = text.rfind('\n', at == 0 ? 0 : at - 1);
+      const std::size_t from = begin == std::string::npos || at == 0 ? 0 : begin + 1;
+      const std::size_t end = text.find('\n', from);
+      return end == std::string::npos ? text.substr(from) : text.substr(from, end - from);
+    };
+    v.problem = "the dynamic tree differs from a from-scratch build on the final " + std::to_string(pts.size()) +
+                " points (" + std::to_string(leaves.size()) + " vs " + std::to_string(oracle.leaves().size()) +
+                " leaves; first difference at .cells line " + std::to_string(line) + ": '" +
+                line_at(dynamic_text, pos) + "' vs '" + line_at(static_text, pos) + "')";
+    return v;
+  }
+  try {
+    require_valid_tree<d>(tree.positions(), leaves);
+    tree.check_invariants();
+  } catch (const dynmesh::InvariantError& e) {
+    v.problem = "invariant check failed: " + one_line(e.what());
+    return v;
+  } catch (const sac::InvariantError& e) {
+    v.problem = "runtime invariant check failed: " + one_line(e.what());
+    return v;
+  }
+  v.ok = true;
+  return v;
+}
+
+}  // namespace dynmesh::tool

@@ -1,0 +1,152 @@
+#!/usr/bin/env bash
+# tests/cli/cli_test.sh CASE DYNMESH DATA_DIR WORK_DIR — end-to-end tests of the `dynmesh`
+# command (shared/FORMATS.md contracts), one ctest per CASE (see tests/cli/CMakeLists.txt).
+# Exit 0 pass, 1 fail, 77 skipped (ctest SKIP_RETURN_CODE).
+set -uo pipefail
+
+case_name=$1 dynmesh=$2 data=$3 work=$4
+rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+
+fail() {
+  echo "FAIL [$case_name]: $*" >&2
+  exit 1
+}
+
+# run CMD...: must exit 0; stdout in out.txt, stderr in err.txt.
+run() {
+  "$@" >out.txt 2>err.txt
+  local rc=$?
+  ((rc == 0)) || { cat err.txt >&2; fail "exit status $rc: $*"; }
+}
+
+# expect_error WANT_STATUS WANT_TEXT CMD...: must exit WANT_STATUS with exactly one line on
+# stderr, of the form "dynmesh: ...", containing WANT_TEXT (fixed string).
+expect_error() {
+  local want_status=$1 want=$2
+  shift 2
+  "$@" >out.txt 2>err.txt
+  local rc=$?
+  ((rc == want_status)) || { cat err.txt >&2; fail "exit status $rc, expected $want_status: $*"; }
+  [[ $(wc -l <err.txt) -eq 1 ]] || { cat err.txt >&2; fail "stderr is not exactly one line: $*"; }
+  grep -q '^dynmesh: ' err.txt || fail "stderr does not start with 'dynmesh: ': $(cat err.txt)"
+  grep -qF -- "$want" err.txt || fail "stderr lacks '$want': $(cat err.txt)"
+}
+
+# box_of CELLS: the "o1 o2 [o3] L" of a .cells file's "# box" line (printed %.17g: exact).
+box_of() { sed -n '3s/^# box //p' "$1"; }
+
+# same_after_edits POINTS EDITS FINAL [--dim 3]: the .cells after the edits, propagated one by
+# one, in batches of 3, and all at once, equal a from-scratch run on FINAL in the same box.
+same_after_edits() {
+  local points=$1 edits=$2 final=$3
+  shift 3
+  run "$dynmesh" quadtree "$points" "$@" --edits "$edits" --cells dyn.cells --check
+  local box
+  box=$(box_of dyn.cells)
+  [[ -n $box ]] || fail "no box line in dyn.cells"
+  # shellcheck disable=SC2086  # the box is several numbers
+  run "$dynmesh" quadtree "$final" "$@" --box $box --cells scratch.cells --check
+  cmp dyn.cells scratch.cells || fail "$edits: dynamic result differs from a from-scratch run on $final"
+  run "$dynmesh" quadtree "$points" "$@" --edits "$edits" --batch 3 --cells batch3.cells --check
+  cmp dyn.cells batch3.cells || fail "$edits: --batch 3 differs from single edits"
+  run "$dynmesh" quadtree "$points" "$@" --edits "$edits" --batch 1000 --cells batchall.cells --check
+  cmp dyn.cells batchall.cells || fail "$edits: one batch differs from single edits"
+}
+
+case $case_name in
+  inputs) # every input kind builds and passes --check; the header records the dimension
+    run "$dynmesh" quadtree "$data/points2d.node" --cells p2.cells --check
+    grep -qx '# dim 2' p2.cells || fail "points2d.node: not 2D"
+    head -1 p2.cells | grep -qx '# dynmesh cells v1' || fail "bad first line"
+    run "$dynmesh" quadtree "$data/points3d.node" --cells p3.cells --check
+    grep -qx '# dim 3' p3.cells || fail "points3d.node: the header's dimension was not used"
+    run "$dynmesh" quadtree "$data/points3d.node" --dim 3 --cells p3b.cells --check
+    cmp p3.cells p3b.cells || fail "--dim 3 on a 3D .node changes the result"
+    run "$dynmesh" quadtree "$data/scan.xyz" --dim 3 --cells xyz.cells --check
+    grep -qx '# dim 3' xyz.cells || fail "scan.xyz --dim 3: not 3D"
+    run "$dynmesh" quadtree "$data/scan.xyz" --cells xyz2.cells --check  # first two columns
+    run "$dynmesh" quadtree "$data/boundary.txt" --box 0 0 1 --cells boundary.cells --check
+    grep -qx '# box 0 0 1' boundary.cells || fail "--box not recorded exactly"
+    run "$dynmesh" quadtree "$data/boundary.txt" --cells boundary2.cells --check
+    run "$dynmesh" quadtree "$data/collinear.txt" --cells collinear.cells --check
+    run "$dynmesh" quadtree "$data/grid.txt" --cells grid.cells --check
+    run "$dynmesh" quadtree "$data/final3d.txt" --dim 3 --cells f3.cells --check
+    # One leaf line per leaf after the three header lines, sorted by (level, i, j).
+    tail -n +4 grid.cells | sort -n -k1,1 -k2,2 -k3,3 -c || fail "grid.cells is not sorted"
+    ;;
+
+  edits2d)
+    same_after_edits "$data/points2d.node" "$data/edits2d.txt" "$data/final2d.txt"
+    ;;
+
+  edits3d)
+    same_after_edits "$data/points3d.node" "$data/edits3d.txt" "$data/final3d.txt" --dim 3
+    ;;
+
+  errors) # one line on stderr naming file and line; exit 1; no output file
+    expect_error 1 'bad_number.txt:3: ' "$dynmesh" quadtree "$data/bad_number.txt" --cells e.cells
+    expect_error 1 'nan.txt:4: ' "$dynmesh" quadtree "$data/nan.txt" --cells e.cells
+    expect_error 1 'duplicate.txt:5: ' "$dynmesh" quadtree "$data/duplicate.txt" --cells e.cells
+    expect_error 1 'resolution.txt:4: ' "$dynmesh" quadtree "$data/resolution.txt" --cells e.cells
+    grep -qF '(lines 2, 4)' err.txt || fail "resolution: both lines not named: $(cat err.txt)"
+    expect_error 1 'outside.txt:4: ' "$dynmesh" quadtree "$data/outside.txt" --box 0 0 1 --cells e.cells
+    # Edit errors, propagating one edit at a time and in batches of 2.
+    for batch in "" "--batch 2"; do
+      # shellcheck disable=SC2086  # $batch is zero or two words
+      edit() { "$dynmesh" quadtree "$data/points2d.node" --edits "$data/$1" $batch --cells e.cells; }
+      expect_error 1 'edits_absent.txt:3: ' edit edits_absent.txt
+      grep -q 'not in the set' err.txt || fail "absent point: unclear message: $(cat err.txt)"
+      expect_error 1 'edits_present.txt:2: ' edit edits_present.txt
+      expect_error 1 'edits_outside.txt:3: ' edit edits_outside.txt
+    done
+    [[ ! -e e.cells ]] || fail "a failed run wrote its output file"
+    expect_error 1 'cannot open' "$dynmesh" quadtree "$data/no-such-file.txt" --cells e.cells
+    expect_error 1 'draws 2D trees only' "$dynmesh" quadtree "$data/points3d.node" --cells e.cells --svg e.svg
+    expect_error 1 'points3d.node:1: ' "$dynmesh" quadtree "$data/points3d.node" --dim 2 --cells e.cells
+    expect_error 1 '--box' "$dynmesh" quadtree "$data/grid.txt" --box 0 0 0 1 --cells e.cells
+    expect_error 2 '--cells' "$dynmesh" quadtree "$data/grid.txt"
+    expect_error 2 '--batch' "$dynmesh" quadtree "$data/grid.txt" --cells e.cells --batch 0
+    expect_error 1 'unknown distribution' "$dynmesh" stability --dim 2 --dist nope --n 10 --csv e.csv
+    ;;
+
+  stability)
+    header='dist,dim,n,log2_spread,op,trace_distance,seconds'
+    run "$dynmesh" stability --dim 2 --dist uniform --n 300 --updates 30 --csv s.csv
+    [[ $(head -1 s.csv) == "$header" ]] || fail "CSV header: $(head -1 s.csv)"
+    [[ $(wc -l <s.csv) -eq 31 ]] || fail "expected header + 30 rows, got $(wc -l <s.csv) lines"
+    run "$dynmesh" stability --dim 3 --dist shrinking --n 300 --spread 4096 --updates 20 --seed 5 --csv s.csv
+    [[ $(wc -l <s.csv) -eq 51 ]] || fail "append: expected header + 50 rows, got $(wc -l <s.csv) lines"
+    [[ $(grep -c '^dist,' s.csv) -eq 1 ]] || fail "header written twice"
+    # Every row: 7 fields, op insert|delete, integer trace distance, the run's dist/dim/n.
+    tail -n +2 s.csv | awk -F, 'NF != 7 || ($5 != "insert" && $5 != "delete") || $6 !~ /^[0-9]+$/ ||
+      !(($1 == "uniform" && $2 == 2 && $3 == 300) || ($1 == "shrinking" && $2 == 3 && $3 == 300)) { bad = 1; print }
+      END { exit bad }' || fail "malformed rows"
+    [[ $(grep -c ',delete,' s.csv) -eq 25 && $(grep -c ',insert,' s.csv) -eq 25 ]] || fail "not half deletions"
+    if command -v gnuplot >/dev/null; then
+      run "$dynmesh" stability --dim 2 --dist clusters --n 300 --updates 10 --csv s.csv --plot plot.svg
+      head -c 200 plot.svg | grep -q '<svg\|<?xml' || fail "plot.svg is not SVG"
+    else
+      echo "gnuplot not installed: --plot not tested"
+    fi
+    ;;
+
+  svg)
+    run "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits2d.txt" --cells s.cells --svg tree.svg
+    head -c 5 tree.svg | grep -q '^<?xml\|^<svg' || fail "tree.svg does not start like SVG"
+    tail -1 tree.svg | grep -qx '</svg>' || fail "tree.svg is not closed"
+    # 52 points after the edits, each drawn as one dot (none coincide at this scale).
+    [[ $(grep -c '<circle' tree.svg) -eq $(grep -vc '^#' "$data/final2d.txt") ]] || fail "wrong number of dots"
+    ;;
+
+  demo)
+    run "$dynmesh" demo --n 1000 --updates 100 --svg demo.svg
+    grep -q '^verified: yes' out.txt || { cat out.txt; fail "demo not verified"; }
+    grep -q 'trace distance' out.txt || fail "demo lacks the trace distance figure"
+    head -c 5 demo.svg | grep -q '^<?xml\|^<svg' || fail "demo.svg is not SVG"
+    ;;
+
+  *)
+    fail "unknown case"
+    ;;
+esac
+echo "ok [$case_name]"
