@@ -250,14 +250,6 @@ struct DynamicState {
 
 }  // namespace detail
 
-namespace {
-
-template <std::size_t d>
-std::string at(std::size_t line, std::size_t index) {
-  return line ? "line " + std::to_string(line) : "edit " + std::to_string(index);
-}
-
-}  // namespace
 
 template <std::size_t d>
   requires SupportedDim<d>
@@ -370,7 +362,6 @@ std::vector<PointId> DynamicQuadtree<d>::apply(std::span<const Edit<d>> edits) {
   };
   for (std::size_t i = 0; i < edits.size(); ++i) {
     const Edit<d>& e = edits[i];
-    const std::string where = at<d>(e.line, i);
     try {
       const Position<d> q = s.locate_checked(e.point, 0);
       if (e.op == EditOp::Insert) {
@@ -393,7 +384,9 @@ std::vector<PointId> DynamicQuadtree<d>::apply(std::span<const Edit<d>> edits) {
                            "point " + to_string<d>(e.point) + " is not in the set");
       }
     } catch (const InputError& err) {
-      throw InputError(err.kind(), where + ": " + err.text(), std::string{}, 0);
+      // The script line when the edit has one (InputError::line()), else the edit's index.
+      if (e.line != 0) throw InputError(err.kind(), err.text(), std::string{}, e.line);
+      throw InputError(err.kind(), "edit " + std::to_string(i) + ": " + err.text());
     }
   }
   // Apply: nothing below can fail on valid input.

@@ -149,7 +149,7 @@ struct Refine {
   static void main(sac::Engine& r, Refine* cx) {
     // The root is crowded when it holds two points (its neighbourhood is itself).
     Crowded* c0 = r.alloc<Crowded>(0);
-    r.read(*cx->input, [cx, c0](sac::Engine& x, Node* a) {
+    r.read(*cx->input, [c0](sac::Engine& x, Node* a) {
       if (!a) return x.write(*c0, nullptr);
       x.read(a->next, [c0](sac::Engine& y, Node* b) {
         if (!b) return y.write(*c0, nullptr);
