@@ -366,7 +366,7 @@ std::vector<PointId> DynamicQuadtree<d>::apply(std::span<const Edit<d>> edits) {
       const Position<d> q = s.locate_checked(e.point, 0);
       if (e.op == EditOp::Insert) {
         if (present(q))
-          throw InputError(InputError::Kind::Present,
+          throw InputError(InputError::Kind::Duplicate,  // as insert() reports it
                            "point " + to_string<d>(e.point) + " is already in the set (same located position)");
         s.check_resolution(q, present, 0);
         added.emplace(q, &e.point);
