@@ -1,0 +1,144 @@
+#!/usr/bin/env bash
+# stability_experiments.sh — the trace-distance experiments of docs/EXPERIMENTS.md.
+#
+# Runs `dynmesh stability` (shared/FORMATS.md) over
+#   1. spread: `shrinking` at n = 4096 with L/s = 2^8 ... 2^40, 2D and 3D;
+#   2. the other distributions (uniform, clusters, spiral), whose spread grows with n,
+#      at n = 1000 ... 64000, 2D;
+#   3. size: `shrinking` at L/s = 2^20, n = 10^3, 10^4, 10^5, 2D and 3D;
+# then fits trace distance = a + b·log2(L/s) per distribution (least squares over every
+# measured update), tabulates the mean distance and update time per n, and draws two
+# gnuplot pictures. Everything lands in docs/data/ and docs/figures/; the tables are
+# printed as Markdown for docs/EXPERIMENTS.md.
+#
+# Usage: bash bench/stability_experiments.sh [--quick]   (after `bash dev.sh run`, which builds)
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$ROOT"
+BIN=${DYNMESH:-build/release/bin/dynmesh}
+DATA=docs/data
+FIG=docs/figures
+mkdir -p "$DATA" "$FIG"
+QUICK=0
+[[ ${1:-} == --quick ]] && QUICK=1
+U=400
+((QUICK)) && U=60
+
+SPREAD_CSV=$DATA/stability_spread.csv
+DIST_CSV=$DATA/stability_distributions.csv
+SIZE_CSV=$DATA/stability_size.csv
+rm -f "$SPREAD_CSV" "$DIST_CSV" "$SIZE_CSV"
+
+RUNS=$DATA/run_means.dat  # one line per run: series log2_spread mean_distance n mean_us
+rm -f "$RUNS"
+# run ARGS...: one `dynmesh stability` run; its rows are the last U of the CSV (the last
+# argument), whose means go to $RUNS.
+run() {
+  echo "+ $BIN stability $*" >&2
+  "$BIN" stability "$@"
+  local csv=${*: -1}
+  tail -n "$U" "$csv" | awk -F, '{ x += $4; y += $6; t += $7; k++; s = $1 "-" $2 "d"; n = $3 }
+    END { printf "%s %.3f %.2f %s %.2f\n", s, x / k, y / k, n, t / k * 1e6 }' >> "$RUNS"
+}
+
+# 1. Trace distance against the spread, at fixed n.
+for dim in 2 3; do
+  for k in 8 12 16 20 24 28 32 36 40; do
+    ((QUICK)) && ((k % 8 != 0)) && continue
+    run --dim $dim --dist shrinking --n 4096 --spread $((2 ** k)) --updates $U --seed 1 --csv "$SPREAD_CSV"
+  done
+done
+
+# 2. The other distributions: their spread comes with n.
+for dist in uniform clusters spiral; do
+  for n in 1000 4000 16000 64000; do
+    ((QUICK)) && ((n > 4000)) && continue
+    run --dim 2 --dist $dist --n $n --updates $U --seed 1 --csv "$DIST_CSV"
+  done
+done
+
+# 3. No dependence on n at a fixed spread.
+for dim in 2 3; do
+  for n in 1000 10000 100000; do
+    ((QUICK)) && ((n > 10000)) && continue
+    run --dim $dim --dist shrinking --n $n --spread $((2 ** 20)) --updates $U --seed 1 --csv "$SIZE_CSV"
+  done
+done
+
+# ---------------------------------------------------------------- tables
+echo
+echo "### Fit: trace distance = a + b · log2(L/s), least squares over every update"
+echo
+echo "| data | dist | dim | updates | log2(L/s) range | slope b | intercept a |"
+echo "| --- | --- | --- | --- | --- | --- | --- |"
+for f in "$SPREAD_CSV" "$DIST_CSV"; do
+  awk -F, -v file="$(basename "$f")" 'FNR > 1 {
+      k = $1 "," $2; n[k]++; x = $4; y = $6
+      sx[k] += x; sy[k] += y; sxx[k] += x * x; sxy[k] += x * y
+      if (!(k in lo) || x < lo[k]) lo[k] = x
+      if (!(k in hi) || x > hi[k]) hi[k] = x }
+    END { for (k in n) { split(k, p, ",")
+      den = n[k] * sxx[k] - sx[k] * sx[k]
+      b = den ? (n[k] * sxy[k] - sx[k] * sy[k]) / den : 0
+      a = (sy[k] - b * sx[k]) / n[k]
+      printf "| %s | %s | %s | %d | %.1f – %.1f | %.1f | %.1f |\n", file, p[1], p[2], n[k], lo[k], hi[k], b, a } }' "$f" | sort
+done
+
+echo
+echo "### Mean trace distance and update time against n (shrinking, L/s = 2^20)"
+echo
+echo "| dim | n | updates | mean trace distance | mean update (µs) | median update (µs) |"
+echo "| --- | --- | --- | --- | --- | --- |"
+awk -F, 'FNR > 1 { k = $2 "," $3; n[k]++; td[k] += $6; t[k] += $7; v[k] = v[k] " " $7 }
+  END { for (k in n) { split(k, p, ","); m = split(v[k], a, " ")
+      # median by insertion sort (a few hundred values)
+      for (i = 2; i <= m; i++) { x = a[i]; j = i - 1; while (j > 0 && a[j] > x) { a[j + 1] = a[j]; j-- } a[j + 1] = x }
+      med = m % 2 ? a[(m + 1) / 2] : (a[m / 2] + a[m / 2 + 1]) / 2
+      printf "| %s | %s | %d | %.1f | %.1f | %.1f |\n", p[1], p[2], n[k], td[k] / n[k], t[k] / n[k] * 1e6, med * 1e6 } }' \
+  "$SIZE_CSV" | sort -t'|' -k2,2n -k3,3n
+
+# ---------------------------------------------------------------- pictures
+# Per-run means (series, log2 spread, distance) for the spread plot; size means per dim.
+grep -v '^shrinking' "$RUNS" > "$DATA/spread_means.dat" || true
+# The spread sweep's runs are the shrinking runs at n = 4096.
+awk '$1 ~ /^shrinking/ && $4 == 4096' "$RUNS" >> "$DATA/spread_means.dat"
+sort -k1,1 -k2,2n -o "$DATA/spread_means.dat" "$DATA/spread_means.dat"
+awk -F, 'FNR > 1 { k = $2 "d," $3; n[k]++; s[k] += $7; td[k] += $6 }
+  END { for (k in n) { split(k, p, ","); print p[1], p[2], s[k] / n[k] * 1e6, td[k] / n[k] } }' "$SIZE_CSV" |
+  sort -k1,1 -k2,2n > "$DATA/size_means.dat"
+
+if command -v gnuplot >/dev/null; then
+  series=$(cut -d' ' -f1 "$DATA/spread_means.dat" | sort -u)
+  {
+    echo "set terminal svg size 900,600 dynamic font 'sans,13'"
+    echo "set output '$FIG/trace_distance_vs_spread.svg'"
+    echo "set title 'Mean trace distance per update against log2(L/s) (one point per run)'"
+    echo "set xlabel 'log2(L/s)'; set ylabel 'trace events created + undone'"
+    echo "set key left top; set grid; set yrange [0:*]"
+    printf "plot "
+    first=1
+    for s in $series; do
+      ((first)) || printf ", "
+      first=0
+      printf "'< grep \"^%s \" %s' using 2:3 with linespoints title '%s'" "$s" "$DATA/spread_means.dat" "$s"
+    done
+    echo
+  } > "$DATA/spread.gp"
+  gnuplot "$DATA/spread.gp"
+  {
+    echo "set terminal svg size 900,600 dynamic font 'sans,13'"
+    echo "set output '$FIG/update_time_vs_n.svg'"
+    echo "set title 'Mean update time and trace distance against n (shrinking, L/s = 2^{20})'"
+    echo "set xlabel 'n'; set logscale x; set ylabel 'mean update time (µs)'; set y2label 'mean trace distance'"
+    echo "set y2tics; set ytics nomirror; set key left top; set grid"
+    echo "plot '< grep \"^2d \" $DATA/size_means.dat' using 2:3 with linespoints title '2D time', \\"
+    echo "     '< grep \"^3d \" $DATA/size_means.dat' using 2:3 with linespoints title '3D time', \\"
+    echo "     '< grep \"^2d \" $DATA/size_means.dat' using 2:4 axes x1y2 with linespoints dt 2 title '2D distance', \\"
+    echo "     '< grep \"^3d \" $DATA/size_means.dat' using 2:4 axes x1y2 with linespoints dt 2 title '3D distance'"
+  } > "$DATA/size.gp"
+  gnuplot "$DATA/size.gp"
+  echo
+  echo "pictures: $FIG/trace_distance_vs_spread.svg $FIG/update_time_vs_n.svg"
+else
+  echo "gnuplot not found: no pictures (bash dev.sh deps installs it)" >&2
+fi
