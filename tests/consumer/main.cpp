@@ -1,7 +1,9 @@
 // Builds against the installed sac and dynmesh packages and uses one thing from each.
+#include <algorithm>
 #include <array>
 #include <vector>
 
+#include <dynmesh/dynamic_quadtree.hpp>
 #include <dynmesh/static_quadtree.hpp>
 #include <sac/sac.hpp>
 
@@ -17,5 +19,12 @@ int main() {
   const std::vector<dynmesh::Point<2>> pts{{{0.0, 0.0}}, {{1.0, 1.0}}};
   const auto box = dynmesh::derive_box<2>(pts);
   const auto tree = dynmesh::StaticQuadtree<2>::from_points(box, pts);
-  return tree.leaves().empty() ? 1 : 0;
+  if (tree.leaves().empty()) return 1;
+  // The dynamic tree after an insertion equals the static tree of the new set.
+  dynmesh::DynamicQuadtree<2> dyn(box, pts);
+  dyn.insert({0.5, 0.25});
+  const std::vector<dynmesh::Point<2>> now{{{0.0, 0.0}}, {{1.0, 1.0}}, {{0.5, 0.25}}};
+  const auto fresh = dynmesh::StaticQuadtree<2>::from_points(box, now);
+  const auto leaves = dyn.leaves();
+  return std::equal(leaves.begin(), leaves.end(), fresh.leaves().begin(), fresh.leaves().end()) ? 0 : 1;
 }

@@ -395,6 +395,7 @@ void Engine::run(F&& f) {
     throw;
   }
   index_pending_allocs();
+  order_.trim();
   tail_ = now_;
   now_ = nullptr;
   in_computation_ = false;

@@ -126,6 +126,9 @@ class OrderList {
   std::size_t size() const { return size_; }
   std::size_t group_count() const { return group_count_; }
   std::size_t memory_bytes() const { return groups_.capacity() * sizeof(Group); }
+  /// Drops the group array's growth slack (after a bulk build such as a from-scratch run,
+  /// whose appends double the array up to twice the size it needs). O(groups).
+  void trim() { groups_.shrink_to_fit(); }
   std::uint64_t top_relabels() const { return top_relabels_; }
 
   /// Throws sac::InvariantError describing the first broken invariant.

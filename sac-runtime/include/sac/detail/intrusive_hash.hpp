@@ -5,9 +5,8 @@
 // the table is one bucket array. Lookups return every record of a bucket; the engine filters
 // by ops, key and trace window.
 // Invariants: every record is in bucket hash(record) & mask; size() counts them;
-//             buckets.size() is a power of two >= size() (grows at load factor 1: every
-//             chain link a lookup follows is a cache miss on a cold record, and a miss
-//             walks the whole chain; 8 bytes per record buy chains half as long).
+//             buckets.size() is a power of two >= size() / 2 (grows at load factor 2:
+//             lookups happen only during re-execution, inserts on every keyed allocation).
 // Complexity: insert O(1) amortized, erase O(chain), lookup O(chain).
 #pragma once
 
@@ -24,7 +23,7 @@ class IntrusiveHash {
  public:
   template <class HashOf>
   void insert(N* n, std::size_t h, HashOf&& hash_of) {
-    if (size_ + 1 > buckets_.size()) grow(hash_of);
+    if (size_ + 1 > 2 * buckets_.size()) grow(hash_of);
     N*& b = buckets_[h & (buckets_.size() - 1)];
     n->hnext = b;
     b = n;
@@ -43,7 +42,7 @@ class IntrusiveHash {
   template <class HashOf>
   void reserve(std::size_t count, HashOf&& hash_of) {
     std::size_t want = buckets_.empty() ? 64 : buckets_.size();
-    while (count > want) want *= 2;
+    while (count > 2 * want) want *= 2;
     if (want != buckets_.size()) rebucket(want, hash_of);
   }
 
