@@ -77,7 +77,35 @@ class Directory {
     return v ? *v : nullptr;
   }
   std::size_t size() const noexcept { return table_.size(); }
-  std::size_t bytes() const noexcept { return pool_.bytes() + table_.size() * 2 * (8 * d + sizeof(void*)); }
+  std::size_t bytes() const noexcept {
+    return pool_.bytes() + copies_.bytes() + table_.size() * 2 * (8 * d + sizeof(void*));
+  }
+
+  /// The node of p's point one level below p's, created on first use.
+  PNode<d>* below(PNode<d>* p) {
+    if (!p->down) p->down = copies_.create(p->q);
+    return p->down;
+  }
+  /// Frees the nodes below p that the trace no longer refers to (the deepest levels a point
+  /// has left), or all of them (`all`, for an erased point). Returns false if a node that
+  /// had to go is still referred to.
+  bool release_below(sac::Engine& rt, PNode<d>* p, bool all) {
+    // The levels a point is partitioned at are contiguous from the top, so the unused ones
+    // form a suffix of the chain.
+    PNode<d>* keep = p;
+    if (!all)
+      for (PNode<d>* c = p->down; c && !rt.unused(c->next); c = c->down) keep = c;
+    PNode<d>* c = keep->down;
+    keep->down = nullptr;
+    bool ok = true;
+    while (c) {
+      PNode<d>* nx = c->down;
+      ok = ok && rt.unused(c->next);
+      copies_.destroy(c);
+      c = nx;
+    }
+    return ok;
+  }
 
   /// Releases every slot the trace no longer refers to. O(size).
   void sweep(sac::Engine& rt) {
@@ -100,6 +128,7 @@ class Directory {
  private:
   CellTable<d, Slot<d>*> table_;
   StablePool<Slot<d>> pool_;
+  StablePool<PNode<d>> copies_;
 };
 
 template <std::size_t d>
@@ -192,7 +221,7 @@ struct DynamicState {
   /// After propagate(): the unlinked nodes are no longer read by anyone.
   void release(const std::vector<Node*>& gone) {
     for (Node* n : gone) {
-      if (!rt.unused(n->next))
+      if (!rt.unused(n->next) || !dir.release_below(rt, n, true))
         throw InvariantError("dynmesh: an erased point is still read by the trace");
       rt.retire(n->next);
       inputs.destroy(n);
@@ -212,6 +241,7 @@ struct DynamicState {
   }
   void compact() {
     dir.sweep(rt);
+    for (Node* n = first; n; n = n->succ) dir.release_below(rt, n, false);
     compact_mark = dir.size();
   }
 

@@ -71,25 +71,17 @@
 
 namespace dynmesh::detail {
 
-/// A cell of a point list: the located point and the rest of the list.
+/// A cell of a point list: the located point and the rest of the list. A point has one
+/// node per level at which it is partitioned (the input node at level 0); `down` links it
+/// to its node one level deeper. The nodes live outside the trace with their point, so the
+/// node of (point, level) is always the same object: what a keyed allocation would give,
+/// without its hash lookup and its trace event.
 template <std::size_t d>
 struct PNode {
   explicit PNode(const Position<d>& p) : q(p) {}
   Position<d> q;
   sac::Mod<PNode*> next;
-};
-
-/// Key of a point's list cell at one level: the point (its position is unique) and level.
-template <std::size_t d>
-struct PointAtLevel {
-  Position<d> q;
-  int level;
-  bool operator==(const PointAtLevel&) const = default;
-  std::size_t hash() const noexcept {
-    std::uint64_t h = sac::mix64(static_cast<std::uint64_t>(level) * 0x9e3779b97f4a7c15ULL);
-    for (std::size_t a = 0; a < d; ++a) h = sac::mix64(h ^ q[a]);
-    return static_cast<std::size_t>(h);
-  }
+  PNode* down = nullptr;  // the point's node one level deeper (owned by the directory)
 };
 
 /// The directory entry of a cell: its versioned state. Lives outside the trace; found by
@@ -112,7 +104,8 @@ struct QNode {
 
 /// What the program needs from its owner: the cell directory and the root's point list.
 /// `Dir` provides `Slot<d>& get(sac::Engine&, const CellId<d>&)`, creating a slot with
-/// default state on first use.
+/// default state on first use, and `PNode<d>* below(PNode<d>*)`, the point's node one level
+/// deeper, created on first use.
 template <std::size_t d, class Dir>
 struct Refine {
   using Node = PNode<d>;
@@ -213,7 +206,7 @@ struct Refine {
       return;
     }
     const unsigned w = child_code(p->q, child_level);
-    Node* copy = r.alloc<Node>(PointAtLevel<d>{p->q, child_level}, p->q);
+    Node* copy = cx->dir->below(p);
     r.write(*to.to[w], copy);
     to.to[w] = &copy->next;
     r.memo_read(p->next, sac::fn<&partition>(cx, witness, child_level, to));

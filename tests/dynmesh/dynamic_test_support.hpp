@@ -2,6 +2,7 @@
 // the build-speed switch, the oracle comparison and the "nothing changed" snapshot.
 #pragma once
 
+#include "../sanitized.hpp"
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,17 +27,7 @@ namespace dynmesh_test {
 /// Built with AddressSanitizer (CI runs it at -O0) or without optimization: tests scale their
 /// sizes down. (Optimization, not NDEBUG: the RelWithDebInfo build of the brief sets its
 /// flags to "-O2 -g", without -DNDEBUG.)
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
+using test_support::kSanitized;
 #ifdef __OPTIMIZE__
 constexpr bool kSlowBuild = kSanitized;
 #else

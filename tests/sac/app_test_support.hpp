@@ -1,6 +1,7 @@
 // app_test_support.hpp — helpers shared by the differential tests of the classic apps.
 #pragma once
 
+#include "../sanitized.hpp"
 #include <cstddef>
 #include <random>
 
@@ -11,17 +12,7 @@
 namespace app_test {
 
 /// Built with AddressSanitizer (CI runs it at -O0): tests scale their sizes down.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
+using test_support::kSanitized;
 
 /// After a propagate: the output is right, the engine is sound, and the live trace equals a
 /// from-scratch run's on the current input.
