@@ -31,8 +31,9 @@
 //     a cell that does not exist yet reads the default and is re-run if it comes to exist
 //     earlier in the trace;
 //   * SPLIT's partition is a memoized, order-preserving, destination-passing walk over the
-//     cell's point list (one memo_read, one keyed allocation and one write per point), so a
-//     new point changes O(1) expected trace per level;
+//     cell's point list (one memo_read and one write per point; the point's node at the
+//     child level is its own, PNode::down, so it needs no keyed allocation), so a new point
+//     changes O(1) expected trace per level;
 //   * the crowding test of a child k reads only k's first two list cells and, when k holds
 //     exactly one point, the list heads of N(k) until it finds a point;
 //   * C_{l+1} is a modifiable list built by destination passing; each walk step is a
