@@ -51,12 +51,16 @@ main_job() {
 # ==========================================================================================
 
 # Benchmark figures of bench/RESULTS.md: the list apps at n = 10^6, the sorts and hulls at
-# n = 10^5 (their traces are 5-9 KB per element). Extra arguments (e.g. --csv) go to both runs.
+# n = 10^5 (their traces are 5-9 KB per element), then the dynamic quadtree against its static
+# oracle (2D to 10^5, 3D to 10^5; the 10^6 row of RESULTS.md takes 14 GB and is run by hand).
+# Extra arguments (e.g. --csv) go to every run.
 bench_job() {
   build/release/bin/sac_suite --apps map,filter,reverse,minimum,sum,exptrees --n 1000000 \
     --updates 100 "$@"
   build/release/bin/sac_suite --apps quicksort,mergesort,quickhull,diameter --n 100000 \
     --updates 100 "$@"
+  build/release/bin/dynmesh_bench --dim 2 --n 1000,10000,100000 --updates 1000 --reps 3 "$@"
+  build/release/bin/dynmesh_bench --dim 3 --n 1000,10000,100000 --updates 1000 --reps 3 "$@"
 }
 
 cmd_run() { deps; build_release; main_job "$@"; }
