@@ -126,9 +126,17 @@ class OrderList {
   std::size_t size() const { return size_; }
   std::size_t group_count() const { return group_count_; }
   std::size_t memory_bytes() const { return groups_.capacity() * sizeof(Group); }
-  /// Drops the group array's growth slack (after a bulk build such as a from-scratch run,
-  /// whose appends double the array up to twice the size it needs). O(groups).
-  void trim() { groups_.shrink_to_fit(); }
+  /// Cuts the group array's growth slack to 1/8 (after a bulk build such as a from-scratch
+  /// run, whose appends double the array up to twice the size it needs), keeping enough that
+  /// the first updates do not reallocate it at once. O(groups).
+  void trim() {
+    const std::size_t want = groups_.size() + groups_.size() / 8 + 16;
+    if (groups_.capacity() <= want) return;
+    std::vector<Group> g;
+    g.reserve(want);
+    g.assign(groups_.begin(), groups_.end());
+    groups_.swap(g);
+  }
   std::uint64_t top_relabels() const { return top_relabels_; }
 
   /// Throws sac::InvariantError describing the first broken invariant.
