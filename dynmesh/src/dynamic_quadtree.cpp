@@ -125,6 +125,24 @@ class Directory {
     table_.for_each([&](const CellId<d>&, Slot<d>* s) { f(*s); });
   }
 
+  /// Throws InvariantError unless each slot is filed under its own cell and every child of
+  /// a split cell has a slot with a written point list. O(size).
+  void check_invariants(const sac::Engine& rt) const {
+    table_.for_each([&](const CellId<d>& c, const Slot<d>* s) {
+      if (!(s->id == c)) throw InvariantError("dynmesh: directory slot filed under another cell");
+      if (!s->split.written() || !s->pts.written())
+        throw InvariantError("dynmesh: directory slot " + to_string(c) + " without its default state");
+      if (s->split.get() == 0) return;
+      if (c.level >= kMaxLevel) throw InvariantError("dynmesh: a level-52 cell is split");
+      for (const CellId<d>& k : children(c)) {
+        const Slot<d>* ks = find(k);
+        if (!ks || rt.unused(ks->pts))
+          throw InvariantError("dynmesh: child " + to_string(k) + " of split cell " + to_string(c) +
+                               " has no point list");
+      }
+    });
+  }
+
  private:
   CellTable<d, Slot<d>*> table_;
   StablePool<Slot<d>> pool_;
@@ -607,6 +625,10 @@ void DynamicQuadtree<d>::check_invariants() const {
       throw InvariantError("dynmesh: point indexes disagree with the input list");
   }
   if (s.head.get() != s.first) throw InvariantError("dynmesh: list head differs from its mirror");
+  for (auto* n = s.first; n; n = n->succ)
+    for (const detail::PNode<d>* c = n->down; c; c = c->down)
+      if (c->q != n->q) throw InvariantError("dynmesh: a point's list node holds another point");
+  s.dir.check_invariants(s.rt);
   if (k != s.by_pos.size() || k != s.by_id.size())
     throw InvariantError("dynmesh: point indexes hold points not in the input list");
   // Every leaf's list holds exactly the points located in it.

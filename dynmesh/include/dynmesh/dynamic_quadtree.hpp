@@ -14,7 +14,9 @@
 //     occupancy, separation, grading, crowding, minimality), and every point lies in the
 //     leaf that holds it;
 //   * the position index, the id index and the input list hold the same points;
-//   * every directory slot that the trace does not reference is reclaimable (compact()).
+//   * the cell directory is consistent: each slot is filed under its own cell, every
+//     child of a split cell has a slot whose point list was written, and each point's
+//     per-level list nodes hold that point.
 // Failure atomicity: every mutator call validates its whole input before changing anything,
 // so a call that throws InputError leaves the tree, the ids and the engine as they were.
 // Determinism: results depend only on the point set; ids never enter the computation, and
