@@ -231,14 +231,27 @@ struct Refine {
       if (!a) return test_child(x, cx, e, w + 1, out);  // empty: not crowded
       x.read(a->next, [cx, e, w, out](sac::Engine& y, Node* b) {
         if (b) return queue_crowded(y, cx, e, w, out);  // two points: self-crowded
-        scan_neighbourhood(y, cx, e, w, 1, out);          // one point: look around
+        scan_neighbourhood(y, cx, e, w, 0, out);          // one point: look around
       });
     });
   }
 
+  /// N(k) without k, k's siblings first: when k's parent holds two or more points, one
+  /// besides k's is in a sibling, so the scan usually stops within 2^d − 1 reads.
+  static CellList<d, kNeighbourhood<d>> scan_order(const CellId<d>& k) {
+    CellList<d, kNeighbourhood<d>> out;
+    const CellId<d> p = parent(k);
+    for (const CellId<d>& s : children(p))
+      if (!(s == k)) out.push_back(s);
+    for_each_neighbour(k, [&](const CellId<d>& nb) {
+      if (!(parent(nb) == p)) out.push_back(nb);
+    });
+    return out;
+  }
+
   static void scan_neighbourhood(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, int i,
                                  Crowded* out) {
-    const auto around = neighbourhood(child(e->cell, w));  // k itself first
+    const auto around = scan_order(child(e->cell, w));
     if (i >= around.size()) return test_child(r, cx, e, w + 1, out);
     r.read(cx->slot(r, around[i]).pts, [cx, e, w, i, out](sac::Engine& x, Node* p) {
       if (p) return queue_crowded(x, cx, e, w, out);
