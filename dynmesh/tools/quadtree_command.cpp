@@ -8,7 +8,6 @@
 #include <optional>
 #include <span>
 #include <string>
-#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -52,20 +51,6 @@ InputError edit_error(const Edit<d>& e, const InputError& err, const std::string
   std::string text = e.op == EditOp::Insert ? "insert" : "delete";
   if (why.find(point) == std::string::npos) text += " " + point;
   return InputError(err.kind(), text + ": " + why, file, e.line);
-}
-
-// DynamicQuadtree::apply names the failing edit in its text as "line N: ..." (or "edit I:
-// ..." without a line). Returns N and the rest of the text, or nothing if the text does not
-// start that way.
-std::optional<std::pair<std::size_t, std::string>> split_line_prefix(const std::string& text) {
-  constexpr std::string_view kLine = "line ";
-  if (text.compare(0, kLine.size(), kLine) != 0) return std::nullopt;
-  std::size_t i = kLine.size(), n = 0;
-  const std::size_t digits = i;
-  while (i < text.size() && text[i] >= '0' && text[i] <= '9' && i - digits < 18)
-    n = n * 10 + static_cast<std::size_t>(text[i++] - '0');
-  if (i == digits || text.compare(i, 2, ": ") != 0) return std::nullopt;
-  return std::pair{n, text.substr(i + 2)};
 }
 
 template <std::size_t d>
@@ -151,13 +136,11 @@ int run(const QuadtreeOptions& o) {
         try {
           tree.apply(all.subspan(i, k));
         } catch (const InputError& err) {
+          // apply() names the failing edit's script line in InputError::line().
           if (!err.file().empty()) throw;
-          auto where = err.line() != 0 ? std::optional{std::pair{err.line(), err.text()}}
-                                       : split_line_prefix(err.text());
-          if (where) {
+          if (err.line() != 0)
             for (const Edit<d>& e : all.subspan(i, k))
-              if (e.line == where->first) throw edit_error<d>(e, err, o.edits, where->second);
-          }
+              if (e.line == err.line()) throw edit_error<d>(e, err, o.edits, err.text());
           rethrow_in(err, o.edits);
         }
         progress.tick(i + k);
