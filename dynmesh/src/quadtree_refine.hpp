@@ -214,8 +214,9 @@ struct Refine {
   }
 
   /// Step of the second walk over C_l, after all its splits: queue the crowded children of
-  /// the entry's cell. Each child's test is its own chain of reads, so a change near one
-  /// child re-runs that child's test only.
+  /// the entry's cell. A change that one child's test read re-runs the tests from that child
+  /// on; the walk re-joins its old trace at the next entry with a crowded child (the memo
+  /// key holds the queue's tail).
   static void classify(sac::Engine& r, QNode<d>* e, Refine* cx, Crowded* out) {
     if (!e) return r.write(*out, nullptr);
     test_child(r, cx, e, 0, out);
@@ -264,7 +265,6 @@ struct Refine {
     r.write(*out, k);
     test_child(r, cx, e, w + 1, &k->next);
   }
-
 };
 
 }  // namespace dynmesh::detail
