@@ -2,6 +2,8 @@
 // indexes, the cell directory, validation, and reading the tree out of the slots.
 #include "dynmesh/dynamic_quadtree.hpp"
 
+#include "dynmesh/detail/touching_leaves.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <deque>
@@ -543,27 +545,11 @@ template <std::size_t d>
 std::vector<CellId<d>> DynamicQuadtree<d>::neighbours(const CellId<d>& leaf) const {
   const auto& s = *s_;
   if (!s.is_leaf(leaf)) throw std::invalid_argument("neighbours: " + to_string(leaf) + " is not a leaf");
-  std::vector<CellId<d>> out;
-  for_each_neighbour(leaf, [&](const CellId<d>& x) {
-    // The smallest existing cell over x: a larger (or equal) leaf, or x split further.
-    CellId<d> c = CellId<d>::root();
-    while (c.level < x.level && s.is_split(c)) c = ancestor(x, c.level + 1);
-    if (!s.is_split(c)) {
-      out.push_back(c);
-      return;
-    }
-    std::vector<CellId<d>> stack{c};
-    while (!stack.empty()) {
-      const CellId<d> y = stack.back();
-      stack.pop_back();
-      if (!touches(y, leaf)) continue;
-      if (s.is_split(y)) {
-        for (const auto& k : children(y)) stack.push_back(k);
-      } else {
-        out.push_back(y);
-      }
-    }
-  });
+  std::vector<CellId<d>> out, stack;
+  detail::for_each_touching_leaf<d>(
+      leaf, [&](const CellId<d>& x) { return s.is_split(x); }, [](const CellId<d>&) { return true; },
+      [&](const CellId<d>& l) { out.push_back(l); },
+      [&](const CellId<d>& l, const CellId<d>&) { out.push_back(l); }, stack);
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;

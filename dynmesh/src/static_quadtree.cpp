@@ -3,6 +3,8 @@
 // single bottom-up closure pass is the least fixed point.
 #include "dynmesh/static_quadtree.hpp"
 
+#include "dynmesh/detail/touching_leaves.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <limits>
@@ -125,12 +127,10 @@ CellId<d> locate_in(const CellTable<d, V>& split, int max_split, const Position<
   return cell_of(q, lo);
 }
 
-/// The leaf (of the tree given by its split set) that contains the unsplit cell c: c itself
-/// when its parent is split, else the nearest ancestor whose parent is split.
+/// The leaf (of the tree given by its split set) that contains the unsplit cell c.
 template <std::size_t d, class V>
-CellId<d> leaf_containing(const CellTable<d, V>& split, CellId<d> c) {
-  while (c.level > 0 && !split.contains(parent(c))) c = parent(c);
-  return c;
+CellId<d> leaf_of(const CellTable<d, V>& split, const CellId<d>& c) {
+  return detail::leaf_containing<d>([&](const CellId<d>& x) { return split.contains(x); }, c);
 }
 
 /// The leaves touching leaf a, sorted, a excluded, into `out` (`stack` is scratch space).
@@ -138,24 +138,10 @@ template <std::size_t d, class V>
 void touching_leaves(const CellTable<d, V>& split, const CellId<d>& a, std::vector<CellId<d>>& out,
                      std::vector<CellId<d>>& stack) {
   out.clear();
-  for_each_neighbour(a, [&](const CellId<d>& nb) {
-    if (split.contains(nb)) {
-      stack.push_back(nb);
-      while (!stack.empty()) {
-        const CellId<d> x = stack.back();
-        stack.pop_back();
-        for (const CellId<d>& ch : children(x)) {
-          if (!touches(ch, a)) continue;
-          if (split.contains(ch))
-            stack.push_back(ch);
-          else
-            out.push_back(ch);
-        }
-      }
-    } else {
-      out.push_back(leaf_containing(split, nb));
-    }
-  });
+  detail::for_each_touching_leaf<d>(
+      a, [&](const CellId<d>& x) { return split.contains(x); }, [](const CellId<d>&) { return true; },
+      [&](const CellId<d>& leaf) { out.push_back(leaf); },
+      [&](const CellId<d>& leaf, const CellId<d>&) { out.push_back(leaf); }, stack);
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }
@@ -620,7 +606,7 @@ CheckReport<d> check_tree(std::span<const Position<d>> points, std::span<const L
           *v = static_cast<std::uint16_t>(*v | kForced);
           return;
         }
-        const CellId<d> b = leaf_containing(split, u);
+        const CellId<d> b = leaf_of(split, u);
         if (!reported.insert(b)) return;
         add(ViolationKind::Grading, b, s,
             "leaf " + to_string<d>(b) + " touches split cell " + to_string<d>(s) +
@@ -635,7 +621,7 @@ CheckReport<d> check_tree(std::span<const Position<d>> points, std::span<const L
   const MortonIndex<d> index(std::move(valid_points));
   auto holds_point = [&](const CellId<d>& c) {
     if (split.contains(c)) return index.any(c);
-    const Occupied* o = occupied.find(leaf_containing(split, c));
+    const Occupied* o = occupied.find(leaf_of(split, c));
     return o != nullptr && contains(c, points[o->point]);
   };
   auto neighbours_hold_points = [&](const CellId<d>& c) {
@@ -650,30 +636,23 @@ CheckReport<d> check_tree(std::span<const Position<d>> points, std::span<const L
     const CellId<d>& a = cell_at(k);
     bool crowded = false;
     touching_occupied.clear();
-    for_each_neighbour(a, [&](const CellId<d>& nb) {
-      if (split.contains(nb)) {
-        if (!index.any(nb)) return;
-        crowded = true;
-        stack.push_back(nb);
-        while (!stack.empty()) {
-          const CellId<d> x = stack.back();
-          stack.pop_back();
-          for (const CellId<d>& ch : children(x)) {
-            if (!touches(ch, a)) continue;
-            if (split.contains(ch))
-              stack.push_back(ch);
-            else if (occupied.contains(ch))
-              touching_occupied.push_back(ch);
+    detail::for_each_touching_leaf<d>(
+        a, [&](const CellId<d>& x) { return split.contains(x); },
+        [&](const CellId<d>& nb) {  // only a split neighbour with points can hide an occupied leaf
+          if (!index.any(nb)) return false;
+          crowded = true;
+          return true;
+        },
+        [&](const CellId<d>& leaf) {
+          if (occupied.contains(leaf)) touching_occupied.push_back(leaf);
+        },
+        [&](const CellId<d>& b, const CellId<d>& nb) {
+          if (const Occupied* o = occupied.find(b)) {
+            touching_occupied.push_back(b);
+            if (contains(nb, points[o->point])) crowded = true;
           }
-        }
-      } else {
-        const CellId<d> b = leaf_containing(split, nb);
-        if (const Occupied* o = occupied.find(b)) {
-          touching_occupied.push_back(b);
-          if (contains(nb, points[o->point])) crowded = true;
-        }
-      }
-    });
+        },
+        stack);
     std::sort(touching_occupied.begin(), touching_occupied.end());
     touching_occupied.erase(std::unique(touching_occupied.begin(), touching_occupied.end()), touching_occupied.end());
     for (const CellId<d>& b : touching_occupied)
