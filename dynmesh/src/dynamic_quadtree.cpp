@@ -191,24 +191,16 @@ struct DynamicState {
   /// level-52 cell crowded: spread beyond the resolution.
   template <class Present>
   static void check_resolution(const Position<d>& q, Present&& present, std::size_t line) {
-    Position<d> r{};
-    for (int code = 0; code < kNeighbourhood<d>; ++code) {
-      int rest = code;
-      bool inside = true, self = true;
-      for (std::size_t a = 0; a < d; ++a) {
-        const int off = rest % 3 - 1;
-        rest /= 3;
-        if (off != 0) self = false;
-        if ((off < 0 && q[a] == 0) || (off > 0 && q[a] + 1 >= kResolution)) inside = false;
-        r[a] = q[a] + static_cast<std::uint64_t>(static_cast<std::int64_t>(off));
-      }
-      if (self || !inside) continue;
-      if (present(r))
-        throw InputError(InputError::Kind::Resolution,
-                         "another point lies within one grid unit (L/2^52): spread beyond the "
-                         "resolution of 2^52",
-                         std::string{}, line);
-    }
+    // q's level-52 cell and its neighbourhood: the located positions one unit away.
+    bool near = false;
+    for_each_neighbour(cell_of(q, kMaxLevel), [&](const CellId<d>& nb) {
+      if (!near && present(nb.index)) near = true;
+    });
+    if (near)
+      throw InputError(InputError::Kind::Resolution,
+                       "another point lies within one grid unit (L/2^52): spread beyond the "
+                       "resolution of 2^52",
+                       std::string{}, line);
   }
 
   // ------------------------------------------------------------------ list edits
