@@ -49,7 +49,6 @@ class StablePool {
     p->~T();
     free_.push_back(p);
   }
-  std::size_t live() const noexcept { return store_.size() - free_.size(); }
   std::size_t bytes() const noexcept {
     return store_.size() * sizeof(T) + free_.capacity() * sizeof(T*);
   }
@@ -183,10 +182,6 @@ struct DynamicState {
   sac::Engine rt;
 
   // ------------------------------------------------------------------ validation
-  Position<d> locate_checked(const Point<d>& x, std::size_t line) const {
-    return dynmesh::locate(box, x, std::string{}, line);
-  }
-
   /// The located points within one grid unit of q per axis (excluding q itself) make a
   /// level-52 cell crowded: spread beyond the resolution.
   template <class Present>
@@ -357,7 +352,7 @@ template <std::size_t d>
   requires SupportedDim<d>
 PointId DynamicQuadtree<d>::insert(const Point<d>& p) {
   auto& s = *s_;
-  const Position<d> q = s.locate_checked(p, 0);
+  const Position<d> q = dynmesh::locate(s.box, p);
   if (auto it = s.by_pos.find(q); it != s.by_pos.end())
     throw InputError(InputError::Kind::Duplicate,
                      "point " + to_string<d>(p) + " has the same located position as point " +
@@ -405,7 +400,7 @@ std::vector<PointId> DynamicQuadtree<d>::apply(std::span<const Edit<d>> edits) {
   for (std::size_t i = 0; i < edits.size(); ++i) {
     const Edit<d>& e = edits[i];
     try {
-      const Position<d> q = s.locate_checked(e.point, 0);
+      const Position<d> q = dynmesh::locate(s.box, e.point);
       if (e.op == EditOp::Insert) {
         if (present(q))
           throw InputError(InputError::Kind::Duplicate,  // as insert() reports it
