@@ -185,7 +185,7 @@ struct DynamicState {
   /// The located points within one grid unit of q per axis (excluding q itself) make a
   /// level-52 cell crowded: spread beyond the resolution.
   template <class Present>
-  static void check_resolution(const Position<d>& q, Present&& present, std::size_t line) {
+  static void check_resolution(const Position<d>& q, Present&& present) {
     // q's level-52 cell and its neighbourhood: the located positions one unit away.
     bool near = false;
     for_each_neighbour(cell_of(q, kMaxLevel), [&](const CellId<d>& nb) {
@@ -194,8 +194,7 @@ struct DynamicState {
     if (near)
       throw InputError(InputError::Kind::Resolution,
                        "another point lies within one grid unit (L/2^52): spread beyond the "
-                       "resolution of 2^52",
-                       std::string{}, line);
+                       "resolution of 2^52");
   }
 
   // ------------------------------------------------------------------ list edits
@@ -319,9 +318,7 @@ DynamicQuadtree<d>::DynamicQuadtree(const Box<d>& box, std::span<const Point<d>>
   }
   for (std::size_t i = 0; i < points.size(); ++i) {
     try {
-      detail::DynamicState<d>::check_resolution(qs[i], [&](const Position<d>& r) {
-        return seen.contains(r);
-      }, 0);
+      detail::DynamicState<d>::check_resolution(qs[i], [&](const Position<d>& r) { return seen.contains(r); });
     } catch (InputError& e) {
       throw InputError(e.kind(), "point " + std::to_string(i) + ": " + e.text()).with_points({i});
     }
@@ -357,7 +354,7 @@ PointId DynamicQuadtree<d>::insert(const Point<d>& p) {
     throw InputError(InputError::Kind::Duplicate,
                      "point " + to_string<d>(p) + " has the same located position as point " +
                          std::to_string(it->second->id));
-  s.check_resolution(q, [&](const Position<d>& r) { return s.by_pos.contains(r); }, 0);
+  s.check_resolution(q, [&](const Position<d>& r) { return s.by_pos.contains(r); });
   auto* n = s.link_new(q, p);
   s.propagate();
   s.maybe_compact();
@@ -405,7 +402,7 @@ std::vector<PointId> DynamicQuadtree<d>::apply(std::span<const Edit<d>> edits) {
         if (present(q))
           throw InputError(InputError::Kind::Duplicate,  // as insert() reports it
                            "point " + to_string<d>(e.point) + " is already in the set (same located position)");
-        s.check_resolution(q, present, 0);
+        s.check_resolution(q, present);
         added.emplace(q, &e.point);
       } else {
         bool ok = false;
