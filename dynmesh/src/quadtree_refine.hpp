@@ -117,9 +117,6 @@ struct Refine {
   List* input;  // the root's list: the input points
 
   Slot<d>& slot(sac::Engine& r, const CellId<d>& c) { return dir->get(r, c); }
-  List& points_of(sac::Engine& r, const CellId<d>& c) {
-    return c.level == 0 ? *input : slot(r, c).pts;
-  }
 
   /// Where SPLIT sends each child's points.
   struct Dests {
@@ -193,11 +190,13 @@ struct Refine {
   /// earlier witness, matching the old partition far ahead in the trace would discard all
   /// the trace in between (a memo hit undoes everything up to the entry it reuses).
   static void split(sac::Engine& r, Refine* cx, const CellId<d>& c, const CellId<d>& witness) {
-    r.write(cx->slot(r, c).split, std::uint8_t{1});
+    Slot<d>& cell = cx->slot(r, c);
+    r.write(cell.split, std::uint8_t{1});
     Dests to;
     for (unsigned w = 0; w < static_cast<unsigned>(kChildren<d>); ++w)
       to.to[w] = &cx->slot(r, child(c, w)).pts;
-    r.memo_read(cx->points_of(r, c), sac::fn<&partition>(cx, witness, c.level + 1, to));
+    List& points = c.level == 0 ? *cx->input : cell.pts;
+    r.memo_read(points, sac::fn<&partition>(cx, witness, c.level + 1, to));
   }
 
   static void partition(sac::Engine& r, Node* p, Refine* cx, CellId<d> witness, int child_level,
