@@ -8,7 +8,7 @@ JOBS="${JOBS:-$(nproc 2>/dev/null || echo 2)}"
 # Debian packages the project needs. gnuplot-nox is listed so that apt satisfies gnuplot's
 # "gnuplot-qt | gnuplot-x11 | gnuplot-nox" without pulling in Qt.
 DEPS=(cmake g++ ninja-build libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev libgmp-dev
-      gnuplot gnuplot-nox clang libclang-rt-14-dev)
+      libmpfr-dev libcgal-dev gnuplot gnuplot-nox clang libclang-rt-14-dev)
 
 deps() {
   local missing=() p

@@ -363,9 +363,10 @@ std::vector<Position<d>> locate_points(const PointFile<d>& file, const Box<d>& b
 // edit scripts
 
 template <std::size_t d>
-std::vector<Edit<d>> read_edits(std::istream& in, const std::string& name) {
+EditScript<d> read_edits(std::istream& in, const std::string& name) {
   LineReader r(in, name);
-  std::vector<Edit<d>> out;
+  EditScript<d> out;
+  out.name = name;
   std::vector<std::string_view> f;
   while (r.next(f)) {
     EditOp op;
@@ -378,15 +379,16 @@ std::vector<Edit<d>> read_edits(std::istream& in, const std::string& name) {
     if (f.size() != 1 + d)
       r.fail(Kind::Count, "an edit needs exactly " + std::to_string(d) + " coordinates, found " +
                               std::to_string(f.size() - 1));
-    Edit<d> e{op, {}, r.line()};
+    Edit<d> e{op, {}};
     for (std::size_t a = 0; a < d; ++a) e.point[a] = r.coordinate(f[1 + a]);
-    out.push_back(e);
+    out.edits.push_back(e);
+    out.lines.push_back(r.line());
   }
   return out;
 }
 
 template <std::size_t d>
-std::vector<Edit<d>> read_edits_file(const std::string& path) {
+EditScript<d> read_edits_file(const std::string& path) {
   std::ifstream in = open_input(path);
   return read_edits<d>(in, path);
 }
@@ -497,8 +499,8 @@ CellsFile<d> read_cells_file(const std::string& path) {
   template PointFile<D> read_plain<D>(std::istream&, const std::string&);                            \
   template PointFile<D> read_points_file<D>(const std::string&, PointFormat);                        \
   template std::vector<Position<D>> locate_points<D>(const PointFile<D>&, const Box<D>&);            \
-  template std::vector<Edit<D>> read_edits<D>(std::istream&, const std::string&);                    \
-  template std::vector<Edit<D>> read_edits_file<D>(const std::string&);                              \
+  template EditScript<D> read_edits<D>(std::istream&, const std::string&);                           \
+  template EditScript<D> read_edits_file<D>(const std::string&);                                     \
   template std::string format_cells<D>(const Box<D>&, std::span<const Leaf<D>>);                     \
   template void write_cells<D>(std::ostream&, const Box<D>&, std::span<const Leaf<D>>);              \
   template void write_cells_file<D>(const std::string&, const Box<D>&, std::span<const Leaf<D>>);    \

@@ -85,13 +85,23 @@ struct PNode {
   PNode* down = nullptr;  // the point's node one level deeper (owned by the directory)
 };
 
+/// Values of a slot's `split`. QuadTreeRefine writes 0 or kTreeSplit; a postprocess that
+/// refines T* further writes later versions (kRefineSplit, or a leaf's mark with the low two
+/// bits 0), which QuadTreeRefine's reads, being earlier in the trace, never see.
+inline constexpr std::uint8_t kTreeSplit = 1;
+inline constexpr std::uint8_t kRefineSplit = 2;
+/// Split in T*.
+constexpr bool tree_split(std::uint8_t v) noexcept { return (v & 3u) == kTreeSplit; }
+/// Split in T* or in a postprocess's refinement of it.
+constexpr bool any_split(std::uint8_t v) noexcept { return (v & 3u) != 0; }
+
 /// The directory entry of a cell: its versioned state. Lives outside the trace; found by
 /// CellId, so identities never depend on when or where a run first named the cell.
 template <std::size_t d>
 struct Slot {
   explicit Slot(const CellId<d>& c) : id(c) {}
   CellId<d> id;
-  sac::Mod<std::uint8_t> split;  // 1 once SPLIT ran on the cell
+  sac::Mod<std::uint8_t> split;  // kTreeSplit once SPLIT ran on the cell (see above)
   sac::Mod<PNode<d>*> pts;       // the cell's points (written by its parent's SPLIT)
 };
 
@@ -191,7 +201,7 @@ struct Refine {
   /// the trace in between (a memo hit undoes everything up to the entry it reuses).
   static void split(sac::Engine& r, Refine* cx, const CellId<d>& c, const CellId<d>& witness) {
     Slot<d>& cell = cx->slot(r, c);
-    r.write(cell.split, std::uint8_t{1});
+    r.write(cell.split, kTreeSplit);
     Dests to;
     for (unsigned w = 0; w < static_cast<unsigned>(kChildren<d>); ++w)
       to.to[w] = &cx->slot(r, child(c, w)).pts;

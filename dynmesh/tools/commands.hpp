@@ -2,7 +2,7 @@
 //
 // Purpose: one options struct and one entry point per subcommand; main.cpp parses the
 // command line into these with CLI11 and calls the entry point. The contracts are
-// shared/FORMATS.md's `dynmesh quadtree` and `dynmesh stability`; `demo` is the README's
+// shared/FORMATS.md's `dynmesh quadtree`, `dynmesh mesh` (2D) and `dynmesh stability`; `demo` is the README's
 // main job.
 // Invariants: an entry point returns the exit status (0 success, 1 failure) or throws; every
 // exception becomes one line `dynmesh: <message>` on stderr in main.cpp, so the commands
@@ -31,6 +31,24 @@ struct QuadtreeOptions {
   std::string svg;          // --svg OUT.svg (2D)
 };
 
+// `dynmesh mesh` (2D); named apart from dynmesh::MeshOptions, the library's.
+struct MeshCommandOptions {
+  std::string points;            // POINTS: .node or plain text (2D)
+  std::vector<double> box;       // --box o1 o2 L (empty: derive from the initial points)
+  std::string postprocess;       // --postprocess hpu|quadtree (empty: the default, hpu)
+  double min_angle = 0;          // --min-angle DEG
+  bool min_angle_given = false;  // --min-angle appeared
+  std::string edits;             // --edits FILE
+  std::size_t batch = 0;         // --batch K (0: one propagation per edit)
+  std::string outbase;           // -o OUTBASE: OUTBASE.node and OUTBASE.ele
+  std::string feed;              // --feed F
+  std::string vtk;               // --vtk F
+  std::string msh;               // --msh F
+  std::string svg;               // --svg F
+  bool check = false;            // --check
+  bool stats = false;            // --stats
+};
+
 struct StabilityOptions {
   int dim = 2;
   std::string dist;
@@ -50,6 +68,7 @@ struct DemoOptions {
 };
 
 int run_quadtree(const QuadtreeOptions& options);
+int run_mesh(const MeshCommandOptions& options);
 int run_stability(const StabilityOptions& options);
 int run_demo(const DemoOptions& options);
 

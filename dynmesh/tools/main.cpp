@@ -1,6 +1,9 @@
 // dynmesh — the command-line tool of the dynmesh library (shared/FORMATS.md):
 //   dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--edits FILE] [--batch K]
 //                   --cells OUT [--check] [--svg OUT.svg]
+//   dynmesh mesh POINTS [--box o1 o2 L] [--postprocess hpu|quadtree] [--min-angle DEG]
+//                [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F] [--msh F] [--svg F]
+//                [--check] [--stats]
 //   dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]
 //                     --csv OUT.csv [--plot OUT.svg]
 //   dynmesh demo [--n N] [--updates U] [--seed X] [--svg OUT.svg]
@@ -46,6 +49,30 @@ int main(int argc, char** argv) {
   quadtree->add_flag("--check", q.check, "also rebuild from scratch on the final points and fail if the trees differ");
   quadtree->add_option("--svg", q.svg, "also draw the final tree and points (2D only)");
 
+  MeshCommandOptions me;
+  CLI::App* mesh = app.add_subcommand(
+      "mesh", "Mesh the box of a 2D point file, apply an edit script dynamically, write the final mesh");
+  mesh->add_option("POINTS", me.points, "point file: .node (Triangle) or plain text (x y per line)")->required();
+  mesh->add_option("--box", me.box, "domain box: origin and side length (default: derived from the initial points)")
+      ->expected(3)
+      ->type_name("o1 o2 L");
+  mesh->add_option("--postprocess", me.postprocess,
+                   "hpu (the default; not available yet) or quadtree (the quadtree mesh, angles >= 18.4)");
+  CLI::Option* min_angle_opt =
+      mesh->add_option("--min-angle", me.min_angle, "smallest angle in degrees (quadtree: at most 18.4)");
+  mesh->add_option("--edits", me.edits, "edit script: '+ x y' inserts, '- x y' deletes, one per line");
+  mesh->add_option("--batch", me.batch, "propagate K consecutive edits together (default: each edit alone)")
+      ->check(at_least_one);
+  mesh->add_option("-o", me.outbase, "output base: writes OUTBASE.node and OUTBASE.ele")
+      ->required()
+      ->type_name("OUTBASE");
+  mesh->add_option("--feed", me.feed, "also write the change feed of every propagation");
+  mesh->add_option("--vtk", me.vtk, "also write the mesh as legacy VTK");
+  mesh->add_option("--msh", me.msh, "also write the mesh as Gmsh 2.2 ASCII");
+  mesh->add_option("--svg", me.svg, "also draw the mesh and its input points");
+  mesh->add_flag("--check", me.check, "also mesh the final points from scratch and fail unless the meshes agree");
+  mesh->add_flag("--stats", me.stats, "print a quality report on stderr");
+
   StabilityOptions s;
   CLI::App* stability = app.add_subcommand(
       "stability",
@@ -84,6 +111,10 @@ int main(int argc, char** argv) {
     if (*quadtree) {
       q.dim_given = dim_opt->count() > 0;
       return run_quadtree(q);
+    }
+    if (*mesh) {
+      me.min_angle_given = min_angle_opt->count() > 0;
+      return run_mesh(me);
     }
     if (*stability) return run_stability(s);
     if (*demo) return run_demo(m);

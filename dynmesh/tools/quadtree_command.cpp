@@ -44,13 +44,18 @@ Box<d> box_from_option(const std::vector<double>& values) {
   return box;
 }
 
-// The error of edit `e` as "FILE:LINE: insert (x, y): why" (the point only once).
+// The error of edit i of the script as "FILE:LINE: insert (x, y): why" (the point only
+// once; an "edit K: " prefix from a batch dropped, the line names the edit).
 template <std::size_t d>
-InputError edit_error(const Edit<d>& e, const InputError& err, const std::string& file, const std::string& why) {
+InputError edit_error(const EditScript<d>& script, std::size_t i, const InputError& err) {
+  const Edit<d>& e = script.edits[i];
+  std::string why = err.text();
+  if (why.rfind("edit ", 0) == 0)
+    if (const auto colon = why.find(": "); colon != std::string::npos) why.erase(0, colon + 2);
   const std::string point = to_string<d>(e.point);
   std::string text = e.op == EditOp::Insert ? "insert" : "delete";
   if (why.find(point) == std::string::npos) text += " " + point;
-  return InputError(err.kind(), text + ": " + why, file, e.line);
+  return InputError(err.kind(), text + ": " + why, script.name, script.lines[i]);
 }
 
 template <std::size_t d>
@@ -73,7 +78,8 @@ int run(const QuadtreeOptions& o) {
   // Outside the box, NaN, duplicates: named by line here, before the tree sees the points.
   const std::vector<Position<d>> located = locate_points<d>(file, box);
   // Read the whole script before building, so a malformed script fails fast.
-  const std::vector<Edit<d>> edits = o.edits.empty() ? std::vector<Edit<d>>{} : read_edits_file<d>(o.edits);
+  const EditScript<d> script = o.edits.empty() ? EditScript<d>{} : read_edits_file<d>(o.edits);
+  const std::vector<Edit<d>>& edits = script.edits;
 
   auto line_of = [&](std::size_t i) { return i < file.lines.size() ? file.lines[i] : std::size_t{0}; };
   std::optional<DynamicQuadtree<d>> built;
@@ -126,7 +132,7 @@ int run(const QuadtreeOptions& o) {
           else
             tree.erase(e.point);
         } catch (const InputError& err) {
-          throw edit_error<d>(e, err, o.edits, err.text());
+          throw edit_error<d>(script, i, err);
         }
         progress.tick(i + 1);
       }
@@ -136,12 +142,9 @@ int run(const QuadtreeOptions& o) {
         try {
           tree.apply(all.subspan(i, k));
         } catch (const InputError& err) {
-          // apply() names the failing edit's script line in InputError::line().
-          if (!err.file().empty()) throw;
-          if (err.line() != 0)
-            for (const Edit<d>& e : all.subspan(i, k))
-              if (e.line == err.line()) throw edit_error<d>(e, err, o.edits, err.text());
-          rethrow_in(err, o.edits);
+          // apply() names the failing edit by its index in the batch.
+          if (err.point_indices().empty()) rethrow_in(err, o.edits);
+          throw edit_error<d>(script, i + err.point_indices().back(), err);
         }
         progress.tick(i + k);
       }

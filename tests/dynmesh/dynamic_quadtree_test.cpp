@@ -313,12 +313,12 @@ class Driver {
       if (ins) {
         const std::size_t i = take_absent(rng);
         inserted.push_back(i);
-        edits.push_back({EditOp::Insert, s_.pool[i], j + 1});
+        edits.push_back({EditOp::Insert, s_.pool[i]});
         last_ += " +pool[" + std::to_string(i) + "]";
       } else if (!present_.empty()) {
         const PointId id = take_present(rng);
         erased.push_back(id);
-        edits.push_back({EditOp::Delete, want_.at(id), j + 1});
+        edits.push_back({EditOp::Delete, want_.at(id)});
         last_ += " -id" + std::to_string(id);
       }
     }
@@ -506,8 +506,8 @@ TYPED_TEST(DynamicQuadtreeDifferential, BatchesApplyEditsInOrder) {
   const Point<d> a = pool[out[0]], b = pool[out[1]], c = pool[out[2]];
   const Point<d> x = want.at(0), y = want.at(1);
   const std::vector<Edit<d>> edits = {
-      {EditOp::Insert, a, 0}, {EditOp::Delete, a, 0}, {EditOp::Delete, x, 0}, {EditOp::Insert, x, 0},
-      {EditOp::Insert, b, 0}, {EditOp::Delete, y, 0}, {EditOp::Insert, c, 0},
+      {EditOp::Insert, a}, {EditOp::Delete, a}, {EditOp::Delete, x}, {EditOp::Insert, x},
+      {EditOp::Insert, b}, {EditOp::Delete, y}, {EditOp::Insert, c},
   };
   const auto ids = tree.apply(edits);
   ASSERT_EQ(ids.size(), 4u);
@@ -552,8 +552,8 @@ void edited_equals_fresh(Distribution dist, std::size_t pool_size, std::uint64_t
   for (const auto i : q_idx) in_q[i] = 1;
   std::vector<Edit<d>> edits;
   for (std::size_t i = 0; i < pool.size(); ++i) {
-    if (in_q[i] && !in_p[i]) edits.push_back({EditOp::Delete, pool[i], 0});
-    if (in_p[i] && !in_q[i]) edits.push_back({EditOp::Insert, pool[i], 0});
+    if (in_q[i] && !in_p[i]) edits.push_back({EditOp::Delete, pool[i]});
+    if (in_p[i] && !in_q[i]) edits.push_back({EditOp::Insert, pool[i]});
   }
   rng.shuffle(edits);
   ASSERT_GT(edits.size(), 10u);
@@ -955,36 +955,31 @@ TYPED_TEST(DynamicQuadtreeBadInput, BadBatchAppliesNothing) {
     Kind kind;
   };
   const std::vector<BadCase> cases = {
-      {"NaN", {EditOp::Insert, nan, 0}, Kind::NotFinite},
-      {"outside", {EditOp::Insert, far, 0}, Kind::OutsideBox},
-      {"delete absent", {EditOp::Delete, c, 0}, Kind::Absent},
-      {"delete deleted", {EditOp::Delete, b, 0}, Kind::Absent},
+      {"NaN", {EditOp::Insert, nan}, Kind::NotFinite},
+      {"outside", {EditOp::Insert, far}, Kind::OutsideBox},
+      {"delete absent", {EditOp::Delete, c}, Kind::Absent},
+      {"delete deleted", {EditOp::Delete, b}, Kind::Absent},
       // A point already in the set: the kind insert() reports for it (Duplicate).
-      {"insert inserted", {EditOp::Insert, a, 0}, Kind::Duplicate},
-      {"insert present", {EditOp::Insert, init[0], 0}, Kind::Duplicate},
-      {"insert same position as present", {EditOp::Insert, *twin_of_present, 0}, Kind::Duplicate},
-      {"resolution", {EditOp::Insert, *close_to_a, 0}, Kind::Resolution},
+      {"insert inserted", {EditOp::Insert, a}, Kind::Duplicate},
+      {"insert present", {EditOp::Insert, init[0]}, Kind::Duplicate},
+      {"insert same position as present", {EditOp::Insert, *twin_of_present}, Kind::Duplicate},
+      {"resolution", {EditOp::Insert, *close_to_a}, Kind::Resolution},
   };
   // insert() and apply() classify the same bad insertion alike.
   expect_rejected(tree, Kind::Duplicate, "insert() of a present point", [&] { tree.insert(init[0]); });
   for (const auto& bc : cases) {
-    for (const bool lines : {true, false}) {
-      // + a, − b, <bad>, + c: the first two are valid and must not be applied either.
-      std::vector<Edit<d>> edits = {{EditOp::Insert, a, 0}, {EditOp::Delete, b, 0}, bc.third, {EditOp::Insert, c, 0}};
-      if (lines)
-        for (std::size_t j = 0; j < edits.size(); ++j) edits[j].line = 40 + j;  // the bad edit is on line 42
-      const std::string msg = expect_rejected(tree, bc.kind, bc.name + (lines ? " (script lines)" : " (no lines)"),
-                                              [&] { tree.apply(edits); });
-      if (lines) {
-        EXPECT_NE(msg.find("42"), std::string::npos) << "the message should name the script line 42: " << msg;
-      } else {
-        EXPECT_TRUE(msg.find('2') != std::string::npos || msg.find('3') != std::string::npos)
-            << "the message should name the edit's index (2, or 3 counting from 1): " << msg;
-      }
+    // + a, − b, <bad>, + c: the first two are valid and must not be applied either.
+    const std::vector<Edit<d>> edits = {{EditOp::Insert, a}, {EditOp::Delete, b}, bc.third, {EditOp::Insert, c}};
+    const std::string msg = expect_rejected(tree, bc.kind, bc.name, [&] { tree.apply(edits); });
+    EXPECT_NE(msg.find("edit 2"), std::string::npos) << "the message should name the edit's index: " << msg;
+    try {
+      tree.apply(edits);
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.point_indices(), std::vector<std::size_t>{2}) << bc.name;
     }
   }
   // The same batch without the bad edit goes through.
-  const std::vector<Edit<d>> good = {{EditOp::Insert, a, 0}, {EditOp::Delete, b, 0}, {EditOp::Insert, c, 0}};
+  const std::vector<Edit<d>> good = {{EditOp::Insert, a}, {EditOp::Delete, b}, {EditOp::Insert, c}};
   const auto ids = tree.apply(good);
   ASSERT_EQ(ids.size(), 2u);
   PointMap<d> want;
@@ -1277,7 +1272,7 @@ TYPED_TEST(DynamicQuadtreeTiny, EraseDownToEmptyAndBack) {
       want[tree.insert(back[k])] = back[k];
       ASSERT_TRUE(consistent(tree, want));
     } else {
-      rest.push_back({EditOp::Insert, back[k], 0});
+      rest.push_back({EditOp::Insert, back[k]});
     }
   }
   const auto ids = tree.apply(rest);

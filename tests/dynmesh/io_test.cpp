@@ -35,7 +35,7 @@ PointFile<d> plain(const std::string& text, const std::string& name = "in.xyz") 
 }
 
 template <std::size_t d>
-std::vector<Edit<d>> edits(const std::string& text, const std::string& name = "edits.txt") {
+EditScript<d> edits(const std::string& text, const std::string& name = "edits.txt") {
   std::istringstream in(text);
   return read_edits<d>(in, name);
 }
@@ -227,16 +227,16 @@ TEST(LocatePoints, OutsideTheGivenBox) {
 // --- edit scripts ----------------------------------------------------------------------------
 
 TEST(ReadEdits, Basic) {
-  const auto e = edits<2>("# script\n+ 0.5 0.25\n\n- 1 2 # delete\n  +\t3 4\n");
+  const auto script = edits<2>("# script\n+ 0.5 0.25\n\n- 1 2 # delete\n  +\t3 4\n");
+  const auto& e = script.edits;
   ASSERT_EQ(e.size(), 3u);
+  ASSERT_EQ(script.lines, (std::vector<std::size_t>{2, 4, 5}));
   EXPECT_EQ(e[0].op, EditOp::Insert);
   EXPECT_EQ(e[0].point, (Point<2>{0.5, 0.25}));
-  EXPECT_EQ(e[0].line, 2u);
   EXPECT_EQ(e[1].op, EditOp::Delete);
-  EXPECT_EQ(e[1].line, 4u);
   EXPECT_EQ(e[2].point, (Point<2>{3, 4}));
   const auto e3 = edits<3>("- 1 2 3\n");
-  EXPECT_EQ(e3[0].point, (Point<3>{1, 2, 3}));
+  EXPECT_EQ(e3.edits[0].point, (Point<3>{1, 2, 3}));
 }
 
 TEST(ReadEdits, Errors) {

@@ -39,7 +39,7 @@
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/cell.hpp"
-#include "dynmesh/io.hpp"
+#include "dynmesh/edit.hpp"
 #include "dynmesh/point.hpp"
 #include "dynmesh/static_quadtree.hpp"
 
@@ -88,7 +88,7 @@ class DynamicQuadtree {
   /// Erases the point with exactly these coordinates; InputError(Absent) if there is none.
   void erase(const Point<d>& p);
   /// Applies the edits in order and propagates once. Validated as a whole first: on error
-  /// (naming the edit's script line when it has one, else its index) nothing changes.
+  /// nothing changes, and InputError::point_indices() holds the failing edit's index.
   /// Returns the ids of the inserted points in edit order.
   std::vector<PointId> apply(std::span<const Edit<d>> edits);
 

@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "dynmesh/box.hpp"
+#include "dynmesh/edit.hpp"
 #include "dynmesh/point.hpp"
 #include "dynmesh/static_quadtree.hpp"
 
@@ -76,20 +77,19 @@ int node_file_dimension(const std::string& path);
 template <std::size_t d>
 std::vector<Position<d>> locate_points(const PointFile<d>& file, const Box<d>& box);
 
-enum class EditOp { Insert, Delete };
-
+/// An edit script: the edits in order and, for each, its 1-based line in the file.
 template <std::size_t d>
   requires SupportedDim<d>
-struct Edit {
-  EditOp op;
-  Point<d> point;
-  std::size_t line;  // 1-based line in the script
+struct EditScript {
+  std::string name;                // as used in error messages
+  std::vector<Edit<d>> edits;
+  std::vector<std::size_t> lines;  // lines[i]: the line of edits[i]
 };
 
 template <std::size_t d>
-std::vector<Edit<d>> read_edits(std::istream& in, const std::string& name);
+EditScript<d> read_edits(std::istream& in, const std::string& name);
 template <std::size_t d>
-std::vector<Edit<d>> read_edits_file(const std::string& path);
+EditScript<d> read_edits_file(const std::string& path);
 
 /// Writes the `.cells` format; the leaves are sorted by (level, i, j, k) on the way out.
 template <std::size_t d>

@@ -1,0 +1,456 @@
+// The checker of the 2D mesh contract (see dynmesh/mesh_check.hpp for what it checks).
+#include "dynmesh/mesh_check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <utility>
+
+#include "dynmesh/errors.hpp"
+#include "dynmesh/predicates.hpp"
+
+namespace dynmesh {
+
+std::string_view defect_name(MeshDefect defect) noexcept {
+  switch (defect) {
+    case MeshDefect::Canonical: return "canonical";
+    case MeshDefect::BadIndex: return "bad-index";
+    case MeshDefect::Orientation: return "orientation";
+    case MeshDefect::OutsideBox: return "outside-box";
+    case MeshDefect::IsolatedVertex: return "isolated-vertex";
+    case MeshDefect::MissingCorner: return "missing-corner";
+    case MeshDefect::EdgeTwice: return "edge-twice";
+    case MeshDefect::OpenEdge: return "open-edge";
+    case MeshDefect::VertexInEdge: return "vertex-in-edge";
+    case MeshDefect::Area: return "area";
+    case MeshDefect::MissingInput: return "missing-input";
+    case MeshDefect::SmallAngle: return "small-angle";
+    case MeshDefect::NotDelaunay: return "not-delaunay";
+  }
+  return "unknown";
+}
+
+bool MeshReport::ok() const noexcept {
+  for (std::size_t c : counts)
+    if (c != 0) return false;
+  return true;
+}
+
+std::string MeshReport::summary() const {
+  if (ok())
+    return "mesh ok: angles in [" + format_exact(min_angle_deg) + ", " + format_exact(max_angle_deg) + "] degrees";
+  std::size_t total = 0;
+  std::string kinds;
+  for (std::size_t k = 0; k < kMeshDefectKinds; ++k) {
+    if (counts[k] == 0) continue;
+    total += counts[k];
+    if (!kinds.empty()) kinds += ", ";
+    kinds += std::string(defect_name(static_cast<MeshDefect>(k))) + " " + std::to_string(counts[k]);
+  }
+  std::string s = "mesh invalid: " + std::to_string(total) + " problem" + (total == 1 ? "" : "s") + " (" + kinds + ")";
+  for (const std::string& p : problems) s += "\n  " + p;
+  if (truncated) s += "\n  ... (" + std::to_string(total - problems.size()) + " more)";
+  return s;
+}
+
+namespace {
+
+using Index = std::uint32_t;
+using Tri = std::array<Index, 3>;
+
+// The closed domain: its side lines, computed once as the contract states (fl(o + L)).
+struct Domain {
+  double x0, x1, y0, y1;
+  explicit Domain(const Box<2>& box)
+      : x0(box.origin[0]), x1(box.origin[0] + box.side), y0(box.origin[1]), y1(box.origin[1] + box.side) {}
+  bool contains(const Point<2>& p) const noexcept { return p[0] >= x0 && p[0] <= x1 && p[1] >= y0 && p[1] <= y1; }
+  // Both ends on one side line: the only edges that may be used by one triangle alone.
+  bool on_one_side(const Point<2>& a, const Point<2>& b) const noexcept {
+    return (a[0] == x0 && b[0] == x0) || (a[0] == x1 && b[0] == x1) || (a[1] == y0 && b[1] == y0) ||
+           (a[1] == y1 && b[1] == y1);
+  }
+};
+
+// Collects defects: counts all, keeps the first max_problems messages. The message is built
+// only when it is kept, so a badly broken large mesh stays cheap to check.
+class Recorder {
+ public:
+  Recorder(MeshReport& report, std::size_t max_problems) : report_(report), max_(max_problems) {}
+
+  template <class Describe>
+  void add(MeshDefect defect, Describe&& describe) {
+    ++report_.counts[static_cast<std::size_t>(defect)];
+    if (report_.problems.size() < max_) {
+      report_.problems.push_back(std::string(defect_name(defect)) + ": " + describe());
+    } else {
+      report_.truncated = true;
+    }
+  }
+
+ private:
+  MeshReport& report_;
+  std::size_t max_;
+};
+
+std::string describe_triangle(const Mesh& mesh, std::size_t t) {
+  const Tri& tri = mesh.triangles[t];
+  std::string s = "triangle " + std::to_string(t) + " [" + std::to_string(tri[0]) + " " + std::to_string(tri[1]) +
+                  " " + std::to_string(tri[2]) + "]";
+  for (Index i : tri)
+    if (i < mesh.num_vertices()) s += " " + to_string(mesh.vertices[i]);
+  return s;
+}
+
+std::string describe_vertex(const Mesh& mesh, Index i) { return "vertex " + std::to_string(i) + " " + to_string(mesh.vertices[i]); }
+
+// ---- VertexInEdge: a bounding-volume tree over the vertices in Morton order -------------
+//
+// The vertices are sorted along a Z-order curve of the box and cut into blocks of kBlock;
+// a complete binary tree over the blocks stores each node's exact bounding box (min and max
+// of the doubles themselves, so pruning on it is exact). A query walks the nodes whose box
+// meets the edge's bounding box and is not strictly on one side of the edge's line.
+class VertexTree {
+ public:
+  static constexpr std::size_t kBlock = 8;
+
+  VertexTree(const Mesh& mesh, const Domain& domain) {
+    const double width = domain.x1 - domain.x0, height = domain.y1 - domain.y0;
+    const double sx = width > 0 ? 0x1p32 / width : 0, sy = height > 0 ? 0x1p32 / height : 0;
+    std::vector<std::pair<std::uint64_t, Index>> order;
+    order.reserve(mesh.num_vertices());
+    for (Index i = 0; i < mesh.num_vertices(); ++i) {
+      const Point<2>& p = mesh.vertices[i];
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1])) continue;  // reported as outside the box
+      // A monotone quantization (clamped) is all the order needs: it only affects speed.
+      order.emplace_back(morton(quantize((p[0] - domain.x0) * sx), quantize((p[1] - domain.y0) * sy)), i);
+    }
+    std::sort(order.begin(), order.end());
+    points_.reserve(order.size());
+    for (const auto& entry : order) points_.push_back({mesh.vertices[entry.second], entry.second});
+
+    const std::size_t blocks = (points_.size() + kBlock - 1) / kBlock;
+    leaves_ = 1;
+    while (leaves_ < blocks) leaves_ *= 2;
+    nodes_.assign(2 * leaves_, Bounds{});
+    for (std::size_t b = 0; b < blocks; ++b) {
+      Bounds& box = nodes_[leaves_ + b];
+      for (std::size_t k = b * kBlock; k < std::min(points_.size(), (b + 1) * kBlock); ++k) box.add(points_[k].p);
+    }
+    for (std::size_t n = leaves_ - 1; n >= 1; --n) nodes_[n] = Bounds::merge(nodes_[2 * n], nodes_[2 * n + 1]);
+  }
+
+  // Calls found(w) for every vertex w collinear with a, b and strictly between them.
+  template <class Found>
+  void vertices_inside(const Point<2>& a, const Point<2>& b, Found&& found) const {
+    if (points_.empty()) return;
+    const double lox = std::min(a[0], b[0]), hix = std::max(a[0], b[0]);
+    const double loy = std::min(a[1], b[1]), hiy = std::max(a[1], b[1]);
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    const bool axis_parallel = dx == 0 || dy == 0;
+    std::size_t stack[128];
+    std::size_t top = 0;
+    stack[top++] = 1;
+    while (top > 0) {
+      const std::size_t n = stack[--top];
+      const Bounds& box = nodes_[n];
+      if (box.hix < lox || box.lox > hix || box.hiy < loy || box.loy > hiy) continue;
+      if (!axis_parallel && box.off_line(a, dx, dy)) continue;
+      if (n < leaves_) {
+        stack[top++] = 2 * n + 1;
+        stack[top++] = 2 * n;
+        continue;
+      }
+      const std::size_t block = n - leaves_;
+      const std::size_t end = std::min(points_.size(), (block + 1) * kBlock);
+      for (std::size_t k = block * kBlock; k < end; ++k) {
+        const Point<2>& w = points_[k].p;
+        if (w[0] < lox || w[0] > hix || w[1] < loy || w[1] > hiy) continue;
+        if (w == a || w == b) continue;
+        // In the closed bounding box and not an end: collinear means strictly between. For
+        // an axis-parallel edge the box is the segment itself.
+        if (axis_parallel || orient2d(a, b, w) == 0) found(points_[k].index);
+      }
+    }
+  }
+
+ private:
+  struct Located {
+    Point<2> p;
+    Index index;
+  };
+
+  struct Bounds {
+    double lox = std::numeric_limits<double>::infinity(), hix = -std::numeric_limits<double>::infinity();
+    double loy = std::numeric_limits<double>::infinity(), hiy = -std::numeric_limits<double>::infinity();
+
+    void add(const Point<2>& p) noexcept {
+      lox = std::min(lox, p[0]);
+      hix = std::max(hix, p[0]);
+      loy = std::min(loy, p[1]);
+      hiy = std::max(hiy, p[1]);
+    }
+    static Bounds merge(const Bounds& l, const Bounds& r) noexcept {
+      return Bounds{std::min(l.lox, r.lox), std::max(l.hix, r.hix), std::min(l.loy, r.loy), std::max(l.hiy, r.hiy)};
+    }
+
+    // True when the whole box lies strictly on one side of the line through a with direction
+    // (dx, dy), certified in double: f(c) = dx·(cy − ay) − dy·(cx − ax) is linear, so its
+    // extremes over the box are at the corners chosen by the signs of dx and dy. Each is
+    // trusted only beyond an error bound (Shewchuk's for orient2d is 3.3e-16 times the
+    // permanent; 1e-15 leaves margin, 1e-300 covers underflow), so pruning never loses a
+    // vertex; a box it cannot certify is simply visited.
+    bool off_line(const Point<2>& a, double dx, double dy) const noexcept {
+      const double hi_cx = dy > 0 ? lox : hix, hi_cy = dx > 0 ? hiy : loy;  // maximizes f
+      const double lo_cx = dy > 0 ? hix : lox, lo_cy = dx > 0 ? loy : hiy;  // minimizes f
+      const double ahx = hi_cx - a[0], ahy = hi_cy - a[1], alx = lo_cx - a[0], aly = lo_cy - a[1];
+      const double fmax = dx * ahy - dy * ahx, fmin = dx * aly - dy * alx;
+      const double emax = 1e-15 * (std::abs(dx * ahy) + std::abs(dy * ahx)) + 1e-300;
+      const double emin = 1e-15 * (std::abs(dx * aly) + std::abs(dy * alx)) + 1e-300;
+      return fmax < -emax || fmin > emin;
+    }
+  };
+
+  static std::uint32_t quantize(double t) noexcept {
+    if (!(t > 0)) return 0;
+    if (t >= 0x1p32) return 0xffffffffu;
+    return static_cast<std::uint32_t>(t);
+  }
+  static std::uint64_t spread(std::uint32_t v) noexcept {
+    std::uint64_t x = v;
+    x = (x | (x << 16)) & 0x0000ffff0000ffffull;
+    x = (x | (x << 8)) & 0x00ff00ff00ff00ffull;
+    x = (x | (x << 4)) & 0x0f0f0f0f0f0f0f0full;
+    x = (x | (x << 2)) & 0x3333333333333333ull;
+    x = (x | (x << 1)) & 0x5555555555555555ull;
+    return x;
+  }
+  static std::uint64_t morton(std::uint32_t qx, std::uint32_t qy) noexcept { return spread(qx) | (spread(qy) << 1); }
+
+  std::vector<Located> points_;
+  std::vector<Bounds> nodes_;  // heap layout: node n has children 2n, 2n+1; leaves from leaves_
+  std::size_t leaves_ = 1;
+};
+
+// ---- the directed edges, grouped by their start vertex ---------------------------------
+
+struct OutEdge {
+  Index to;
+  Index tri;
+  friend bool operator<(const OutEdge& l, const OutEdge& r) noexcept {
+    return l.to < r.to || (l.to == r.to && l.tri < r.tri);
+  }
+};
+
+// Compressed rows: out[start[u] .. start[u+1]) are the edges leaving u, sorted by end.
+struct EdgeTable {
+  std::vector<std::size_t> start;
+  std::vector<OutEdge> out;
+
+  std::span<const OutEdge> from(Index u) const noexcept { return {out.data() + start[u], start[u + 1] - start[u]}; }
+  // The number of directed edges v -> u, and the triangle of the first.
+  std::pair<std::size_t, Index> count(Index v, Index u) const noexcept {
+    const auto row = from(v);
+    const auto lo = std::lower_bound(row.begin(), row.end(), OutEdge{u, 0});
+    auto hi = lo;
+    while (hi != row.end() && hi->to == u) ++hi;
+    return {static_cast<std::size_t>(hi - lo), lo == hi ? Index{0} : lo->tri};
+  }
+};
+
+EdgeTable build_edges(const Mesh& mesh, const std::vector<char>& well_formed) {
+  EdgeTable table;
+  const std::size_t n = mesh.num_vertices();
+  table.start.assign(n + 1, 0);
+  for (std::size_t t = 0; t < mesh.num_triangles(); ++t)
+    if (well_formed[t])
+      for (Index i : mesh.triangles[t]) ++table.start[i + 1];
+  for (std::size_t i = 0; i < n; ++i) table.start[i + 1] += table.start[i];
+  table.out.resize(table.start[n]);
+  std::vector<std::size_t> fill(table.start.begin(), table.start.end() - 1);
+  for (std::size_t t = 0; t < mesh.num_triangles(); ++t) {
+    if (!well_formed[t]) continue;
+    const Tri& tri = mesh.triangles[t];
+    for (int k = 0; k < 3; ++k) table.out[fill[tri[k]]++] = OutEdge{tri[(k + 1) % 3], static_cast<Index>(t)};
+  }
+  for (std::size_t u = 0; u < n; ++u)
+    std::sort(table.out.begin() + static_cast<std::ptrdiff_t>(table.start[u]),
+              table.out.begin() + static_cast<std::ptrdiff_t>(table.start[u + 1]));
+  return table;
+}
+
+// The corner of triangle `tri` that is neither u nor v.
+Index opposite(const Tri& tri, Index u, Index v) noexcept {
+  for (Index i : tri)
+    if (i != u && i != v) return i;
+  return tri[0];
+}
+
+}  // namespace
+
+double corner_angle_deg(const Point<2>& at, const Point<2>& p, const Point<2>& q) noexcept {
+  const double ux = p[0] - at[0], uy = p[1] - at[1], vx = q[0] - at[0], vy = q[1] - at[1];
+  const double cross = ux * vy - uy * vx, dot = ux * vx + uy * vy;
+  return std::atan2(std::abs(cross), dot) * (180.0 / std::numbers::pi);
+}
+
+MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point<2>> inputs,
+                      const MeshCheckOptions& options, std::size_t max_problems) {
+  MeshReport report;
+  Recorder record(report, max_problems);
+  const Domain domain(box);
+  const std::size_t nv = mesh.num_vertices(), nt = mesh.num_triangles();
+  const auto& vs = mesh.vertices;
+
+  // Canonical vertex order. Lookups below need a sorted list; a broken mesh gets a copy.
+  bool vertices_sorted = true;
+  for (std::size_t i = 1; i < nv; ++i) {
+    if (!xy_less(vs[i - 1], vs[i])) {
+      vertices_sorted = false;
+      record.add(MeshDefect::Canonical, [&] {
+        return "vertices " + std::to_string(i - 1) + " " + to_string(vs[i - 1]) + " and " + std::to_string(i) + " " +
+               to_string(vs[i]) + " are not in strictly increasing (x, y) order";
+      });
+    }
+  }
+  std::vector<Point<2>> sorted_copy;
+  if (!vertices_sorted) {
+    sorted_copy = vs;
+    std::sort(sorted_copy.begin(), sorted_copy.end(), xy_less);
+  }
+  const std::vector<Point<2>>& lookup = vertices_sorted ? vs : sorted_copy;
+  auto is_vertex = [&](const Point<2>& p) {
+    const auto it = std::lower_bound(lookup.begin(), lookup.end(), p, xy_less);
+    return it != lookup.end() && !xy_less(p, *it);
+  };
+
+  for (Index i = 0; i < nv; ++i)
+    if (!domain.contains(vs[i])) record.add(MeshDefect::OutsideBox, [&] { return describe_vertex(mesh, i) + " is outside the box"; });
+  const Point<2> corners[4] = {{domain.x0, domain.y0}, {domain.x1, domain.y0}, {domain.x0, domain.y1}, {domain.x1, domain.y1}};
+  for (const Point<2>& c : corners)
+    if (!is_vertex(c)) record.add(MeshDefect::MissingCorner, [&] { return "box corner " + to_string(c) + " is not a vertex"; });
+
+  // Per triangle: indices, canonical rotation and order, orientation, area, angles.
+  std::vector<char> well_formed(nt, 0), ccw(nt, 0);
+  double area = 0, area_compensation = 0;  // Neumaier summation: 10^6 terms of mixed sizes
+  double min_angle = std::numeric_limits<double>::infinity(), max_angle = 0;
+  for (std::size_t t = 0; t < nt; ++t) {
+    const Tri& tri = mesh.triangles[t];
+    if (t > 0 && tri < mesh.triangles[t - 1])
+      record.add(MeshDefect::Canonical, [&] { return describe_triangle(mesh, t) + " is out of order"; });
+    if (tri[0] >= nv || tri[1] >= nv || tri[2] >= nv || tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+      record.add(MeshDefect::BadIndex, [&] { return describe_triangle(mesh, t) + " names a missing vertex or one twice"; });
+      continue;
+    }
+    well_formed[t] = 1;
+    if (!(tri[0] < tri[1] && tri[0] < tri[2]))
+      record.add(MeshDefect::Canonical, [&] { return describe_triangle(mesh, t) + " does not start at its smallest index"; });
+    const Point<2>&a = vs[tri[0]], &b = vs[tri[1]], &c = vs[tri[2]];
+    const int turn = orient2d(a, b, c);
+    if (turn > 0) {
+      ccw[t] = 1;
+    } else {
+      record.add(MeshDefect::Orientation, [&] {
+        return describe_triangle(mesh, t) + (turn < 0 ? " is clockwise" : " is degenerate (collinear corners)");
+      });
+    }
+    const double twice = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    const double sum = area + twice;
+    area_compensation += std::abs(area) >= std::abs(twice) ? (area - sum) + twice : (twice - sum) + area;
+    area = sum;
+
+    const double angles[3] = {corner_angle_deg(a, b, c), corner_angle_deg(b, c, a), corner_angle_deg(c, a, b)};
+    const double lo = std::min({angles[0], angles[1], angles[2]}), hi = std::max({angles[0], angles[1], angles[2]});
+    min_angle = std::min(min_angle, lo);
+    max_angle = std::max(max_angle, hi);
+    if (lo < options.min_angle_deg)
+      record.add(MeshDefect::SmallAngle, [&] {
+        return describe_triangle(mesh, t) + " has an angle of " + format_exact(lo) + " degrees, below " +
+               format_exact(options.min_angle_deg);
+      });
+  }
+  if (std::isfinite(min_angle)) {
+    report.min_angle_deg = min_angle;
+    report.max_angle_deg = max_angle;
+  }
+
+  const double box_area = (domain.x1 - domain.x0) * (domain.y1 - domain.y0);
+  const double mesh_area = (area + area_compensation) / 2;
+  if (!(std::abs(mesh_area - box_area) <= 1e-9 * box_area))
+    record.add(MeshDefect::Area, [&] {
+      return "the triangles' area " + format_exact(mesh_area) + " differs from the box's " + format_exact(box_area);
+    });
+
+  // Edges: matched in opposite directions inside, on a side of the box when used once.
+  const EdgeTable edges = build_edges(mesh, well_formed);
+  std::vector<std::pair<Index, Index>> undirected;  // each edge once, for VertexInEdge
+  undirected.reserve(edges.out.size() / 2 + nv);
+  for (Index u = 0; u < nv; ++u) {
+    const auto row = edges.from(u);
+    if (row.empty()) {
+      record.add(MeshDefect::IsolatedVertex, [&] { return describe_vertex(mesh, u) + " belongs to no triangle"; });
+      continue;
+    }
+    for (std::size_t k = 0; k < row.size(); ++k) {
+      const Index v = row[k].to, t = row[k].tri;
+      if (k > 0 && row[k - 1].to == v) {
+        record.add(MeshDefect::EdgeTwice, [&] {
+          return "edge " + std::to_string(u) + " -> " + std::to_string(v) + " " + to_string(vs[u]) + " -> " +
+                 to_string(vs[v]) + " is used by triangles " + std::to_string(row[k - 1].tri) + " and " +
+                 std::to_string(t);
+        });
+        continue;
+      }
+      const auto [reverse, across] = edges.count(v, u);
+      if (reverse == 0) {
+        if (!domain.on_one_side(vs[u], vs[v]))
+          record.add(MeshDefect::OpenEdge, [&] {
+            return "edge " + std::to_string(u) + " -> " + std::to_string(v) + " " + to_string(vs[u]) + " -> " +
+                   to_string(vs[v]) + " of triangle " + std::to_string(t) +
+                   " has no neighbour and is not on the box boundary";
+          });
+        undirected.emplace_back(u, v);
+        continue;
+      }
+      if (u > v) continue;  // interior edges are handled once, from their smaller end
+      undirected.emplace_back(u, v);
+      if (options.delaunay && ccw[t] && ccw[across]) {
+        const Index apex = opposite(mesh.triangles[t], u, v), far = opposite(mesh.triangles[across], u, v);
+        if (incircle(vs[u], vs[v], vs[apex], vs[far]) > 0)
+          record.add(MeshDefect::NotDelaunay, [&] {
+            return describe_vertex(mesh, far) + " of triangle " + std::to_string(across) +
+                   " is strictly inside the circumcircle of triangle " + std::to_string(t) + " across edge " +
+                   std::to_string(u) + " - " + std::to_string(v);
+          });
+      }
+    }
+  }
+
+  // No vertex strictly inside an edge (edges with a non-finite end are reported elsewhere).
+  const VertexTree tree(mesh, domain);
+  for (const auto& [u, v] : undirected) {
+    const Point<2>&a = vs[u], &b = vs[v];
+    if (!std::isfinite(a[0]) || !std::isfinite(a[1]) || !std::isfinite(b[0]) || !std::isfinite(b[1])) continue;
+    tree.vertices_inside(a, b, [&](Index w) {
+      record.add(MeshDefect::VertexInEdge, [&] {
+        return describe_vertex(mesh, w) + " lies inside edge " + std::to_string(u) + " - " + std::to_string(v) + " " +
+               to_string(a) + " - " + to_string(b);
+      });
+    });
+  }
+
+  for (std::size_t i = 0; i < inputs.size(); ++i)
+    if (!is_vertex(inputs[i]))
+      record.add(MeshDefect::MissingInput, [&] {
+        return "input point " + std::to_string(i) + " " + to_string(inputs[i]) + " is not a vertex";
+      });
+  return report;
+}
+
+void require_valid_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point<2>> inputs,
+                        const MeshCheckOptions& options, std::size_t max_problems) {
+  const MeshReport report = check_mesh(mesh, box, inputs, options, max_problems);
+  if (!report.ok()) throw InvariantError(report.summary());
+}
+
+}  // namespace dynmesh

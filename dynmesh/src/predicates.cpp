@@ -1,0 +1,41 @@
+// predicates.cpp — orient2d and incircle on CGAL's filtered kernel (see predicates.hpp).
+//
+// Purpose: the only translation unit that sees CGAL. Both predicates forward to
+// Exact_predicates_inexact_constructions_kernel, whose predicates are filtered: a static
+// error bound on the double evaluation, then interval arithmetic, then exact rationals (GMP)
+// when neither can certify the sign.
+// Invariants: the returned int is the sign of the exact determinant of the double inputs
+// (−1, 0 or +1); CGAL's Sign enum already uses exactly these values.
+// Complexity: O(1); the exact fallback costs microseconds but runs only on (nearly)
+// degenerate input.
+// Paper: Shewchuk (1997) for the determinants and their sign conventions; Brönnimann,
+// Burnikel, Pion, "Interval arithmetic yields efficient dynamic filters for computational
+// geometry" (1998) for the filter CGAL implements.
+#include "dynmesh/predicates.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+namespace dynmesh {
+
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using KPoint = Kernel::Point_2;
+
+KPoint to_kernel(const Point<2>& p) noexcept { return KPoint(p[0], p[1]); }
+
+}  // namespace
+
+int orient2d(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept {
+  // CGAL::LEFT_TURN == POSITIVE == +1: c left of the directed line ab, i.e. a, b, c ccw.
+  return static_cast<int>(Kernel::Orientation_2()(to_kernel(a), to_kernel(b), to_kernel(c)));
+}
+
+int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept {
+  // ON_POSITIVE_SIDE == +1 of the circle oriented by a, b, c: the inside when a, b, c are ccw.
+  // CGAL evaluates the full lifted determinant, so collinear a, b, c get its sign, as promised.
+  return static_cast<int>(Kernel::Side_of_oriented_circle_2()(to_kernel(a), to_kernel(b),
+                                                              to_kernel(c), to_kernel(d)));
+}
+
+}  // namespace dynmesh

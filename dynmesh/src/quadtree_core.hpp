@@ -1,0 +1,456 @@
+// quadtree_core.hpp (private) — the program layer: the engine, the input point list, the
+// cell directory and QuadTreeRefine, composed so that more than one program can share them.
+//
+// Purpose: DynamicQuadtree runs QuadTreeRefine alone; DynamicMesh runs it and then a
+// postprocess in the same engine and the same run(), so one propagate() carries a point
+// update through the tree into the mesh. QuadtreeCore owns everything both need: the
+// engine, the input list (the root's point list, appended in insertion order), the point
+// indexes, the directory of cell slots (quadtree_refine.hpp), validation of a batch of
+// edits, and the mutator's side of an update (link, unlink, propagate, release, compact).
+// A postprocess is a callable run after Refine::main inside the same run().
+//
+// Invariants (check_invariants()): the engine's; the input list, its mirror and the two
+// indexes hold the same points; every per-level list node holds its point; the directory's.
+// Failure atomicity: validate() runs over a whole batch before anything changes.
+// Complexity: validate O(k·3^d) hash probes for k edits; an update O(trace distance) plus
+// amortised O(1) compaction per slot.
+// Paper: Acar & Hudson, Section 4 (the mutator: insertions and deletions as changes to the
+// input, then change propagation).
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <optional>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+#include <sac/engine.hpp>
+#include <sac/hash.hpp>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/cell.hpp"
+#include "dynmesh/detail/cell_table.hpp"
+#include "dynmesh/dynamic_quadtree.hpp"
+#include "dynmesh/edit.hpp"
+#include "dynmesh/errors.hpp"
+#include "quadtree_refine.hpp"
+
+namespace dynmesh::detail {
+
+
+/// An input point: a list cell the program reads, plus the mutator's bookkeeping.
+template <std::size_t d>
+struct InputNode : PNode<d> {
+  InputNode(const Position<d>& pos, const Point<d>& x, PointId i) : PNode<d>(pos), point(x), id(i) {}
+  Point<d> point;
+  PointId id;
+  InputNode* prev = nullptr;  // list neighbours, mirrored for O(1) unlinking
+  InputNode* succ = nullptr;
+};
+
+/// A pool of T that never moves its objects; freed objects are reused. T must be trivially
+/// destructible, so the deque may drop them without running destructors twice.
+template <class T>
+class StablePool {
+  static_assert(std::is_trivially_destructible_v<T>);
+
+ public:
+  template <class... A>
+  T* create(A&&... a) {
+    if (free_.empty()) return &store_.emplace_back(std::forward<A>(a)...);
+    T* p = free_.back();
+    free_.pop_back();
+    return new (p) T(std::forward<A>(a)...);
+  }
+  void destroy(T* p) noexcept {
+    p->~T();
+    free_.push_back(p);
+  }
+  std::size_t bytes() const noexcept {
+    return store_.size() * sizeof(T) + free_.capacity() * sizeof(T*);
+  }
+
+ private:
+  std::deque<T> store_;
+  std::vector<T*> free_;
+};
+
+/// Cells by name, outside the trace (see quadtree_refine.hpp). A slot is created, with
+/// default state, the first time the program names its cell, and released by sweep() once
+/// nothing in the trace refers to it.
+template <std::size_t d>
+class Directory {
+ public:
+  Slot<d>& get(sac::Engine& rt, const CellId<d>& c) {
+    auto [v, fresh] = table_.try_emplace(c, nullptr);
+    if (!fresh) return **v;
+    Slot<d>* s = pool_.create(c);
+    *v = s;
+    rt.init(s->split, std::uint8_t{0});
+    rt.init(s->pts, static_cast<PNode<d>*>(nullptr));
+    return *s;
+  }
+  const Slot<d>* find(const CellId<d>& c) const {
+    Slot<d>* const* v = table_.find(c);
+    return v ? *v : nullptr;
+  }
+  std::size_t size() const noexcept { return table_.size(); }
+  std::size_t bytes() const noexcept {
+    return pool_.bytes() + copies_.bytes() + table_.size() * 2 * (8 * d + sizeof(void*));
+  }
+
+  /// The node of p's point one level below p's, created on first use.
+  PNode<d>* below(PNode<d>* p) {
+    if (!p->down) p->down = copies_.create(p->q);
+    return p->down;
+  }
+  /// Frees the nodes below p that the trace no longer refers to (the deepest levels a point
+  /// has left), or all of them (`all`, for an erased point). Returns false if a node that
+  /// had to go is still referred to.
+  bool release_below(sac::Engine& rt, PNode<d>* p, bool all) {
+    // The levels a point is partitioned at are contiguous from the top, so the unused ones
+    // form a suffix of the chain.
+    PNode<d>* keep = p;
+    if (!all)
+      for (PNode<d>* c = p->down; c && !rt.unused(c->next); c = c->down) keep = c;
+    PNode<d>* c = keep->down;
+    keep->down = nullptr;
+    bool ok = true;
+    while (c) {
+      PNode<d>* nx = c->down;
+      ok = ok && rt.unused(c->next);
+      copies_.destroy(c);
+      c = nx;
+    }
+    return ok;
+  }
+
+  /// Releases every slot the trace no longer refers to. O(size).
+  void sweep(sac::Engine& rt) {
+    std::vector<Slot<d>*> dead;
+    table_.for_each([&](const CellId<d>&, Slot<d>* s) {
+      if (rt.unused(s->split) && rt.unused(s->pts)) dead.push_back(s);
+    });
+    for (Slot<d>* s : dead) {
+      rt.retire(s->split);
+      rt.retire(s->pts);
+      table_.erase(s->id);
+      pool_.destroy(s);
+    }
+  }
+  template <class F>
+  void for_each(F&& f) const {
+    table_.for_each([&](const CellId<d>&, Slot<d>* s) { f(*s); });
+  }
+
+  /// Throws InvariantError unless each slot is filed under its own cell and every child of
+  /// a split cell has a slot with a written point list. O(size).
+  void check_invariants(const sac::Engine& rt) const {
+    table_.for_each([&](const CellId<d>& c, const Slot<d>* s) {
+      if (!(s->id == c)) throw InvariantError("dynmesh: directory slot filed under another cell");
+      if (!s->split.written() || !s->pts.written())
+        throw InvariantError("dynmesh: directory slot " + to_string(c) + " without its default state");
+      if (!tree_split(s->split.get())) return;
+      if (c.level >= kMaxLevel) throw InvariantError("dynmesh: a level-52 cell is split");
+      for (const CellId<d>& k : children(c)) {
+        const Slot<d>* ks = find(k);
+        if (!ks || rt.unused(ks->pts))
+          throw InvariantError("dynmesh: child " + to_string(k) + " of split cell " + to_string(c) +
+                               " has no point list");
+      }
+    });
+  }
+
+ private:
+  CellTable<d, Slot<d>*> table_;
+  StablePool<Slot<d>> pool_;
+  StablePool<PNode<d>> copies_;
+};
+
+template <std::size_t d>
+struct PositionHash {
+  std::size_t operator()(const Position<d>& q) const noexcept {
+    std::uint64_t h = 0x51ed27a5ULL;
+    for (std::size_t a = 0; a < d; ++a) h = sac::mix64(h ^ q[a]);
+    return static_cast<std::size_t>(h);
+  }
+};
+
+
+/// No checks beyond the quadtree's own (DynamicQuadtree). A postprocess's checks see each
+/// validated insertion (insert(q, p, fail) may reject it) and deletion, in batch order.
+struct NoExtraChecks {
+  template <class Q, class P, class Fail>
+  void insert(const Q&, const P&, Fail&&) {}
+  template <class Q>
+  void erase(const Q&) {}
+};
+
+template <std::size_t d>
+class QuadtreeCore {
+ public:
+  using Node = InputNode<d>;
+  using Program = Refine<d, Directory<d>>;
+
+  explicit QuadtreeCore(const Box<d>& b) : box(b) {
+    validate_box(box);
+    rt.set(head, static_cast<PNode<d>*>(nullptr));
+    program.dir = &dir;
+    program.input = &head;
+  }
+
+  Box<d> box;
+  StablePool<Node> inputs;
+  Node* first = nullptr;  // the input list, mirrored for the mutator
+  Node* tail = nullptr;
+  std::unordered_map<Position<d>, Node*, PositionHash<d>> by_pos;
+  std::unordered_map<PointId, Node*> by_id;
+  PointId next_id = 0;
+  Directory<d> dir;
+  sac::Mod<PNode<d>*> head;
+  UpdateStats last;
+  std::size_t compact_mark = 0;
+  Program program{};
+  // Declared last, destroyed first: its records point into the slots and input nodes.
+  sac::Engine rt;
+
+  // ------------------------------------------------------------------ validation
+  /// Checks a batch of edits against the set as it will be when each applies, changing
+  /// nothing. `noun` names an edit in messages ("point 3", "edit 3"); empty for a single
+  /// call, whose message names the point instead. The failing edit's index goes into
+  /// InputError::point_indices() (both indices for two inserts at one position). `extra`
+  /// adds a postprocess's own rules (see NoExtraChecks).
+  template <class Extra = NoExtraChecks>
+  void validate(std::span<const Edit<d>> edits, const std::string& noun, Extra&& extra = {}) const {
+    std::unordered_map<Position<d>, std::size_t, PositionHash<d>> added;  // q -> edit index
+    std::unordered_set<Position<d>, PositionHash<d>> removed;
+    auto present = [&](const Position<d>& q) {
+      return added.contains(q) || (by_pos.contains(q) && !removed.contains(q));
+    };
+    for (std::size_t i = 0; i < edits.size(); ++i) {
+      const Edit<d>& e = edits[i];
+      const std::string who = noun.empty() ? std::string{} : noun + " " + std::to_string(i) + ": ";
+      auto fail = [&](InputError::Kind kind, const std::string& text) {
+        throw InputError(kind, who + text).with_points({i});
+      };
+      std::optional<Position<d>> located;
+      for (std::size_t a = 0; a < d; ++a)
+        if (!std::isfinite(e.point[a])) fail(InputError::Kind::NotFinite, "point " + to_string<d>(e.point) + " has a NaN or infinite coordinate");
+      located = try_locate(box, e.point);
+      if (!located) fail(InputError::Kind::OutsideBox, "point " + to_string<d>(e.point) + " is outside the domain box");
+      const Position<d> q = *located;
+      if (e.op == EditOp::Insert) {
+        if (auto a = added.find(q); a != added.end())
+          throw InputError(InputError::Kind::Duplicate,
+                           (noun.empty() ? std::string("points") : noun + "s") + " " + std::to_string(a->second) +
+                               " and " + std::to_string(i) + " have the same located position")
+              .with_points({a->second, i});
+        if (present(q))
+          fail(InputError::Kind::Duplicate, "point " + to_string<d>(e.point) +
+                                                " has the same located position as a point in the set");
+        check_resolution(q, present, [&](const std::string& text) { fail(InputError::Kind::Resolution, text); });
+        extra.insert(q, e.point, [&](const std::string& text) { fail(InputError::Kind::Resolution, text); });
+        added.emplace(q, i);
+      } else {
+        bool ok = false;
+        if (auto a = added.find(q); a != added.end()) {
+          ok = edits[a->second].point == e.point;
+          if (ok) added.erase(a);
+        } else if (auto b = by_pos.find(q); b != by_pos.end() && !removed.contains(q)) {
+          ok = b->second->point == e.point;
+          if (ok) removed.insert(q);
+        }
+        if (!ok) fail(InputError::Kind::Absent, "point " + to_string<d>(e.point) + " is not in the set");
+        extra.erase(q);
+      }
+    }
+  }
+
+  /// A level-52 cell would be crowded: another located point within one grid unit of q per
+  /// axis (q's level-52 neighbourhood): spread beyond the resolution.
+  template <class Present, class Fail>
+  static void check_resolution(const Position<d>& q, Present&& present, Fail&& fail) {
+    bool near = false;
+    for_each_neighbour(cell_of(q, kMaxLevel), [&](const CellId<d>& nb) {
+      if (!near && present(nb.index)) near = true;
+    });
+    if (near)
+      fail("another point lies within one grid unit (L/2^52): spread beyond the resolution of 2^52");
+  }
+
+  // ------------------------------------------------------------------ building and updating
+  /// Links the (validated) points and runs QuadTreeRefine, then `post(engine)` in the same
+  /// run. Ids are the input indices.
+  template <class Post>
+  void build(std::span<const Point<d>> points, Post&& post) {
+    by_pos.reserve(points.size());
+    by_id.reserve(points.size());
+    for (const Point<d>& p : points) link_new(*try_locate(box, p), p);
+    Program* refine = &program;
+    rt.run([refine, &post](sac::Engine& e) {
+      Program::main(e, refine);
+      post(e);
+    });
+    compact_mark = dir.size();
+  }
+
+  /// Applies validated edits and propagates once; returns the ids of the insertions.
+  std::vector<PointId> update(std::span<const Edit<d>> edits) {
+    std::vector<PointId> ids;
+    std::vector<Node*> gone;
+    for (const Edit<d>& e : edits) {
+      const Position<d> q = *try_locate(box, e.point);
+      if (e.op == EditOp::Insert) {
+        ids.push_back(link_new(q, e.point)->id);
+      } else {
+        Node* n = by_pos.at(q);
+        unlink(n);
+        gone.push_back(n);
+      }
+    }
+    propagate();
+    release(gone);
+    maybe_compact();
+    return ids;
+  }
+
+  /// The single edit that erases the point with this id (InputError(Absent) if none).
+  Edit<d> erase_edit(PointId id) const {
+    auto it = by_id.find(id);
+    if (it == by_id.end()) throw InputError(InputError::Kind::Absent, "no point with id " + std::to_string(id));
+    return Edit<d>{EditOp::Delete, it->second->point};
+  }
+
+  std::optional<PointId> find(const Point<d>& p) const noexcept {
+    const auto q = try_locate(box, p);
+    if (!q) return std::nullopt;
+    auto it = by_pos.find(*q);
+    if (it == by_pos.end() || it->second->point != p) return std::nullopt;
+    return it->second->id;
+  }
+  const Point<d>& point(PointId id) const {
+    auto it = by_id.find(id);
+    if (it == by_id.end()) throw InputError(InputError::Kind::Absent, "no point with id " + std::to_string(id));
+    return it->second->point;
+  }
+  std::vector<std::pair<PointId, Point<d>>> points() const {
+    std::vector<std::pair<PointId, Point<d>>> out;
+    out.reserve(by_id.size());
+    for (const Node* n = first; n; n = n->succ) out.emplace_back(n->id, n->point);
+    return out;
+  }
+
+  std::size_t bytes() const {
+    return rt.trace_bytes() + rt.input_bytes() + dir.bytes() + inputs.bytes();
+  }
+
+  void compact() {
+    dir.sweep(rt);
+    for (Node* n = first; n; n = n->succ) dir.release_below(rt, n, false);
+    compact_mark = dir.size();
+  }
+
+  /// The engine, the list and indexes, the point nodes and the directory (not the tree's
+  /// shape: see DynamicQuadtree::check_invariants).
+  void check_invariants() const {
+    rt.check_invariants();
+    std::size_t k = 0;
+    for (const Node* n = first; n; n = n->succ, ++k) {
+      if (n->succ && n->succ->prev != n) throw InvariantError("dynmesh: input list links broken");
+      if (n->next.get() != n->succ) throw InvariantError("dynmesh: input list differs from its mirror");
+      auto a = by_pos.find(n->q);
+      auto b = by_id.find(n->id);
+      if (a == by_pos.end() || a->second != n || b == by_id.end() || b->second != n)
+        throw InvariantError("dynmesh: point indexes disagree with the input list");
+      for (const PNode<d>* c = n->down; c; c = c->down)
+        if (c->q != n->q) throw InvariantError("dynmesh: a point's list node holds another point");
+    }
+    if (head.get() != first) throw InvariantError("dynmesh: list head differs from its mirror");
+    if (k != by_pos.size() || k != by_id.size())
+      throw InvariantError("dynmesh: point indexes hold points not in the input list");
+    dir.check_invariants(rt);
+  }
+
+  // ------------------------------------------------------------------ reading the tree
+  /// Split in T* (the quadtree), as opposed to split by a postprocess's refinement.
+  bool is_split(const CellId<d>& c) const {
+    const Slot<d>* s = dir.find(c);
+    return s && s->split.written() && tree_split(s->split.get());
+  }
+  const PNode<d>* points_in(const CellId<d>& c) const {
+    if (c.level == 0) return head.get();
+    const Slot<d>* s = dir.find(c);
+    return s && s->pts.written() ? s->pts.get() : nullptr;
+  }
+  /// Leaves of the tree whose split cells satisfy `split`, depth first.
+  template <class IsSplit, class F>
+  void for_each_leaf_of(IsSplit&& split, F&& f) const {
+    std::vector<CellId<d>> stack{CellId<d>::root()};
+    while (!stack.empty()) {
+      const CellId<d> c = stack.back();
+      stack.pop_back();
+      if (split(c)) {
+        for (unsigned w = kChildren<d>; w-- > 0;) stack.push_back(child(c, w));
+      } else {
+        f(c);
+      }
+    }
+  }
+
+ private:
+  /// Appends a point to the input list. Appending, not prepending, keeps every cell's list
+  /// head unchanged unless the cell held fewer than two points, and the crowding tests read
+  /// only list heads.
+  Node* link_new(const Position<d>& q, const Point<d>& x) {
+    Node* n = inputs.create(q, x, next_id++);
+    rt.set(n->next, static_cast<PNode<d>*>(nullptr));
+    rt.set(tail ? tail->next : head, static_cast<PNode<d>*>(n));
+    n->prev = tail;
+    if (tail) tail->succ = n;
+    else first = n;
+    tail = n;
+    by_pos.emplace(q, n);
+    by_id.emplace(n->id, n);
+    return n;
+  }
+  void unlink(Node* n) {
+    PNode<d>* after = n->next.get();
+    if (n->prev) rt.set(n->prev->next, after);
+    else rt.set(head, after);
+    if (n->prev) n->prev->succ = n->succ;
+    else first = n->succ;
+    if (n->succ) n->succ->prev = n->prev;
+    else tail = n->prev;
+    by_pos.erase(n->q);
+    by_id.erase(n->id);
+  }
+  /// After propagate(): the unlinked nodes are no longer read by anyone.
+  void release(const std::vector<Node*>& gone) {
+    for (Node* n : gone) {
+      if (!rt.unused(n->next) || !dir.release_below(rt, n, true))
+        throw InvariantError("dynmesh: an erased point is still read by the trace");
+      rt.retire(n->next);
+      inputs.destroy(n);
+    }
+  }
+  void propagate() {
+    const auto t0 = std::chrono::steady_clock::now();
+    rt.propagate();
+    const auto t1 = std::chrono::steady_clock::now();
+    last.seconds = std::chrono::duration<double>(t1 - t0).count();
+    last.trace_distance = rt.stats().last_trace_distance;
+    last.reexecuted = rt.stats().last_reexecuted;
+  }
+  void maybe_compact() {
+    if (dir.size() > 2 * std::max<std::size_t>(compact_mark, 4096)) compact();
+  }
+};
+
+}  // namespace dynmesh::detail

@@ -1,0 +1,184 @@
+// quadtree_mesh_program.hpp (private) — the quadtree postprocess written as static code on
+// sac-runtime, run after QuadTreeRefine in the same run() (DynamicMesh).
+//
+// Purpose: the rules of detail/quadtree_mesh_rules.hpp as a program whose trace is local, so
+// that a point update changes O(lg L/s) of it:
+//
+//   main:        place(each input point); then visit(the root)
+//   place(p):    descend to p's leaf in T*; target c_t; SPLIT' each level-(t−1) cell
+//                touching c_t; mark the leaves around the warped vertex; c_t.pts := p
+//   split'(c):   unless c is split: c.split := kRefineSplit; split' each coarser cell
+//                touching c (grading)
+//   visit(c):    for each child k: split → visit(k), leaf → emit(k)
+//   emit(k):     read the side neighbours (midpoints) and, when k is marked, the warping
+//                point; make the leaf's triangle block
+//
+// How it is made stable and order independent:
+//   * T' is written into the same `split` modifiables as T*, as later versions: QuadTreeRefine
+//     reads earlier in the trace and never sees them, the postprocess reads T' (see
+//     kRefineSplit). Marks are leaf values of `split` (low bits 0), read by emit anyway.
+//   * p's T* level is found by reading the point lists down p's path: cell_of(q, l).pts is
+//     non-empty exactly when T* split its parent (QuadTreeRefine's partition wrote it). No
+//     postprocess write lands there before p's own descent (c_t.pts is p's alone), so the
+//     descent sees T* whatever the order of the points.
+//   * T' is the least closure of the seeds, a set: the order in which the points add to it
+//     changes the trace, not the result. Each point's work is memoized on its list node,
+//     so an insertion or deletion re-runs only its own place() and what reads the cells it
+//     changes; the walk of T' is memoized per cell, so it re-runs only where split changed.
+//   * A leaf's triangles are a keyless allocation (LeafBlock) whose constructor and
+//     destructor tell the feed log: what propagation creates and undoes is the change feed.
+// Complexity: from scratch O(Σ_p depth(p) + |T'|) events; per update O(lg L/s) expected.
+// Paper: Acar & Hudson, Section 4 (dynamizing by change propagation) and Section 5
+// (postprocessing the quadtree); Bern, Eppstein & Gilbert (1994).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <sac/engine.hpp>
+#include <sac/fn.hpp>
+
+#include "dynmesh/detail/quadtree_mesh_rules.hpp"
+#include "dynmesh/mesh.hpp"
+#include "quadtree_core.hpp"
+
+namespace dynmesh::detail {
+
+struct LeafBlock;
+
+/// Live leaf blocks and the change of the running update.
+struct FeedLog {
+  explicit FeedLog(const MeshGrid& g) : grid(g) {}
+  MeshGrid grid;
+  LeafBlock* live = nullptr;           // every live block, doubly linked
+  std::vector<LeafBlock*> created;     // blocks made in this update (null once undone)
+  std::vector<Triangle> removed;       // triangles of the blocks undone in this update
+  std::size_t live_count = 0;
+  bool closing = false;                // the engine is being destroyed: log nothing
+};
+
+struct LeafBlock {
+  LeafBlock(FeedLog* l, const LeafShape& s) : log(l), shape(s) {
+    next = log->live;
+    if (next) next->prev = this;
+    log->live = this;
+    ++log->live_count;
+    slot = log->created.size();
+    log->created.push_back(this);
+  }
+  ~LeafBlock() {
+    if (log->closing) return;
+    if (prev) prev->next = next;
+    else log->live = next;
+    if (next) next->prev = prev;
+    --log->live_count;
+    if (slot != kOld) log->created[slot] = nullptr;  // made and undone in one update
+    else triangulate_leaf(log->grid, shape, log->removed);
+  }
+  LeafBlock(const LeafBlock&) = delete;
+  LeafBlock& operator=(const LeafBlock&) = delete;
+
+  static constexpr std::size_t kOld = ~std::size_t{0};
+  FeedLog* log;
+  LeafShape shape;
+  LeafBlock* prev = nullptr;
+  LeafBlock* next = nullptr;
+  std::size_t slot;  // index in log->created, or kOld
+};
+
+struct QuadtreeMeshProgram {
+  using Node = PNode<2>;
+  Directory<2>* dir;
+  sac::Mod<Node*>* input;
+  FeedLog* log;
+
+  Slot<2>& slot(sac::Engine& r, const CellId<2>& c) { return dir->get(r, c); }
+  const MeshGrid& grid() const { return log->grid; }
+
+  static void main(sac::Engine& r, QuadtreeMeshProgram* cx) {
+    r.memo_read(*cx->input, sac::fn<&place>(cx));
+    r.memo(sac::fn<&visit_root>(cx));
+  }
+
+  // ------------------------------------------------------------------ the points
+  static void place(sac::Engine& r, Node* n, QuadtreeMeshProgram* cx) {
+    if (!n) return;
+    r.memo(sac::fn<&descend>(cx, n, 1));
+    r.memo_read(n->next, sac::fn<&place>(cx));
+  }
+
+  /// Reads cell_of(q, l).pts: non-empty iff T* split its parent.
+  static void descend(sac::Engine& r, QuadtreeMeshProgram* cx, Node* n, int l) {
+    if (l > kMaxLevel) return settle(r, cx, n, kMaxLevel);
+    r.read(cx->slot(r, cell_of(n->q, l)).pts, [cx, n, l](sac::Engine& e, Node* head) {
+      if (head) descend(e, cx, n, l + 1);
+      else settle(e, cx, n, l - 1);
+    });
+  }
+
+  static void settle(sac::Engine& r, QuadtreeMeshProgram* cx, Node* n, int tree_level) {
+    const auto* in = static_cast<const InputNode<2>*>(n);
+    const WarpTarget t = warp_target(cx->grid(), n->q, in->point, tree_level);
+    for_each_coarser_touching(t.leaf, [&](const CellId<2>& s) { split(r, cx, s); });
+    for_each_marked(t, [&](const CellId<2>& x, std::uint8_t mark) {
+      r.read(cx->slot(r, x).split, [cx, x, mark](sac::Engine& e, std::uint8_t v) {
+        // A split value here would break the closure's rule; the checkers report it.
+        if (!any_split(v)) e.write(cx->slot(e, x).split, mark);
+      });
+    });
+    r.write(cx->slot(r, t.leaf).pts, n);
+  }
+
+  /// SPLIT' and grading: c and the coarser cells it forces become split.
+  static void split(sac::Engine& r, QuadtreeMeshProgram* cx, const CellId<2>& c) {
+    r.read(cx->slot(r, c).split, [cx, c](sac::Engine& e, std::uint8_t v) {
+      if (any_split(v)) return;
+      e.write(cx->slot(e, c).split, kRefineSplit);
+      if (c.level > 0) for_each_coarser_touching(c, [&](const CellId<2>& u) { split(e, cx, u); });
+    });
+  }
+
+  // ------------------------------------------------------------------ the leaves
+  static void visit_root(sac::Engine& r, QuadtreeMeshProgram* cx) { look(r, cx, CellId<2>::root()); }
+
+  static void look(sac::Engine& r, QuadtreeMeshProgram* cx, const CellId<2>& c) {
+    r.read(cx->slot(r, c).split, [cx, c](sac::Engine& e, std::uint8_t v) {
+      if (any_split(v)) e.memo(sac::fn<&visit>(cx, c));
+      else side(e, cx, LeafShape{c, 0, -1, {}}, v, 0);
+    });
+  }
+
+  static void visit(sac::Engine& r, QuadtreeMeshProgram* cx, CellId<2> c) {
+    for (unsigned w = 0; w < 4; ++w) look(r, cx, child(c, w));
+  }
+
+  /// Reads the neighbour across side s (a split one puts a midpoint on the side), then the
+  /// next side; after the last, the warping point if the leaf is marked.
+  static void side(sac::Engine& r, QuadtreeMeshProgram* cx, LeafShape shape, std::uint8_t mark, unsigned s) {
+    CellId<2> nb;
+    while (s < 4 && !side_neighbour(shape.cell, s, nb)) ++s;
+    if (s == 4) return finish(r, cx, shape, mark);
+    r.read(cx->slot(r, nb).split, [cx, shape, mark, s](sac::Engine& e, std::uint8_t v) {
+      LeafShape next = shape;
+      if (any_split(v)) next.midpoints = static_cast<std::uint8_t>(next.midpoints | (1u << s));
+      side(e, cx, next, mark, s + 1);
+    });
+  }
+
+  static void finish(sac::Engine& r, QuadtreeMeshProgram* cx, LeafShape shape, std::uint8_t mark) {
+    if (!is_warped(mark)) {
+      r.make<LeafBlock>(cx->log, shape);
+      return;
+    }
+    shape.warped = static_cast<std::int8_t>(warped_corner(mark));
+    r.read(cx->slot(r, warp_source(shape.cell, mark)).pts, [cx, shape](sac::Engine& e, Node* p) {
+      if (!p) throw InvariantError("dynmesh: a warped leaf without its point");
+      LeafShape s = shape;
+      s.warp_to = static_cast<const InputNode<2>*>(p)->point;
+      e.make<LeafBlock>(cx->log, s);
+    });
+  }
+};
+
+}  // namespace dynmesh::detail

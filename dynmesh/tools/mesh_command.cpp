@@ -1,0 +1,249 @@
+// `dynmesh mesh` (2D): mesh a point file in its box, apply an edit script dynamically, write
+// the final mesh as .node/.ele (and optionally the change feed, VTK, MSH, SVG), shared/
+// FORMATS.md "dynmesh mesh (2D)". Only `--postprocess quadtree` exists so far; `hpu` (the
+// documented default) is refused with a clear message. Every error names the file and line it
+// comes from, as `dynmesh quadtree` does; every output is written aside and renamed into place
+// only after all of them were written (atomic_file.hpp), so a failed run leaves old files
+// untouched.
+// Complexity: construction O(n lg n + |T'|) expected, then O(lg L/s) expected trace distance
+// per edit (DynamicMesh); the outputs are linear in the mesh (the SVG O(t log t)); --check
+// adds a from-scratch QuadtreeMesh and check_mesh, O((t + n) log t).
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <optional>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "atomic_file.hpp"
+#include "commands.hpp"
+#include "dynmesh/box.hpp"
+#include "dynmesh/dynamic_mesh.hpp"
+#include "dynmesh/errors.hpp"
+#include "dynmesh/io.hpp"
+#include "dynmesh/mesh.hpp"
+#include "dynmesh/mesh_check.hpp"
+#include "dynmesh/mesh_io.hpp"
+#include "dynmesh/quadtree_mesh.hpp"
+#include "progress.hpp"
+
+namespace dynmesh::tool {
+namespace {
+
+using Kind = InputError::Kind;
+
+// An error raised without a file name gets `file` (and `line` when it has none).
+[[noreturn]] void rethrow_in(const InputError& e, const std::string& file, std::size_t line = 0) {
+  if (!e.file().empty()) throw e;
+  throw InputError(e.kind(), e.text(), file, e.line() != 0 ? e.line() : line);
+}
+
+Box<2> box_from_option(const std::vector<double>& values) {
+  if (values.size() != 3)
+    throw InputError(Kind::Malformed, "--box needs 3 numbers (o1 o2 L) for 2D points, got " +
+                                          std::to_string(values.size()));
+  Box<2> box;
+  box.origin[0] = values[0];
+  box.origin[1] = values[1];
+  box.side = values[2];
+  validate_box(box);
+  return box;
+}
+
+// The error of edit i of the script as "FILE:LINE: insert (x, y): why" (the point only
+// once; an "edit K: " prefix from a batch dropped, the line names the edit).
+InputError edit_error(const EditScript<2>& script, std::size_t i, const InputError& err) {
+  const Edit<2>& e = script.edits[i];
+  std::string why = err.text();
+  if (why.rfind("edit ", 0) == 0)
+    if (const auto colon = why.find(": "); colon != std::string::npos) why.erase(0, colon + 2);
+  const std::string point = to_string<2>(e.point);
+  std::string text = e.op == EditOp::Insert ? "insert" : "delete";
+  if (why.find(point) == std::string::npos) text += " " + point;
+  return InputError(err.kind(), text + ": " + why, script.name, script.lines[i]);
+}
+
+// The mesh's constructor names point indices (e.g. a pair closer than the resolution);
+// re-label them with the lines of the point file.
+[[noreturn]] void rethrow_construction_error(const InputError& e, const PointFile<2>& file,
+                                             const std::vector<Position<2>>& located) {
+  auto line_of = [&](std::size_t i) { return i < file.lines.size() ? file.lines[i] : std::size_t{0}; };
+  std::vector<std::size_t> idx = e.point_indices();
+  if (idx.empty()) rethrow_in(e, file.name);
+  if (e.kind() == Kind::Resolution && idx.size() == 1 && idx[0] < located.size()) {
+    // Name the partner too: a point within one grid unit per axis.
+    for (std::size_t j = 0; j < located.size(); ++j) {
+      bool near = j != idx[0];
+      for (std::size_t a = 0; a < 2 && near; ++a) {
+        const std::uint64_t x = located[j][a], y = located[idx[0]][a];
+        near = (x > y ? x - y : y - x) <= 1;
+      }
+      if (near) {
+        idx.push_back(j);
+        break;
+      }
+    }
+  }
+  std::sort(idx.begin(), idx.end());
+  std::string text = e.text();
+  for (const std::size_t i : idx) {
+    const std::string prefix = "point " + std::to_string(i) + ": ";
+    if (text.compare(0, prefix.size(), prefix) == 0) text.erase(0, prefix.size());
+  }
+  if (idx.size() > 1) {
+    text += " (lines";
+    for (std::size_t k = 0; k < idx.size(); ++k) text += (k ? ", " : " ") + std::to_string(line_of(idx[k]));
+    text += ")";
+  }
+  throw InputError(e.kind(), text, file.name, line_of(idx.back()));
+}
+
+std::string angle_text(double deg) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", deg);
+  return buf;
+}
+
+// The postprocess and angle options, checked before any file is read.
+void check_mesh_options(const MeshCommandOptions& o) {
+  if (o.postprocess.empty() || o.postprocess == "hpu")
+    throw InputError(Kind::Malformed,
+                     "the hpu postprocess is not available yet (it is the default; pass --postprocess quadtree)");
+  if (o.postprocess != "quadtree")
+    throw InputError(Kind::Malformed, "unknown --postprocess '" + o.postprocess + "' (hpu or quadtree)");
+  if (o.min_angle_given) {
+    if (!std::isfinite(o.min_angle) || o.min_angle < 0)
+      throw InputError(Kind::Malformed, "--min-angle must be a finite angle of at least 0 degrees");
+    if (o.min_angle > kQuadtreeMinAngle)
+      throw InputError(Kind::Malformed, "--min-angle " + angle_text(o.min_angle) +
+                                            " is above the quadtree mesh's bound of " +
+                                            angle_text(kQuadtreeMinAngle) + " degrees");
+  }
+  if (o.outbase.empty()) throw InputError(Kind::Malformed, "-o needs a non-empty OUTBASE");
+}
+
+std::vector<Point<2>> current_points(const DynamicMesh& mesh) {
+  std::vector<Point<2>> pts;
+  for (const auto& entry : mesh.points()) pts.push_back(entry.second);
+  return pts;
+}
+
+}  // namespace
+
+int run_mesh(const MeshCommandOptions& o) {
+  check_mesh_options(o);
+  const double bound = o.min_angle_given ? o.min_angle : kQuadtreeMinAngle;
+
+  const PointFile<2> file = read_points_file<2>(o.points);
+  Box<2> box;
+  if (o.box.empty()) {
+    try {
+      box = derive_box<2>(file.points);
+    } catch (const InputError& e) {
+      rethrow_in(e, file.name);
+    }
+  } else {
+    box = box_from_option(o.box);
+  }
+  // Outside the box, NaN, duplicates: named by line here, before the mesh sees the points.
+  const std::vector<Position<2>> located = locate_points<2>(file, box);
+  // Read the whole script before meshing, so a malformed script fails fast.
+  const EditScript<2> script = o.edits.empty() ? EditScript<2>{} : read_edits_file<2>(o.edits);
+  const std::vector<Edit<2>>& edits = script.edits;
+
+  MeshOptions mesh_options;
+  mesh_options.postprocess = Postprocess::Quadtree;
+  std::optional<DynamicMesh> built;
+  try {
+    built.emplace(box, std::span<const Point<2>>(file.points), mesh_options);
+  } catch (const InputError& e) {
+    rethrow_construction_error(e, file, located);
+  }
+  DynamicMesh& dm = *built;
+
+  const bool want_feed = !o.feed.empty();
+  std::string feed;
+  if (want_feed) feed = feed_header();
+  std::size_t propagations = 0;
+  auto record = [&] {
+    ++propagations;
+    if (want_feed) feed += format_feed_update(propagations, dm.last_change());
+  };
+
+  if (!edits.empty()) {
+    const std::span<const Edit<2>> all(edits);
+    Progress progress("edits", edits.size());
+    if (o.batch == 0) {
+      for (std::size_t i = 0; i < edits.size(); ++i) {
+        const Edit<2>& e = edits[i];
+        try {
+          if (e.op == EditOp::Insert)
+            dm.insert(e.point);
+          else
+            dm.erase(e.point);
+        } catch (const InputError& err) {
+          throw edit_error(script, i, err);
+        }
+        record();
+        progress.tick(i + 1);
+      }
+    } else {
+      for (std::size_t i = 0; i < edits.size(); i += o.batch) {
+        const std::size_t k = std::min(o.batch, edits.size() - i);
+        try {
+          dm.apply(all.subspan(i, k));
+        } catch (const InputError& err) {
+          // apply() names the failing edit by its index in the batch.
+          if (err.point_indices().empty()) rethrow_in(err, o.edits);
+          throw edit_error(script, i + err.point_indices().back(), err);
+        }
+        record();
+        progress.tick(i + k);
+      }
+    }
+  }
+
+  const Mesh mesh = dm.mesh();
+  const std::string node_text = format_node(mesh, box);
+  const std::string ele_text = format_ele(mesh);
+  const std::vector<Point<2>> inputs = current_points(dm);
+
+  if (o.check) {
+    // Everything is checked before any output is written: a failed check leaves old files.
+    dm.check_invariants();
+    MeshCheckOptions check_options;
+    check_options.min_angle_deg = bound;
+    const MeshReport report = check_mesh(mesh, box, inputs, check_options);
+    if (!report.ok()) throw InvariantError("--check failed: " + report.summary());
+    const QuadtreeMesh scratch(box, inputs);
+    const Mesh fresh = scratch.mesh();
+    if (format_node(fresh, box) != node_text || format_ele(fresh) != ele_text)
+      throw InvariantError("--check failed: the dynamic mesh differs from a from-scratch mesh of the final " +
+                           std::to_string(inputs.size()) + " points (" + std::to_string(mesh.num_triangles()) +
+                           " vs " + std::to_string(fresh.num_triangles()) + " triangles)");
+  }
+
+  AtomicOutputs out;
+  out.add(o.outbase + ".node", node_text);
+  out.add(o.outbase + ".ele", ele_text);
+  if (want_feed) out.add(o.feed, feed);
+  if (!o.vtk.empty()) out.add(o.vtk, format_vtk(mesh));
+  if (!o.msh.empty()) out.add(o.msh, format_msh(mesh));
+  if (!o.svg.empty()) out.add(o.svg, format_svg(mesh, box, inputs));
+  out.commit();
+
+  // After the outputs are in place, so that a failed run prints only its error line.
+  if (o.stats) {
+    const std::string report = format_stats(mesh_stats(mesh));
+    std::fflush(stdout);
+    std::fputs(report.c_str(), stderr);
+    std::fflush(stderr);
+  }
+  return 0;
+}
+
+}  // namespace dynmesh::tool

@@ -1,0 +1,181 @@
+// Tests of dynmesh/dynamic_mesh.hpp: differential against the static twin (QuadtreeMesh)
+// after every update, on random sequences with fixed, printed seeds; the checkers run on
+// every mesh; the change feed replays exactly; bad input leaves everything as it was.
+#include "dynamic_test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/dynamic_mesh.hpp"
+#include "dynmesh/mesh_check.hpp"
+#include "dynmesh/quadtree_mesh.hpp"
+
+namespace {
+
+using namespace dynmesh;
+using dynmesh_test::kSlowBuild;
+using Kind = InputError::Kind;
+
+/// The mesh passes the checker with the quadtree bound and every point is a vertex.
+testing::AssertionResult good_mesh(const Mesh& mesh, const Box<2>& box, const std::vector<Point<2>>& points) {
+  MeshCheckOptions opts;
+  opts.min_angle_deg = kQuadtreeMinAngle;
+  const MeshReport r = check_mesh(mesh, box, points, opts);
+  if (!r.ok()) return testing::AssertionFailure() << r.summary();
+  return testing::AssertionSuccess();
+}
+
+testing::AssertionResult agrees(const DynamicMesh& dyn, const std::vector<Point<2>>& points) {
+  try {
+    dyn.check_invariants();
+  } catch (const std::exception& e) {
+    return testing::AssertionFailure() << "check_invariants: " << e.what();
+  }
+  const QuadtreeMesh twin(dyn.box(), points);
+  twin.check_invariants();
+  const auto got = dyn.triangles();
+  if (got != twin.triangles())
+    return testing::AssertionFailure() << "triangles differ from the static twin: " << got.size() << " vs "
+                                       << twin.triangles().size();
+  if (dyn.refined_leaves() != twin.refined_leaves()) return testing::AssertionFailure() << "T' differs";
+  return good_mesh(twin.mesh(), dyn.box(), points);
+}
+
+/// Runs `updates` random single and batched updates from a start set, comparing after each.
+void run_differential(Distribution dist, std::size_t n, std::size_t updates, std::uint64_t seed,
+                      double spread = 0x1p20, bool dyadic_box = false) {
+  SCOPED_TRACE("distribution " + std::string(distribution_name(dist)) + ", n " + std::to_string(n) + ", seed " +
+               std::to_string(seed));
+  auto pool = generate<2>(dist, 2 * n, seed, spread);
+  Box<2> box = derive_box<2>(pool);
+  if (dyadic_box) box = Box<2>{{-1.0, -1.0}, 4.0};
+  Rng rng(seed * 7 + 1);
+  std::map<PointId, Point<2>> present;
+  std::vector<Point<2>> absent(pool.begin() + static_cast<std::ptrdiff_t>(n), pool.end());
+  std::vector<Point<2>> start(pool.begin(), pool.begin() + static_cast<std::ptrdiff_t>(n));
+  DynamicMesh dyn(box, start);
+  for (std::size_t i = 0; i < start.size(); ++i) present[i] = start[i];
+  auto current = [&] {
+    std::vector<Point<2>> v;
+    for (const auto& [id, p] : present) v.push_back(p);
+    return v;
+  };
+  ASSERT_TRUE(agrees(dyn, current()));
+  std::vector<Triangle> mesh = dyn.triangles();
+  for (std::size_t u = 0; u < updates; ++u) {
+    SCOPED_TRACE("update " + std::to_string(u));
+    const std::uint64_t what = rng.below(8);
+    if (what == 0) {  // a batch of up to 4 edits
+      std::vector<Edit<2>> edits;
+      std::vector<PointId> gone;
+      std::vector<Point<2>> coming;
+      for (std::uint64_t k = 1 + rng.below(4); k-- > 0;) {
+        if (!absent.empty() && (rng.below(2) == 0 || present.size() <= gone.size())) {
+          const std::size_t i = rng.below(absent.size());
+          edits.push_back({EditOp::Insert, absent[i]});
+          coming.push_back(absent[i]);
+          absent.erase(absent.begin() + static_cast<std::ptrdiff_t>(i));
+        } else if (present.size() > gone.size()) {
+          auto it = present.begin();
+          std::advance(it, static_cast<std::ptrdiff_t>(rng.below(present.size())));
+          if (std::find(gone.begin(), gone.end(), it->first) != gone.end()) continue;
+          edits.push_back({EditOp::Delete, it->second});
+          gone.push_back(it->first);
+        }
+      }
+      std::vector<PointId> ids;
+      try {
+        ids = dyn.apply(edits);
+      } catch (const InputError& e) {
+        ASSERT_EQ(e.kind(), Kind::Resolution) << e.what();
+        continue;
+      }
+      for (PointId id : gone) {
+        absent.push_back(present.at(id));
+        present.erase(id);
+      }
+      for (std::size_t k = 0; k < ids.size(); ++k) present[ids[k]] = coming[k];
+    } else if (what < 5 && !absent.empty()) {
+      const std::size_t i = rng.below(absent.size());
+      try {
+        present[dyn.insert(absent[i])] = absent[i];
+      } catch (const InputError& e) {
+        ASSERT_EQ(e.kind(), Kind::Resolution) << e.what();
+        continue;
+      }
+      absent.erase(absent.begin() + static_cast<std::ptrdiff_t>(i));
+    } else if (!present.empty()) {
+      auto it = present.begin();
+      std::advance(it, static_cast<std::ptrdiff_t>(rng.below(present.size())));
+      dyn.erase(it->first);
+      absent.push_back(it->second);
+      present.erase(it);
+    }
+    ASSERT_TRUE(apply_change(mesh, dyn.last_change())) << "the feed does not apply to the previous mesh";
+    ASSERT_EQ(mesh, dyn.triangles()) << "the feed does not replay to the new mesh";
+    ASSERT_TRUE(agrees(dyn, current()));
+  }
+}
+
+std::size_t scaled(std::size_t n) { return kSlowBuild ? std::max<std::size_t>(n / 4, 8) : n; }
+
+TEST(DynamicMeshDifferential, Uniform) { run_differential(Distribution::Uniform, 200, scaled(120), 11); }
+TEST(DynamicMeshDifferential, Clusters) { run_differential(Distribution::Clusters, 200, scaled(120), 12); }
+TEST(DynamicMeshDifferential, Spiral) { run_differential(Distribution::Spiral, 150, scaled(80), 13); }
+TEST(DynamicMeshDifferential, Grid) { run_differential(Distribution::Grid, 150, scaled(80), 14); }
+TEST(DynamicMeshDifferential, Collinear) { run_differential(Distribution::Collinear, 120, scaled(80), 15); }
+TEST(DynamicMeshDifferential, CellBoundaries) { run_differential(Distribution::Boundary, 150, scaled(80), 16); }
+TEST(DynamicMeshDifferential, ShrinkingDerivedBox) {
+  for (const double spread : {0x1p10, 0x1p20, 0x1p30})
+    run_differential(Distribution::Shrinking, 100, scaled(60), 17, spread);
+}
+TEST(DynamicMeshDifferential, ShrinkingDyadicBoxTo2e40) {
+  for (const double spread : {0x1p30, 0x1p40}) run_differential(Distribution::Shrinking, 100, scaled(60), 18, spread, true);
+}
+
+TEST(DynamicMesh, TinySets) {
+  const Box<2> box{{0.0, 0.0}, 1.0};
+  for (const std::vector<Point<2>>& pts : std::vector<std::vector<Point<2>>>{
+           {}, {{0.5, 0.5}}, {{0.3, 0.3}}, {{0.1, 0.7}}, {{0.25, 0.25}, {0.75, 0.75}}, {{0.0, 0.5}}, {{0.0, 0.0}}}) {
+    SCOPED_TRACE(std::to_string(pts.size()) + " points");
+    DynamicMesh dyn(box, pts);
+    EXPECT_TRUE(agrees(dyn, pts));
+  }
+}
+
+TEST(DynamicMesh, BadInputChangesNothing) {
+  const auto pts = generate<2>(Distribution::Uniform, 50, 21);
+  DynamicMesh dyn(derive_box<2>(pts), pts);
+  const auto before = dyn.triangles();
+  const auto events = dyn.live_events();
+  auto rejected = [&](Kind kind, auto&& f) {
+    try {
+      f();
+      ADD_FAILURE() << "no InputError";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.kind(), kind) << e.what();
+    }
+    EXPECT_EQ(dyn.triangles(), before);
+    EXPECT_EQ(dyn.live_events(), events);
+    EXPECT_NO_THROW(dyn.check_invariants());
+  };
+  rejected(Kind::NotFinite, [&] { dyn.insert({std::nan(""), 0.5}); });
+  rejected(Kind::OutsideBox, [&] { dyn.insert({1e9, 0.5}); });
+  rejected(Kind::Duplicate, [&] { dyn.insert(pts[3]); });
+  rejected(Kind::Absent, [&] { dyn.erase(Point<2>{0.123456, 0.5}); });
+  rejected(Kind::OutsideBox, [&] { dyn.erase(Point<2>{1e9, 0.5}); });
+  rejected(Kind::Absent, [&] { dyn.erase(PointId{999}); });
+  // A few grid units away: not a duplicate, but far below what the mesh can resolve.
+  const Box<2> box = dyn.box();
+  rejected(Kind::Resolution, [&] { dyn.insert({pts[4][0] + 3 * box.side * 0x1p-52, pts[4][1]}); });
+  const std::vector<Edit<2>> batch = {{EditOp::Insert, {0.5, 0.5}}, {EditOp::Delete, pts[0]}, {EditOp::Delete, pts[0]}};
+  rejected(Kind::Absent, [&] { dyn.apply(batch); });
+}
+
+}  // namespace

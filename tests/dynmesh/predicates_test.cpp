@@ -1,0 +1,565 @@
+// predicates_test.cpp — orient2d and incircle (predicates.hpp) against exact GMP arithmetic.
+//
+// Purpose: every case is decided twice, by dynmesh's predicates and by an exact evaluation of
+// the same determinant in GMP integers, and the two signs must agree on every case. Three
+// families of input, each from fixed seeds (printed through SCOPED_TRACE):
+//   random            – 10^6 cases per predicate (fewer in slow builds), from four mixes:
+//                       uniform, a small integer grid, wide exponents, tight clusters;
+//   nearly degenerate – a few ulps (std::nextafter) off collinear and cocircular inputs,
+//                       including the 256×256 orient2d grid of Kettner et al.;
+//   exactly degenerate – lattice points on x²+y²=r², collinear lattices, both scaled by
+//                       powers of two up to 2^±1000, the same rounded by decimal scales
+//                       (1e15 … 1e300, 1e-300, subnormal), and mixed magnitudes up to
+//                       DBL_MAX.
+// Invariants checked: each predicate returns exactly the exact sign (−1, 0, +1) on every case;
+// the GMP reference returns the hand-computed signs and 0 on constructed degeneracies; a naive
+// double evaluation is caught disagreeing on the nearly degenerate sets, so the harness can
+// fail.
+// Complexity: O(cases); the GMP reference dominates (well under a microsecond per case).
+// Paper: Shewchuk, "Adaptive precision floating-point arithmetic and fast robust geometric
+// predicates" (1997) for the determinants; Kettner, Mehlhorn, Pion, Schirra, Yap, "Classroom
+// examples of robustness problems in geometric computations" (2008) for the orient2d grid.
+// The reference uses that a finite double is m·2^e with an integer m: scaling all inputs of a
+// case by one power of two makes them integers exactly, and both determinants are
+// homogeneous, so the scale leaves their signs unchanged.
+#include <gmpxx.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <climits>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "../sanitized.hpp"
+#include "dynmesh/point.hpp"
+#include "dynmesh/predicates.hpp"
+
+namespace {
+
+using dynmesh::Point;
+
+/// Sanitizers (CI runs them at -O0) or no optimization: the random families shrink.
+#ifdef __OPTIMIZE__
+constexpr bool kSlowBuild = test_support::kSanitized;
+#else
+constexpr bool kSlowBuild = true;
+#endif
+constexpr std::size_t kRandomCases = kSlowBuild ? 50'000 : 1'000'000;
+
+struct OrientCase {
+  Point<2> a, b, c;
+};
+struct IncircleCase {
+  Point<2> a, b, c, d;
+};
+
+std::string describe(const OrientCase& k) {
+  return "orient2d" + dynmesh::to_string<2>(k.a) + dynmesh::to_string<2>(k.b) +
+         dynmesh::to_string<2>(k.c);
+}
+std::string describe(const IncircleCase& k) {
+  return "incircle" + dynmesh::to_string<2>(k.a) + dynmesh::to_string<2>(k.b) +
+         dynmesh::to_string<2>(k.c) + dynmesh::to_string<2>(k.d);
+}
+
+// --- the exact reference ------------------------------------------------------------------
+
+/// Exact signs of the two determinants in GMP integers. Members are reused scratch space, so
+/// evaluation allocates only when a case needs more limbs than the previous ones.
+class ExactSign {
+ public:
+  int orient2d(const OrientCase& k) {
+    load(std::array{k.a[0], k.a[1], k.b[0], k.b[1], k.c[0], k.c[1]});
+    // det [[bx − ax, by − ay], [cx − ax, cy − ay]]
+    bx_ = v_[2] - v_[0];
+    by_ = v_[3] - v_[1];
+    cx_ = v_[4] - v_[0];
+    cy_ = v_[5] - v_[1];
+    t1_ = bx_ * cy_;
+    t2_ = by_ * cx_;
+    det_ = t1_ - t2_;
+    return sgn(det_);
+  }
+
+  int incircle(const IncircleCase& k) {
+    load(std::array{k.a[0], k.a[1], k.b[0], k.b[1], k.c[0], k.c[1], k.d[0], k.d[1]});
+    // Translated so that d is the origin: det [[ax, ay, ax²+ay²], [bx, …], [cx, …]], expanded
+    // along the lift column. Positive when d is inside the circle of ccw a, b, c.
+    ax_ = v_[0] - v_[6];
+    ay_ = v_[1] - v_[7];
+    bx_ = v_[2] - v_[6];
+    by_ = v_[3] - v_[7];
+    cx_ = v_[4] - v_[6];
+    cy_ = v_[5] - v_[7];
+    det_ = 0;
+    add_lift_times_minor(ax_, ay_, bx_, by_, cx_, cy_);  // alift · (bx·cy − cx·by)
+    add_lift_times_minor(bx_, by_, cx_, cy_, ax_, ay_);  // blift · (cx·ay − ax·cy)
+    add_lift_times_minor(cx_, cy_, ax_, ay_, bx_, by_);  // clift · (ax·by − bx·ay)
+    return sgn(det_);
+  }
+
+ private:
+  static int sgn(const mpz_class& z) { return (z > 0) - (z < 0); }
+
+  /// v_[i] = xs[i] · 2^−low for the smallest exponent `low` of the case's nonzero inputs.
+  template <std::size_t n>
+  void load(const std::array<double, n>& xs) {
+    int low = INT_MAX;
+    for (double x : xs) {
+      if (x == 0) continue;
+      int e = 0;
+      std::frexp(x, &e);
+      low = std::min(low, e - 53);
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (xs[i] == 0) {
+        v_[i] = 0;
+        continue;
+      }
+      int e = 0;
+      const double mantissa = std::ldexp(std::frexp(xs[i], &e), 53);  // an integer, |m| < 2^53
+      v_[i] = mantissa;                                                // exact: mpz_set_d
+      mpz_mul_2exp(v_[i].get_mpz_t(), v_[i].get_mpz_t(), static_cast<mp_bitcnt_t>(e - 53 - low));
+    }
+  }
+
+  /// det_ += (px² + py²) · (qx·ry − rx·qy)
+  void add_lift_times_minor(const mpz_class& px, const mpz_class& py, const mpz_class& qx,
+                            const mpz_class& qy, const mpz_class& rx, const mpz_class& ry) {
+    t1_ = px * px;
+    t2_ = py * py;
+    lift_ = t1_ + t2_;
+    t1_ = qx * ry;
+    t2_ = rx * qy;
+    minor_ = t1_ - t2_;
+    t1_ = lift_ * minor_;
+    det_ += t1_;
+  }
+
+  std::array<mpz_class, 8> v_;
+  mpz_class ax_, ay_, bx_, by_, cx_, cy_, t1_, t2_, lift_, minor_, det_;
+};
+
+// --- tallies ------------------------------------------------------------------------------
+
+/// Agreement of a predicate with the reference over a family of cases.
+struct Tally {
+  std::size_t cases = 0;
+  std::size_t mismatches = 0;
+  std::size_t exact_zeros = 0;  // cases whose exact sign is 0: how degenerate the family is
+  std::string first_mismatch;
+
+  template <class Case>
+  void record(const Case& k, int got, int want) {
+    ++cases;
+    if (want == 0) ++exact_zeros;
+    if (got == want) return;
+    if (mismatches++ == 0)
+      first_mismatch = describe(k) + ": got " + std::to_string(got) + ", exact " + std::to_string(want);
+  }
+};
+
+using OrientFn = int (*)(const Point<2>&, const Point<2>&, const Point<2>&);
+using IncircleFn = int (*)(const Point<2>&, const Point<2>&, const Point<2>&, const Point<2>&);
+
+Tally check(std::span<const OrientCase> cases, OrientFn fn = dynmesh::orient2d) {
+  ExactSign exact;
+  Tally t;
+  for (const auto& k : cases) t.record(k, fn(k.a, k.b, k.c), exact.orient2d(k));
+  return t;
+}
+
+Tally check(std::span<const IncircleCase> cases, IncircleFn fn = dynmesh::incircle) {
+  ExactSign exact;
+  Tally t;
+  for (const auto& k : cases) t.record(k, fn(k.a, k.b, k.c, k.d), exact.incircle(k));
+  return t;
+}
+
+#define EXPECT_AGREES(tally) \
+  EXPECT_EQ((tally).mismatches, 0u) << "of " << (tally).cases << "; first: " << (tally).first_mismatch
+
+// The textbook double-precision determinants, to show the harness catches a non-robust one.
+int naive_orient2d(const Point<2>& a, const Point<2>& b, const Point<2>& c) {
+  const double det = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+  return (det > 0) - (det < 0);
+}
+int naive_incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) {
+  const double adx = a[0] - d[0], ady = a[1] - d[1], bdx = b[0] - d[0], bdy = b[1] - d[1];
+  const double cdx = c[0] - d[0], cdy = c[1] - d[1];
+  const double det = (adx * adx + ady * ady) * (bdx * cdy - cdx * bdy) +
+                     (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy) +
+                     (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady);
+  return (det > 0) - (det < 0);
+}
+
+// --- generators ---------------------------------------------------------------------------
+
+/// x moved by k representable doubles (k < 0: downwards).
+double ulps(double x, int k) {
+  for (; k > 0; --k) x = std::nextafter(x, std::numeric_limits<double>::infinity());
+  for (; k < 0; ++k) x = std::nextafter(x, -std::numeric_limits<double>::infinity());
+  return x;
+}
+Point<2> ulps(const Point<2>& p, int kx, int ky) { return {ulps(p[0], kx), ulps(p[1], ky)}; }
+
+Point<2> scaled(const Point<2>& p, double s) { return {p[0] * s, p[1] * s}; }
+
+/// Random points from one of four mixes, picked per case: uniform in [−1, 1]²; integers in
+/// [−4, 4] (many exact zeros); sign·[1, 2)·2^[−30, 30] per coordinate; a cluster of width
+/// 1e-9 around a center in [−1e6, 1e6]² (coordinates a few ulps apart).
+class RandomPoints {
+ public:
+  explicit RandomPoints(std::uint64_t seed) : rng_(seed) {}
+
+  int next_mix() { return static_cast<int>(rng_() % 4); }
+
+  Point<2> point(int mix) {
+    switch (mix) {
+      case 0: return {unit_(rng_), unit_(rng_)};
+      case 1: return {static_cast<double>(small_(rng_)), static_cast<double>(small_(rng_))};
+      case 2: return {wide(), wide()};
+      default: return {center_[0] + 1e-9 * unit_(rng_), center_[1] + 1e-9 * unit_(rng_)};
+    }
+  }
+
+  /// A fresh cluster center (mix 3) for the next case.
+  void recenter() { center_ = {1e6 * unit_(rng_), 1e6 * unit_(rng_)}; }
+
+ private:
+  double wide() {
+    const double m = 1.0 + 0.5 * (unit_(rng_) + 1.0);
+    const double s = (rng_() & 1) ? -1.0 : 1.0;
+    return s * std::ldexp(m, exponent_(rng_));
+  }
+
+  std::mt19937_64 rng_;
+  std::uniform_real_distribution<double> unit_{-1.0, 1.0};
+  std::uniform_int_distribution<int> small_{-4, 4};
+  std::uniform_int_distribution<int> exponent_{-30, 30};
+  Point<2> center_{0.0, 0.0};
+};
+
+/// The integer points of the circle x² + y² = r², sorted by angle (counter-clockwise).
+std::vector<Point<2>> lattice_circle(std::int64_t r) {
+  std::vector<std::array<std::int64_t, 2>> pts;
+  for (std::int64_t x = -r; x <= r; ++x) {
+    const auto y = static_cast<std::int64_t>(std::llround(std::sqrt(static_cast<double>(r * r - x * x))));
+    if (x * x + y * y != r * r) continue;
+    pts.push_back({x, y});
+    if (y != 0) pts.push_back({x, -y});
+  }
+  std::sort(pts.begin(), pts.end(), [](const auto& p, const auto& q) {
+    return std::atan2(static_cast<double>(p[1]), static_cast<double>(p[0])) <
+           std::atan2(static_cast<double>(q[1]), static_cast<double>(q[0]));
+  });
+  std::vector<Point<2>> out;
+  for (const auto& p : pts) out.push_back({static_cast<double>(p[0]), static_cast<double>(p[1])});
+  return out;
+}
+
+std::string seed_trace(std::uint64_t seed) { return "seed " + std::to_string(seed); }
+
+// --- conventions: hand-computed signs -----------------------------------------------------
+
+TEST(Predicates, OrientationConvention) {
+  const Point<2> o{0, 0}, x{1, 0}, y{0, 1};
+  EXPECT_EQ(dynmesh::orient2d(o, x, y), 1);
+  EXPECT_EQ(dynmesh::orient2d(o, y, x), -1);
+  EXPECT_EQ(dynmesh::orient2d(o, x, Point<2>{2, 0}), 0);
+  EXPECT_EQ(dynmesh::orient2d(o, o, y), 0);
+}
+
+TEST(Predicates, IncircleConvention) {
+  const Point<2> a{1, 0}, b{0, 1}, c{-1, 0};  // ccw on the unit circle
+  EXPECT_EQ(dynmesh::incircle(a, b, c, Point<2>{0, 0}), 1);
+  EXPECT_EQ(dynmesh::incircle(a, b, c, Point<2>{2, 0}), -1);
+  EXPECT_EQ(dynmesh::incircle(a, b, c, Point<2>{0, -1}), 0);
+  EXPECT_EQ(dynmesh::incircle(b, a, c, Point<2>{0, 0}), -1);  // clockwise flips the sign
+  EXPECT_EQ(dynmesh::incircle(a, a, c, Point<2>{0, 0}), 0);   // repeated point
+  // Collinear a, b, c: left of a→c counts as inside (the limit of ccw circles).
+  EXPECT_EQ(dynmesh::incircle(Point<2>{0, 0}, Point<2>{1, 0}, Point<2>{2, 0}, Point<2>{0, 1}), 1);
+}
+
+TEST(Predicates, ReferenceMatchesHandComputedSigns) {
+  ExactSign exact;
+  EXPECT_EQ(exact.orient2d({{0, 0}, {1, 0}, {0, 1}}), 1);
+  EXPECT_EQ(exact.orient2d({{0, 0}, {0, 1}, {1, 0}}), -1);
+  EXPECT_EQ(exact.orient2d({{0.5, 0.5}, {12, 12}, {24, 24}}), 0);
+  // b − a points up; c lies left of that line by about 1e-300.
+  EXPECT_EQ(exact.orient2d({{1e-300, 0}, {0, 1e300}, {5e-324, 5e-324}}), 1);
+  EXPECT_EQ(exact.incircle({{1, 0}, {0, 1}, {-1, 0}, {0, 0}}), 1);
+  EXPECT_EQ(exact.incircle({{1, 0}, {0, 1}, {-1, 0}, {2, 0}}), -1);
+  EXPECT_EQ(exact.incircle({{1, 0}, {0, 1}, {-1, 0}, {0, -1}}), 0);
+  EXPECT_EQ(exact.incircle({{0, 1}, {1, 0}, {-1, 0}, {0, 0}}), -1);
+  // Collinear a, b, c: the limit of a ccw circle, the half-plane left of a→c, is "inside".
+  EXPECT_EQ(exact.incircle({{0, 0}, {1, 0}, {2, 0}, {0, 1}}), 1);
+  EXPECT_EQ(exact.incircle({{0, 0}, {1, 0}, {2, 0}, {0, -1}}), -1);
+  EXPECT_EQ(exact.incircle({{0, 0}, {1, 0}, {2, 0}, {5, 0}}), 0);
+}
+
+// --- random -------------------------------------------------------------------------------
+
+TEST(Predicates, Orient2dRandomAgreesWithGmp) {
+  constexpr std::uint64_t kSeed = 20240611;
+  SCOPED_TRACE(seed_trace(kSeed) + ", cases " + std::to_string(kRandomCases));
+  RandomPoints gen(kSeed);
+  ExactSign exact;
+  Tally t;
+  for (std::size_t i = 0; i < kRandomCases; ++i) {
+    const int mix = gen.next_mix();
+    gen.recenter();
+    const OrientCase k{gen.point(mix), gen.point(mix), gen.point(mix)};
+    t.record(k, dynmesh::orient2d(k.a, k.b, k.c), exact.orient2d(k));
+  }
+  EXPECT_AGREES(t);
+  EXPECT_GT(t.exact_zeros, 0u);  // the integer mix does reach the exact path
+}
+
+TEST(Predicates, IncircleRandomAgreesWithGmp) {
+  constexpr std::uint64_t kSeed = 20240612;
+  SCOPED_TRACE(seed_trace(kSeed) + ", cases " + std::to_string(kRandomCases));
+  RandomPoints gen(kSeed);
+  ExactSign exact;
+  Tally t;
+  for (std::size_t i = 0; i < kRandomCases; ++i) {
+    const int mix = gen.next_mix();
+    gen.recenter();
+    const IncircleCase k{gen.point(mix), gen.point(mix), gen.point(mix), gen.point(mix)};
+    t.record(k, dynmesh::incircle(k.a, k.b, k.c, k.d), exact.incircle(k));
+  }
+  EXPECT_AGREES(t);
+  EXPECT_GT(t.exact_zeros, 0u);
+}
+
+// --- nearly degenerate --------------------------------------------------------------------
+
+/// Kettner et al.'s grid: p = (0.5 + i·2^-53, 0.5 + j·2^-53), i, j < 256, against q = (12, 12),
+/// r = (24, 24), all three cyclic rotations. Naive evaluation gets large parts of it wrong.
+std::vector<OrientCase> kettner_grid() {
+  std::vector<OrientCase> cases;
+  const double u = std::ldexp(1.0, -53);
+  const Point<2> q{12, 12}, r{24, 24};
+  for (int i = 0; i < 256; ++i)
+    for (int j = 0; j < 256; ++j) {
+      const Point<2> p{0.5 + i * u, 0.5 + j * u};
+      cases.push_back({p, q, r});
+      cases.push_back({q, r, p});
+      cases.push_back({r, p, q});
+    }
+  return cases;
+}
+
+/// c on the segment line through random a, b (rounded), then moved by up to 2 ulps per axis,
+/// at scales from 1e-200 to 1e300.
+std::vector<OrientCase> near_collinear(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), along(-1.0, 2.0);
+  std::uniform_int_distribution<int> nudge(-2, 2);
+  std::vector<OrientCase> cases;
+  for (double s : {1.0, 0x1p40, 0x1p-40, 1e200, 1e-200, 1e300}) {
+    for (int i = 0; i < 5000; ++i) {
+      const Point<2> a{s * unit(rng), s * unit(rng)}, b{s * unit(rng), s * unit(rng)};
+      const double t = along(rng);
+      const Point<2> c{a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])};
+      cases.push_back({a, b, ulps(c, nudge(rng), nudge(rng))});
+    }
+  }
+  return cases;
+}
+
+/// Exactly cocircular lattice quadruples (r = 5) around several dyadic centers and power-of-
+/// two scales, with d (then a) moved by up to 10 ulps per axis.
+std::vector<IncircleCase> perturbed_lattice_circles() {
+  const auto circle = lattice_circle(5);  // 12 points, ccw
+  std::vector<IncircleCase> cases;
+  for (const Point<2> center : {Point<2>{0, 0}, Point<2>{1000.25, -333.5}, Point<2>{0x1p30 + 0.5, 3}})
+    for (double s : {1.0, 0x1p-520, 0x1p500}) {
+      auto at = [&](std::size_t i) { return scaled(Point<2>{center[0] + circle[i][0], center[1] + circle[i][1]}, s); };
+      const Point<2> a = at(0), b = at(2), c = at(5), d = at(8);
+      for (int i = -10; i <= 10; ++i)
+        for (int j = -10; j <= 10; ++j) {
+          cases.push_back({a, b, c, ulps(d, i, j)});
+          cases.push_back({ulps(a, i, j), b, c, d});
+        }
+    }
+  return cases;
+}
+
+/// Four rounded points of a random circle (ccw by angle), d moved by up to 2 ulps per axis, at
+/// scales from 1e-300 to 1e150.
+std::vector<IncircleCase> near_cocircular(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), radius(0.1, 1.0), angle(0.0, 6.283185307179586);
+  std::uniform_int_distribution<int> nudge(-2, 2);
+  std::vector<IncircleCase> cases;
+  for (double s : {1.0, 0x1p30, 0x1p-30, 1e150, 1e-150, 1e-300}) {
+    for (int i = 0; i < 5000; ++i) {
+      const Point<2> o{s * unit(rng), s * unit(rng)};
+      const double r = s * radius(rng);
+      std::array<double, 4> th{angle(rng), angle(rng), angle(rng), angle(rng)};
+      std::sort(th.begin(), th.end());
+      auto on = [&](double t) { return Point<2>{o[0] + r * std::cos(t), o[1] + r * std::sin(t)}; };
+      cases.push_back({on(th[0]), on(th[1]), on(th[2]), ulps(on(th[3]), nudge(rng), nudge(rng))});
+    }
+  }
+  return cases;
+}
+
+TEST(Predicates, Orient2dNearlyDegenerateAgreesWithGmp) {
+  const Tally grid = check(kettner_grid());
+  EXPECT_AGREES(grid);
+  EXPECT_GT(grid.exact_zeros, 0u);
+  constexpr std::uint64_t kSeed = 7001;
+  SCOPED_TRACE(seed_trace(kSeed));
+  const Tally random = check(near_collinear(kSeed));
+  EXPECT_AGREES(random);
+}
+
+TEST(Predicates, IncircleNearlyDegenerateAgreesWithGmp) {
+  const Tally lattice = check(perturbed_lattice_circles());
+  EXPECT_AGREES(lattice);
+  EXPECT_GT(lattice.exact_zeros, 0u);
+  constexpr std::uint64_t kSeed = 7002;
+  SCOPED_TRACE(seed_trace(kSeed));
+  const Tally random = check(near_cocircular(kSeed));
+  EXPECT_AGREES(random);
+}
+
+/// The harness can fail: the naive double determinants disagree with GMP on these families.
+TEST(Predicates, NaiveDoubleEvaluationIsCaught) {
+  EXPECT_GT(check(kettner_grid(), naive_orient2d).mismatches, 0u);
+  EXPECT_GT(check(near_collinear(7001), naive_orient2d).mismatches, 0u);
+  EXPECT_GT(check(perturbed_lattice_circles(), naive_incircle).mismatches, 0u);
+  EXPECT_GT(check(near_cocircular(7002), naive_incircle).mismatches, 0u);
+}
+
+// --- exactly degenerate -------------------------------------------------------------------
+
+/// Scales that keep lattice coordinates (< 2^21) exact, down to subnormal-free 2^-1000 and up
+/// to 2^1000.
+constexpr std::array<double, 5> kExactScales{1.0, 0x1p-1000, 0x1p-500, 0x1p500, 0x1p1000};
+/// Scales that round the same lattices: the degeneracy is lost, the exact answer still counts.
+constexpr std::array<double, 7> kRoundingScales{1e15, 1e100, 1e300, 1e-300, 1e-310, 0.1, 3e-5};
+
+/// Random quadruples of the 108 lattice points of x² + y² = 1105², translated by an integer
+/// center in [−10^6, 10^6]² and scaled by s. Repeated points are allowed.
+std::vector<IncircleCase> lattice_quadruples(std::uint64_t seed, double s, int n) {
+  static const auto circle = lattice_circle(1105);
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<std::size_t> pick(0, circle.size() - 1);
+  std::uniform_int_distribution<int> shift(-1'000'000, 1'000'000);
+  std::vector<IncircleCase> cases;
+  for (int i = 0; i < n; ++i) {
+    const Point<2> o{static_cast<double>(shift(rng)), static_cast<double>(shift(rng))};
+    auto at = [&] {
+      const Point<2>& p = circle[pick(rng)];
+      return scaled(Point<2>{o[0] + p[0], o[1] + p[1]}, s);
+    };
+    cases.push_back({at(), at(), at(), at()});
+  }
+  return cases;
+}
+
+/// Triples of o + k·v, k ∈ [−100, 100], for a random integer o ∈ [−10^6, 10^6]² and direction
+/// v ∈ [−1000, 1000]², scaled by s.
+std::vector<OrientCase> collinear_triples(std::uint64_t seed, double s, int n) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> shift(-1'000'000, 1'000'000), dir(-1000, 1000), step(-100, 100);
+  std::vector<OrientCase> cases;
+  for (int i = 0; i < n; ++i) {
+    const Point<2> o{static_cast<double>(shift(rng)), static_cast<double>(shift(rng))};
+    const Point<2> v{static_cast<double>(dir(rng)), static_cast<double>(dir(rng))};
+    auto at = [&] {
+      const double k = step(rng);
+      return scaled(Point<2>{o[0] + k * v[0], o[1] + k * v[1]}, s);
+    };
+    cases.push_back({at(), at(), at()});
+  }
+  return cases;
+}
+
+TEST(Predicates, Orient2dExactlyDegenerateAgreesWithGmp) {
+  constexpr std::uint64_t kSeed = 9001;
+  SCOPED_TRACE(seed_trace(kSeed));
+  for (double s : kExactScales) {
+    SCOPED_TRACE("exact scale " + dynmesh::format_exact(s));
+    const Tally t = check(collinear_triples(kSeed, s, 2000));
+    EXPECT_AGREES(t);
+    EXPECT_EQ(t.exact_zeros, t.cases);  // the reference sees the construction
+  }
+  for (double s : kRoundingScales) {
+    SCOPED_TRACE("rounding scale " + dynmesh::format_exact(s));
+    EXPECT_AGREES(check(collinear_triples(kSeed, s, 2000)));
+  }
+  // Decimal steps along a line are not collinear once rounded.
+  std::vector<OrientCase> decimal;
+  for (int i = 1; i < 60; ++i)
+    for (int j = i + 1; j < 60; j += 3)
+      decimal.push_back({{0.1 * i, 0.3 * i}, {0.1 * j, 0.3 * j}, {0.1 * (i + j), 0.3 * (i + j)}});
+  EXPECT_AGREES(check(decimal));
+}
+
+TEST(Predicates, IncircleExactlyDegenerateAgreesWithGmp) {
+  constexpr std::uint64_t kSeed = 9002;
+  SCOPED_TRACE(seed_trace(kSeed));
+  for (double s : kExactScales) {
+    SCOPED_TRACE("exact scale " + dynmesh::format_exact(s));
+    const Tally t = check(lattice_quadruples(kSeed, s, 2000));
+    EXPECT_AGREES(t);
+    EXPECT_EQ(t.exact_zeros, t.cases);
+  }
+  for (double s : kRoundingScales) {
+    SCOPED_TRACE("rounding scale " + dynmesh::format_exact(s));
+    EXPECT_AGREES(check(lattice_quadruples(kSeed, s, 2000)));
+  }
+  // Collinear a, b, c: the degenerate lifted determinant, with d off the line (a point of
+  // another line) or on it (a + 2·(b − a), exact on these integers).
+  const auto lines = collinear_triples(kSeed, 1.0, 2000);
+  const auto others = collinear_triples(kSeed + 1, 1.0, 2000);
+  std::vector<IncircleCase> flat;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    const auto& [a, b, c] = lines[i];
+    flat.push_back({a, b, c, others[i].b});
+    flat.push_back({a, b, c, Point<2>{2 * b[0] - a[0], 2 * b[1] - a[1]}});
+  }
+  const Tally t = check(flat);
+  EXPECT_AGREES(t);
+  EXPECT_GT(t.exact_zeros, 0u);
+}
+
+/// Coordinates drawn per axis from a pool of magnitudes from the smallest subnormal to the
+/// largest double, with random signs: repeated values give exact zeros, the spread defeats
+/// every filter, and differences of ±DBL_MAX overflow to infinity in double arithmetic.
+TEST(Predicates, MixedMagnitudesAgreeWithGmp) {
+  constexpr std::array<double, 15> kPool{0.0, 5e-324, 3e-320, 2.2250738585072014e-308, 1e-300,
+                                         1e-150, 0.1, 1.0, 3.0, 1e15, 1e15 + 1, 1e150, 1e300,
+                                         0x1p-1000, std::numeric_limits<double>::max()};
+  constexpr std::uint64_t kSeed = 9003;
+  SCOPED_TRACE(seed_trace(kSeed));
+  std::mt19937_64 rng(kSeed);
+  std::uniform_int_distribution<std::size_t> pick(0, kPool.size() - 1);
+  auto coord = [&] { return ((rng() & 1) ? -1.0 : 1.0) * kPool[pick(rng)]; };
+  auto point = [&] { return Point<2>{coord(), coord()}; };
+  std::vector<OrientCase> orient;
+  std::vector<IncircleCase> circle;
+  for (int i = 0; i < 20000; ++i) {
+    orient.push_back({point(), point(), point()});
+    circle.push_back({point(), point(), point(), point()});
+  }
+  const Tally o = check(orient);
+  EXPECT_AGREES(o);
+  EXPECT_GT(o.exact_zeros, 0u);
+  const Tally c = check(circle);
+  EXPECT_AGREES(c);
+  EXPECT_GT(c.exact_zeros, 0u);
+}
+
+}  // namespace
