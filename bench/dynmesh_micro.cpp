@@ -112,9 +112,21 @@ void run_incircle(benchmark::State& state, const std::vector<Quadruple>& cases) 
 }
 
 void BM_orient2d_random(benchmark::State& state) { run_orient2d(state, random_triples()); }
-void BM_orient2d_degenerate(benchmark::State& state) { run_orient2d(state, collinear_triples()); }
 void BM_incircle_random(benchmark::State& state) { run_incircle(state, random_quadruples()); }
-void BM_incircle_degenerate(benchmark::State& state) { run_incircle(state, cocircular_quadruples()); }
+
+// The degenerate figures mean something only if every case is exactly degenerate.
+void BM_orient2d_degenerate(benchmark::State& state) {
+  const auto cases = collinear_triples();
+  for (const Triple& k : cases)
+    if (dynmesh::orient2d(k.a, k.b, k.c) != 0) return state.SkipWithError("a case is not collinear");
+  run_orient2d(state, cases);
+}
+void BM_incircle_degenerate(benchmark::State& state) {
+  const auto cases = cocircular_quadruples();
+  for (const Quadruple& k : cases)
+    if (dynmesh::incircle(k.a, k.b, k.c, k.d) != 0) return state.SkipWithError("a case is not cocircular");
+  run_incircle(state, cases);
+}
 
 BENCHMARK(BM_orient2d_random);
 BENCHMARK(BM_orient2d_degenerate);

@@ -7,14 +7,6 @@
 namespace dynmesh {
 namespace {
 
-bool xy_equal(const Point<2>& a, const Point<2>& b) noexcept { return !xy_less(a, b) && !xy_less(b, a); }
-
-// The index of p in the sorted, distinct `vertices` (p is known to be there).
-std::uint32_t index_of(const std::vector<Point<2>>& vertices, const Point<2>& p) noexcept {
-  const auto it = std::lower_bound(vertices.begin(), vertices.end(), p, xy_less);
-  return static_cast<std::uint32_t>(it - vertices.begin());
-}
-
 // Rotates a counter-clockwise index triple to start at its smallest index: a rotation keeps
 // the orientation, a reflection would not.
 std::array<std::uint32_t, 3> rotate_to_smallest(std::uint32_t a, std::uint32_t b, std::uint32_t c) noexcept {
@@ -26,17 +18,29 @@ std::array<std::uint32_t, 3> rotate_to_smallest(std::uint32_t a, std::uint32_t b
 }  // namespace
 
 Mesh make_mesh(std::span<const Triangle> triangles) {
+  // Every corner with its slot (3·triangle + corner), sorted by (x, y): one pass then both
+  // numbers the distinct points and tells each slot its vertex, with no searching.
+  struct Corner {
+    Point<2> p;
+    std::size_t slot;
+  };
+  std::vector<Corner> corners;
+  corners.reserve(3 * triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    for (std::size_t k = 0; k < 3; ++k) corners.push_back({triangles[t].v[k], 3 * t + k});
+  std::sort(corners.begin(), corners.end(), [](const Corner& l, const Corner& r) { return xy_less(l.p, r.p); });
+
   Mesh mesh;
-  mesh.vertices.reserve(triangles.size() * 3);
-  for (const Triangle& t : triangles) mesh.vertices.insert(mesh.vertices.end(), t.v.begin(), t.v.end());
-  std::sort(mesh.vertices.begin(), mesh.vertices.end(), xy_less);
-  mesh.vertices.erase(std::unique(mesh.vertices.begin(), mesh.vertices.end(), xy_equal), mesh.vertices.end());
-  mesh.vertices.shrink_to_fit();
+  std::vector<std::uint32_t> vertex_of(corners.size());
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    if (i == 0 || xy_less(corners[i - 1].p, corners[i].p)) mesh.vertices.push_back(corners[i].p);
+    vertex_of[corners[i].slot] = static_cast<std::uint32_t>(mesh.vertices.size() - 1);
+  }
+  corners = {};
 
   mesh.triangles.reserve(triangles.size());
-  for (const Triangle& t : triangles)
-    mesh.triangles.push_back(rotate_to_smallest(index_of(mesh.vertices, t.v[0]), index_of(mesh.vertices, t.v[1]),
-                                                index_of(mesh.vertices, t.v[2])));
+  for (std::size_t t = 0; t < triangles.size(); ++t)
+    mesh.triangles.push_back(rotate_to_smallest(vertex_of[3 * t], vertex_of[3 * t + 1], vertex_of[3 * t + 2]));
   std::sort(mesh.triangles.begin(), mesh.triangles.end());
   return mesh;
 }

@@ -14,19 +14,32 @@ namespace dynmesh {
 
 std::string_view defect_name(MeshDefect defect) noexcept {
   switch (defect) {
-    case MeshDefect::Canonical: return "canonical";
-    case MeshDefect::BadIndex: return "bad-index";
-    case MeshDefect::Orientation: return "orientation";
-    case MeshDefect::OutsideBox: return "outside-box";
-    case MeshDefect::IsolatedVertex: return "isolated-vertex";
-    case MeshDefect::MissingCorner: return "missing-corner";
-    case MeshDefect::EdgeTwice: return "edge-twice";
-    case MeshDefect::OpenEdge: return "open-edge";
-    case MeshDefect::VertexInEdge: return "vertex-in-edge";
-    case MeshDefect::Area: return "area";
-    case MeshDefect::MissingInput: return "missing-input";
-    case MeshDefect::SmallAngle: return "small-angle";
-    case MeshDefect::NotDelaunay: return "not-delaunay";
+    case MeshDefect::Canonical:
+      return "canonical";
+    case MeshDefect::BadIndex:
+      return "bad-index";
+    case MeshDefect::Orientation:
+      return "orientation";
+    case MeshDefect::OutsideBox:
+      return "outside-box";
+    case MeshDefect::IsolatedVertex:
+      return "isolated-vertex";
+    case MeshDefect::MissingCorner:
+      return "missing-corner";
+    case MeshDefect::EdgeTwice:
+      return "edge-twice";
+    case MeshDefect::OpenEdge:
+      return "open-edge";
+    case MeshDefect::VertexInEdge:
+      return "vertex-in-edge";
+    case MeshDefect::Area:
+      return "area";
+    case MeshDefect::MissingInput:
+      return "missing-input";
+    case MeshDefect::SmallAngle:
+      return "small-angle";
+    case MeshDefect::NotDelaunay:
+      return "not-delaunay";
   }
   return "unknown";
 }
@@ -95,39 +108,51 @@ class Recorder {
 
 std::string describe_triangle(const Mesh& mesh, std::size_t t) {
   const Tri& tri = mesh.triangles[t];
-  std::string s = "triangle " + std::to_string(t) + " [" + std::to_string(tri[0]) + " " + std::to_string(tri[1]) +
-                  " " + std::to_string(tri[2]) + "]";
+  std::string s = "triangle " + std::to_string(t) + " [" + std::to_string(tri[0]) + " " + std::to_string(tri[1]) + " " +
+                  std::to_string(tri[2]) + "]";
   for (Index i : tri)
     if (i < mesh.num_vertices()) s += " " + to_string(mesh.vertices[i]);
   return s;
 }
 
-std::string describe_vertex(const Mesh& mesh, Index i) { return "vertex " + std::to_string(i) + " " + to_string(mesh.vertices[i]); }
+std::string describe_vertex(const Mesh& mesh, Index i) {
+  return "vertex " + std::to_string(i) + " " + to_string(mesh.vertices[i]);
+}
 
-// ---- VertexInEdge: a bounding-volume tree over the vertices in Morton order -------------
+// ---- VertexInEdge: vertices in Morton order, with a bounding-volume tree over them --------
 //
-// The vertices are sorted along a Z-order curve of the box and cut into blocks of kBlock;
-// a complete binary tree over the blocks stores each node's exact bounding box (min and max
-// of the doubles themselves, so pruning on it is exact). A query walks the nodes whose box
-// meets the edge's bounding box and is not strictly on one side of the edge's line.
+// The vertices are sorted along a Z-order curve of the box (a monotone quantization of each
+// axis, so every vertex in an edge's bounding box has its code between the codes of the
+// box's lower and upper corners: a contiguous run of the order, found by galloping from the
+// edge's ends). A short run is scanned; a long one (the box straddles a big quadrant line) is
+// searched in a complete binary tree over blocks of kBlock vertices that stores each node's
+// exact bounding box (min and max of the doubles themselves), from the smallest node that
+// holds the run, pruning nodes off the edge's bounding box or strictly off its line.
 class VertexTree {
  public:
   static constexpr std::size_t kBlock = 8;
+  static constexpr std::size_t kScan = 48;  // runs up to this long are scanned directly
 
-  VertexTree(const Mesh& mesh, const Domain& domain) {
+  VertexTree(const Mesh& mesh, const Domain& domain)
+      : x0_(domain.x0), y0_(domain.y0), position_(mesh.num_vertices(), kAbsent) {
     const double width = domain.x1 - domain.x0, height = domain.y1 - domain.y0;
-    const double sx = width > 0 ? 0x1p32 / width : 0, sy = height > 0 ? 0x1p32 / height : 0;
+    sx_ = width > 0 ? 0x1p32 / width : 0;
+    sy_ = height > 0 ? 0x1p32 / height : 0;
     std::vector<std::pair<std::uint64_t, Index>> order;
     order.reserve(mesh.num_vertices());
     for (Index i = 0; i < mesh.num_vertices(); ++i) {
       const Point<2>& p = mesh.vertices[i];
       if (!std::isfinite(p[0]) || !std::isfinite(p[1])) continue;  // reported as outside the box
-      // A monotone quantization (clamped) is all the order needs: it only affects speed.
-      order.emplace_back(morton(quantize((p[0] - domain.x0) * sx), quantize((p[1] - domain.y0) * sy)), i);
+      order.emplace_back(code(p), i);
     }
     std::sort(order.begin(), order.end());
     points_.reserve(order.size());
-    for (const auto& entry : order) points_.push_back({mesh.vertices[entry.second], entry.second});
+    codes_.reserve(order.size());
+    for (const auto& [c, i] : order) {
+      position_[i] = points_.size();
+      points_.push_back({mesh.vertices[i], i});
+      codes_.push_back(c);
+    }
 
     const std::size_t blocks = (points_.size() + kBlock - 1) / kBlock;
     leaves_ = 1;
@@ -140,45 +165,105 @@ class VertexTree {
     for (std::size_t n = leaves_ - 1; n >= 1; --n) nodes_[n] = Bounds::merge(nodes_[2 * n], nodes_[2 * n + 1]);
   }
 
-  // Calls found(w) for every vertex w collinear with a, b and strictly between them.
+  // Calls found(w) for every vertex w collinear with the edge u-v and strictly between its
+  // ends. Both ends must have finite coordinates.
   template <class Found>
-  void vertices_inside(const Point<2>& a, const Point<2>& b, Found&& found) const {
-    if (points_.empty()) return;
-    const double lox = std::min(a[0], b[0]), hix = std::max(a[0], b[0]);
-    const double loy = std::min(a[1], b[1]), hiy = std::max(a[1], b[1]);
-    const double dx = b[0] - a[0], dy = b[1] - a[1];
-    const bool axis_parallel = dx == 0 || dy == 0;
+  void vertices_inside(const Mesh& mesh, Index u, Index v, Found&& found) const {
+    const Point<2>&a = mesh.vertices[u], &b = mesh.vertices[v];
+    const Segment seg(a, b);
+    const std::size_t pu = position_[u], pv = position_[v];
+    const std::size_t lo = first_at_least(std::min(pu, pv), code({seg.lox, seg.loy}));
+    const std::size_t hi = first_above(std::max(pu, pv), code({seg.hix, seg.hiy}));
+    if (hi - lo <= kScan) {
+      scan(seg, lo, hi, found);
+      return;
+    }
+    std::size_t first = leaves_ + lo / kBlock, last = leaves_ + (hi - 1) / kBlock;
+    while (first != last) first /= 2, last /= 2;  // the smallest node holding the run
     std::size_t stack[128];
     std::size_t top = 0;
-    stack[top++] = 1;
+    stack[top++] = first;
     while (top > 0) {
       const std::size_t n = stack[--top];
       const Bounds& box = nodes_[n];
-      if (box.hix < lox || box.lox > hix || box.hiy < loy || box.loy > hiy) continue;
-      if (!axis_parallel && box.off_line(a, dx, dy)) continue;
+      if (box.hix < seg.lox || box.lox > seg.hix || box.hiy < seg.loy || box.loy > seg.hiy) continue;
+      if (!seg.axis_parallel && box.off_line(a, seg.dx, seg.dy)) continue;
       if (n < leaves_) {
         stack[top++] = 2 * n + 1;
         stack[top++] = 2 * n;
         continue;
       }
       const std::size_t block = n - leaves_;
-      const std::size_t end = std::min(points_.size(), (block + 1) * kBlock);
-      for (std::size_t k = block * kBlock; k < end; ++k) {
-        const Point<2>& w = points_[k].p;
-        if (w[0] < lox || w[0] > hix || w[1] < loy || w[1] > hiy) continue;
-        if (w == a || w == b) continue;
-        // In the closed bounding box and not an end: collinear means strictly between. For
-        // an axis-parallel edge the box is the segment itself.
-        if (axis_parallel || orient2d(a, b, w) == 0) found(points_[k].index);
-      }
+      scan(seg, std::max(lo, block * kBlock), std::min(hi, (block + 1) * kBlock), found);
     }
   }
 
  private:
+  static constexpr std::size_t kAbsent = std::numeric_limits<std::size_t>::max();
+
   struct Located {
     Point<2> p;
     Index index;
   };
+
+  struct Segment {
+    const Point<2>&a, &b;
+    double lox, hix, loy, hiy, dx, dy;
+    bool axis_parallel;
+    Segment(const Point<2>& from, const Point<2>& to)
+        : a(from),
+          b(to),
+          lox(std::min(from[0], to[0])),
+          hix(std::max(from[0], to[0])),
+          loy(std::min(from[1], to[1])),
+          hiy(std::max(from[1], to[1])),
+          dx(to[0] - from[0]),
+          dy(to[1] - from[1]),
+          axis_parallel(dx == 0 || dy == 0) {}
+  };
+
+  template <class Found>
+  void scan(const Segment& seg, std::size_t from, std::size_t to, Found& found) const {
+    for (std::size_t k = from; k < to; ++k) {
+      const Point<2>& w = points_[k].p;
+      if (w[0] < seg.lox || w[0] > seg.hix || w[1] < seg.loy || w[1] > seg.hiy) continue;
+      if (w == seg.a || w == seg.b) continue;
+      // In the closed bounding box and not an end: collinear means strictly between. For an
+      // axis-parallel edge the box is the segment itself.
+      if (seg.axis_parallel || orient2d(seg.a, seg.b, w) == 0) found(points_[k].index);
+    }
+  }
+
+  // The first position in [0, start] whose code is >= c (codes_[start] >= c), galloping
+  // down from start: cheap when the answer is near.
+  std::size_t first_at_least(std::size_t start, std::uint64_t c) const noexcept {
+    std::size_t high = start, step = 1;
+    while (step <= high && codes_[high - step] >= c) {
+      high -= step;
+      step *= 2;
+    }
+    const std::size_t low = step <= high ? high - step : 0;
+    return static_cast<std::size_t>(std::lower_bound(codes_.begin() + static_cast<std::ptrdiff_t>(low),
+                                                     codes_.begin() + static_cast<std::ptrdiff_t>(high), c) -
+                                    codes_.begin());
+  }
+
+  // The first position after start whose code is > c (codes_[start] <= c), galloping up.
+  std::size_t first_above(std::size_t start, std::uint64_t c) const noexcept {
+    std::size_t low = start, step = 1;
+    while (low + step < codes_.size() && codes_[low + step] <= c) {
+      low += step;
+      step *= 2;
+    }
+    const std::size_t high = std::min(codes_.size(), low + step);
+    return static_cast<std::size_t>(std::upper_bound(codes_.begin() + static_cast<std::ptrdiff_t>(low) + 1,
+                                                     codes_.begin() + static_cast<std::ptrdiff_t>(high), c) -
+                                    codes_.begin());
+  }
+
+  std::uint64_t code(const Point<2>& p) const noexcept {
+    return morton(quantize((p[0] - x0_) * sx_), quantize((p[1] - y0_) * sy_));
+  }
 
   struct Bounds {
     double lox = std::numeric_limits<double>::infinity(), hix = -std::numeric_limits<double>::infinity();
@@ -227,8 +312,11 @@ class VertexTree {
   }
   static std::uint64_t morton(std::uint32_t qx, std::uint32_t qy) noexcept { return spread(qx) | (spread(qy) << 1); }
 
-  std::vector<Located> points_;
-  std::vector<Bounds> nodes_;  // heap layout: node n has children 2n, 2n+1; leaves from leaves_
+  double x0_, y0_, sx_ = 0, sy_ = 0;   // the quantization: code() is monotone in x and in y
+  std::vector<std::size_t> position_;  // vertex index -> place in points_ (kAbsent: not finite)
+  std::vector<Located> points_;        // in Morton order
+  std::vector<std::uint64_t> codes_;   // codes_[k]: the Morton code of points_[k]
+  std::vector<Bounds> nodes_;          // heap layout: node n has children 2n, 2n+1; leaves from leaves_
   std::size_t leaves_ = 1;
 };
 
@@ -316,19 +404,24 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
   std::vector<Point<2>> sorted_copy;
   if (!vertices_sorted) {
     sorted_copy = vs;
-    std::sort(sorted_copy.begin(), sorted_copy.end(), xy_less);
+    std::sort(sorted_copy.begin(), sorted_copy.end(),
+              [](const Point<2>& l, const Point<2>& r) { return xy_less(l, r); });
   }
   const std::vector<Point<2>>& lookup = vertices_sorted ? vs : sorted_copy;
   auto is_vertex = [&](const Point<2>& p) {
-    const auto it = std::lower_bound(lookup.begin(), lookup.end(), p, xy_less);
+    const auto it = std::lower_bound(lookup.begin(), lookup.end(), p,
+                                     [](const Point<2>& l, const Point<2>& r) { return xy_less(l, r); });
     return it != lookup.end() && !xy_less(p, *it);
   };
 
   for (Index i = 0; i < nv; ++i)
-    if (!domain.contains(vs[i])) record.add(MeshDefect::OutsideBox, [&] { return describe_vertex(mesh, i) + " is outside the box"; });
-  const Point<2> corners[4] = {{domain.x0, domain.y0}, {domain.x1, domain.y0}, {domain.x0, domain.y1}, {domain.x1, domain.y1}};
+    if (!domain.contains(vs[i]))
+      record.add(MeshDefect::OutsideBox, [&] { return describe_vertex(mesh, i) + " is outside the box"; });
+  const Point<2> corners[4] = {
+      {domain.x0, domain.y0}, {domain.x1, domain.y0}, {domain.x0, domain.y1}, {domain.x1, domain.y1}};
   for (const Point<2>& c : corners)
-    if (!is_vertex(c)) record.add(MeshDefect::MissingCorner, [&] { return "box corner " + to_string(c) + " is not a vertex"; });
+    if (!is_vertex(c))
+      record.add(MeshDefect::MissingCorner, [&] { return "box corner " + to_string(c) + " is not a vertex"; });
 
   // Per triangle: indices, canonical rotation and order, orientation, area, angles.
   std::vector<char> well_formed(nt, 0), ccw(nt, 0);
@@ -339,12 +432,14 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
     if (t > 0 && tri < mesh.triangles[t - 1])
       record.add(MeshDefect::Canonical, [&] { return describe_triangle(mesh, t) + " is out of order"; });
     if (tri[0] >= nv || tri[1] >= nv || tri[2] >= nv || tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
-      record.add(MeshDefect::BadIndex, [&] { return describe_triangle(mesh, t) + " names a missing vertex or one twice"; });
+      record.add(MeshDefect::BadIndex,
+                 [&] { return describe_triangle(mesh, t) + " names a missing vertex or one twice"; });
       continue;
     }
     well_formed[t] = 1;
     if (!(tri[0] < tri[1] && tri[0] < tri[2]))
-      record.add(MeshDefect::Canonical, [&] { return describe_triangle(mesh, t) + " does not start at its smallest index"; });
+      record.add(MeshDefect::Canonical,
+                 [&] { return describe_triangle(mesh, t) + " does not start at its smallest index"; });
     const Point<2>&a = vs[tri[0]], &b = vs[tri[1]], &c = vs[tri[2]];
     const int turn = orient2d(a, b, c);
     if (turn > 0) {
@@ -431,7 +526,7 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
   for (const auto& [u, v] : undirected) {
     const Point<2>&a = vs[u], &b = vs[v];
     if (!std::isfinite(a[0]) || !std::isfinite(a[1]) || !std::isfinite(b[0]) || !std::isfinite(b[1])) continue;
-    tree.vertices_inside(a, b, [&](Index w) {
+    tree.vertices_inside(mesh, u, v, [&](Index w) {
       record.add(MeshDefect::VertexInEdge, [&] {
         return describe_vertex(mesh, w) + " lies inside edge " + std::to_string(u) + " - " + std::to_string(v) + " " +
                to_string(a) + " - " + to_string(b);
@@ -441,9 +536,8 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
 
   for (std::size_t i = 0; i < inputs.size(); ++i)
     if (!is_vertex(inputs[i]))
-      record.add(MeshDefect::MissingInput, [&] {
-        return "input point " + std::to_string(i) + " " + to_string(inputs[i]) + " is not a vertex";
-      });
+      record.add(MeshDefect::MissingInput,
+                 [&] { return "input point " + std::to_string(i) + " " + to_string(inputs[i]) + " is not a vertex"; });
   return report;
 }
 

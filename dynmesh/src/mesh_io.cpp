@@ -167,7 +167,9 @@ class FieldReader {
     return false;
   }
 
-  [[noreturn]] void fail(InputError::Kind kind, const std::string& what) const { throw InputError(kind, what, name_, line_); }
+  [[noreturn]] void fail(InputError::Kind kind, const std::string& what) const {
+    throw InputError(kind, what, name_, line_);
+  }
 
   std::size_t integer(std::string_view field) const {
     std::size_t value = 0;
@@ -184,9 +186,11 @@ class FieldReader {
     const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), value);
     if (r.ec == std::errc::result_out_of_range)
       fail(InputError::Kind::NotFinite, "number '" + std::string(field) + "' is out of the range of double");
-    if (r.ec != std::errc() || r.ptr != digits.data() + digits.size() || (digits.size() < field.size() && !digits.empty() && digits.front() == '-'))
+    if (r.ec != std::errc() || r.ptr != digits.data() + digits.size() ||
+        (digits.size() < field.size() && !digits.empty() && digits.front() == '-'))
       fail(InputError::Kind::Malformed, "expected a number, got '" + std::string(field) + "'");
-    if (!std::isfinite(value)) fail(InputError::Kind::NotFinite, "NaN or infinite coordinate '" + std::string(field) + "'");
+    if (!std::isfinite(value))
+      fail(InputError::Kind::NotFinite, "NaN or infinite coordinate '" + std::string(field) + "'");
     return value;
   }
 
@@ -210,16 +214,18 @@ Mesh read_node_ele(const std::string& node_text, const std::string& ele_text) {
   const std::size_t nv = node.integer(fields[0]);
   if (fields.size() > 1 && node.integer(fields[1]) != 2) node.fail(InputError::Kind::Malformed, "dimension must be 2");
   std::size_t base = 0;
-  mesh.vertices.reserve(nv);
+  mesh.vertices.reserve(std::min(nv, node_text.size() / 4));  // a bogus count must not allocate
   for (std::size_t i = 0; i < nv; ++i) {
-    if (!node.next(fields)) node.fail(InputError::Kind::Count, "expected " + std::to_string(nv) + " vertices, found " + std::to_string(i));
+    if (!node.next(fields))
+      node.fail(InputError::Kind::Count, "expected " + std::to_string(nv) + " vertices, found " + std::to_string(i));
     if (fields.size() < 3) node.fail(InputError::Kind::Count, "a vertex line needs a number and two coordinates");
     const std::size_t number = node.integer(fields[0]);
     if (i == 0) {
       if (number > 1) node.fail(InputError::Kind::Malformed, "vertex numbering must start at 0 or 1");
       base = number;
     } else if (number != base + i) {
-      node.fail(InputError::Kind::Malformed, "vertex number " + std::to_string(number) + ", expected " + std::to_string(base + i));
+      node.fail(InputError::Kind::Malformed,
+                "vertex number " + std::to_string(number) + ", expected " + std::to_string(base + i));
     }
     mesh.vertices.push_back({node.number(fields[1]), node.number(fields[2])});
   }
@@ -228,15 +234,18 @@ Mesh read_node_ele(const std::string& node_text, const std::string& ele_text) {
   FieldReader ele(ele_text, "ele");
   if (!ele.next(fields)) ele.fail(InputError::Kind::Malformed, "missing the header line");
   const std::size_t nt = ele.integer(fields[0]);
-  if (fields.size() > 1 && ele.integer(fields[1]) != 3) ele.fail(InputError::Kind::Malformed, "only 3-node triangles are supported");
-  mesh.triangles.reserve(nt);
+  if (fields.size() > 1 && ele.integer(fields[1]) != 3)
+    ele.fail(InputError::Kind::Malformed, "only 3-node triangles are supported");
+  mesh.triangles.reserve(std::min(nt, ele_text.size() / 6));
   for (std::size_t t = 0; t < nt; ++t) {
-    if (!ele.next(fields)) ele.fail(InputError::Kind::Count, "expected " + std::to_string(nt) + " triangles, found " + std::to_string(t));
+    if (!ele.next(fields))
+      ele.fail(InputError::Kind::Count, "expected " + std::to_string(nt) + " triangles, found " + std::to_string(t));
     if (fields.size() < 4) ele.fail(InputError::Kind::Count, "a triangle line needs a number and three vertices");
     std::array<std::uint32_t, 3> tri{};
     for (std::size_t k = 0; k < 3; ++k) {
       const std::size_t v = ele.integer(fields[k + 1]);
-      if (v < base || v - base >= nv) ele.fail(InputError::Kind::Malformed, "vertex " + std::to_string(v) + " does not exist");
+      if (v < base || v - base >= nv)
+        ele.fail(InputError::Kind::Malformed, "vertex " + std::to_string(v) + " does not exist");
       tri[k] = static_cast<std::uint32_t>(v - base);
     }
     mesh.triangles.push_back(tri);
@@ -334,10 +343,13 @@ std::string format_svg(const Mesh& mesh, const Box<2>& box, std::span<const Poin
 
   std::string out;
   out.reserve(512 + segments.size() * 30 + std::min(inputs.size(), opt.max_marked_inputs) * 48);
-  out += "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"";
-  out += pixels(total) + "\" height=\"" + pixels(total) + "\" viewBox=\"0 0 " + pixels(total) + ' ' + pixels(total) + "\">\n";
+  out +=
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"";
+  out += pixels(total) + "\" height=\"" + pixels(total) + "\" viewBox=\"0 0 " + pixels(total) + ' ' + pixels(total) +
+         "\">\n";
   out += "<title>dynmesh mesh: " + std::to_string(mesh.num_vertices()) + " vertices, " +
-         std::to_string(mesh.num_triangles()) + " triangles, " + std::to_string(inputs.size()) + " input points</title>\n";
+         std::to_string(mesh.num_triangles()) + " triangles, " + std::to_string(inputs.size()) +
+         " input points</title>\n";
   out += "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
 
   const std::string path_end = "\" fill=\"none\" stroke=\"#404040\" stroke-width=\"" + pixels(stroke) +

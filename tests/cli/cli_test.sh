@@ -145,6 +145,69 @@ case $case_name in
     head -c 5 demo.svg | grep -q '^<?xml\|^<svg' || fail "demo.svg is not SVG"
     ;;
 
+  mesh) # the quadtree mesh after edits equals a from-scratch mesh of the final points
+    qt=(--postprocess quadtree)
+    # The box derived from points2d.node, as `dynmesh quadtree` records it (same derivation).
+    run "$dynmesh" quadtree "$data/points2d.node" --cells box.cells
+    box=$(box_of box.cells)
+    [[ -n $box ]] || fail "no box line in box.cells"
+    run "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --edits "$data/edits2d.txt" -o dyn --check \
+      --feed dyn.feed --vtk dyn.vtk --msh dyn.msh --svg dyn.svg --stats
+    for f in dyn.node dyn.ele dyn.feed dyn.vtk dyn.msh dyn.svg; do
+      [[ -s $f ]] || fail "$f missing or empty"
+    done
+    [[ $(head -1 dyn.feed) == '# dynmesh feed v1' ]] || fail "feed header: $(head -1 dyn.feed)"
+    # One update per edit, numbered from 1.
+    edits=$(grep -c '^[+-]' "$data/edits2d.txt")
+    [[ $(grep -c '^update ' dyn.feed) -eq $edits ]] || fail "feed: expected $edits updates"
+    [[ $(grep -m1 '^update ' dyn.feed | cut -d' ' -f2) == 1 ]] || fail "feed: first update is not 1"
+    grep -q 'Smallest angle' err.txt || fail "--stats printed no report: $(head -3 err.txt)"
+    head -1 dyn.vtk | grep -q '^# vtk DataFile' || fail "dyn.vtk is not legacy VTK"
+    [[ $(head -1 dyn.msh) == "\$MeshFormat" ]] || fail "dyn.msh is not MSH"
+    tail -1 dyn.svg | grep -q '</svg>' || fail "dyn.svg is not closed"
+    [[ $(head -1 dyn.node | cut -d' ' -f2-) == '2 0 1' ]] || fail "dyn.node header: $(head -1 dyn.node)"
+    # shellcheck disable=SC2086  # the box is several numbers
+    run "$dynmesh" mesh "$data/final2d.txt" "${qt[@]}" --box $box -o scratch --check
+    cmp dyn.node scratch.node || fail "dynamic .node differs from a from-scratch run on final2d.txt"
+    cmp dyn.ele scratch.ele || fail "dynamic .ele differs from a from-scratch run on final2d.txt"
+    run "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --edits "$data/edits2d.txt" --batch 3 -o batch3 \
+      --feed batch3.feed --check
+    cmp dyn.node batch3.node || fail "--batch 3 .node differs from single edits"
+    cmp dyn.ele batch3.ele || fail "--batch 3 .ele differs from single edits"
+    [[ $(grep -c '^update ' batch3.feed) -eq $(((edits + 2) / 3)) ]] || fail "--batch 3: wrong number of updates"
+    run "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --min-angle 18.4 -o plain --check
+    ;;
+
+  mesh_errors) # one line, exit 1, and the files of an earlier run left as they were
+    qt=(--postprocess quadtree)
+    run "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" -o old --feed old.feed
+    cp old.node saved.node && cp old.ele saved.ele && cp old.feed saved.feed
+    for batch in 0 2; do
+      batch_args=()
+      ((batch > 0)) && batch_args=(--batch "$batch")
+      expect_error 1 'edits_absent.txt:3: ' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" \
+        --edits "$data/edits_absent.txt" "${batch_args[@]}" -o old --feed old.feed
+      grep -q 'not in the set' err.txt || fail "absent point: unclear message: $(cat err.txt)"
+      expect_error 1 'edits_outside.txt:3: ' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" \
+        --edits "$data/edits_outside.txt" "${batch_args[@]}" -o old
+    done
+    expect_error 1 'bad_number.txt:3: ' "$dynmesh" mesh "$data/bad_number.txt" "${qt[@]}" -o old
+    expect_error 1 'duplicate.txt:5: ' "$dynmesh" mesh "$data/duplicate.txt" "${qt[@]}" -o old
+    expect_error 1 'above the quadtree' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --min-angle 25 -o old
+    expect_error 1 'hpu postprocess is not available yet' "$dynmesh" mesh "$data/points2d.node" \
+      --postprocess hpu -o old
+    expect_error 1 'hpu postprocess is not available yet' "$dynmesh" mesh "$data/points2d.node" -o old
+    expect_error 1 'points3d.node:1: ' "$dynmesh" mesh "$data/points3d.node" "${qt[@]}" -o old
+    # An output that cannot be written: nothing else of the run is renamed into place.
+    expect_error 1 'no-such-dir/x.svg' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" \
+      --edits "$data/edits2d.txt" -o old --svg no-such-dir/x.svg
+    cmp old.node saved.node || fail "a failed run changed old.node"
+    cmp old.ele saved.ele || fail "a failed run changed old.ele"
+    cmp old.feed saved.feed || fail "a failed run changed old.feed"
+    [[ -z $(find . -name '.*.tmp-*') ]] || fail "temporary files left behind: $(find . -name '.*.tmp-*')"
+    expect_error 2 '-o' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}"
+    ;;
+
   *)
     fail "unknown case"
     ;;

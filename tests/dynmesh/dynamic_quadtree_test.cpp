@@ -971,11 +971,14 @@ TYPED_TEST(DynamicQuadtreeBadInput, BadBatchAppliesNothing) {
     // + a, − b, <bad>, + c: the first two are valid and must not be applied either.
     const std::vector<Edit<d>> edits = {{EditOp::Insert, a}, {EditOp::Delete, b}, bc.third, {EditOp::Insert, c}};
     const std::string msg = expect_rejected(tree, bc.kind, bc.name, [&] { tree.apply(edits); });
-    EXPECT_NE(msg.find("edit 2"), std::string::npos) << "the message should name the edit's index: " << msg;
+    EXPECT_TRUE(msg.find("edit 2") != std::string::npos || msg.find("and 2") != std::string::npos)
+        << "the message should name the edit's index: " << msg;
     try {
       tree.apply(edits);
     } catch (const InputError& e) {
-      EXPECT_EQ(e.point_indices(), std::vector<std::size_t>{2}) << bc.name;
+      // The failing edit comes last (an earlier insert at the same position comes first).
+      ASSERT_FALSE(e.point_indices().empty()) << bc.name;
+      EXPECT_EQ(e.point_indices().back(), 2u) << bc.name;
     }
   }
   // The same batch without the bad edit goes through.

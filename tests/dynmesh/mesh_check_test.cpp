@@ -1,5 +1,7 @@
 // mesh_check_test.cpp — mesh_check.hpp: valid meshes pass, and every kind of corruption is
 // reported as its own defect.
+#include "dynmesh/mesh_check.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,7 +13,6 @@
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh.hpp"
-#include "dynmesh/mesh_check.hpp"
 #include "dynmesh/predicates.hpp"
 
 namespace {
@@ -38,7 +39,7 @@ Mesh grid(int n, double jitter = 0, unsigned seed = 1) {
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
       const Point<2>&a = at[i * (n + 1) + j], &b = at[(i + 1) * (n + 1) + j], &c = at[(i + 1) * (n + 1) + j + 1],
-                     &d = at[i * (n + 1) + j + 1];
+            &d = at[i * (n + 1) + j + 1];
       ts.push_back(canonical_triangle(a, b, c));
       ts.push_back(canonical_triangle(a, c, d));
     }
@@ -72,7 +73,8 @@ std::vector<MeshDefect> kinds(const MeshReport& r) {
 
 bool mentions(const MeshReport& r, MeshDefect d) {
   const std::string prefix = std::string(defect_name(d)) + ": ";
-  return std::any_of(r.problems.begin(), r.problems.end(), [&](const std::string& p) { return p.rfind(prefix, 0) == 0; });
+  return std::any_of(r.problems.begin(), r.problems.end(),
+                     [&](const std::string& p) { return p.rfind(prefix, 0) == 0; });
 }
 
 // ---- valid meshes pass -----------------------------------------------------------------------
@@ -129,7 +131,8 @@ TEST(MeshCheck, FanWithManyBoundaryVerticesPasses) {
   for (int k = 0; k < per_side; ++k) ring.push_back({1 - double(k) / per_side, 1});
   for (int k = 0; k < per_side; ++k) ring.push_back({0, 1 - double(k) / per_side});
   std::vector<Triangle> ts;
-  for (std::size_t k = 0; k < ring.size(); ++k) ts.push_back(canonical_triangle(ring[k], ring[(k + 1) % ring.size()], c));
+  for (std::size_t k = 0; k < ring.size(); ++k)
+    ts.push_back(canonical_triangle(ring[k], ring[(k + 1) % ring.size()], c));
   const MeshReport r = check_mesh(make_mesh(ts), square(0, 0, 1), {});
   EXPECT_TRUE(r.ok()) << r.summary();
 }
@@ -204,7 +207,8 @@ TEST(MeshCheck, VertexOnNonAxisEdgeIsDecidedExactly) {
   struct Case {
     Point<2> p, q, mid;
   };
-  for (const Case& k : {Case{{0.125, 0.25}, {0.875, 0.625}, {0.5, 0.4375}}, Case{{0.1, 0.2}, {0.7, 0.5}, {0.4, 0.35}}}) {
+  for (const Case& k :
+       {Case{{0.125, 0.25}, {0.875, 0.625}, {0.5, 0.4375}}, Case{{0.1, 0.2}, {0.7, 0.5}, {0.4, 0.35}}}) {
     Mesh m = make_mesh(std::vector<Triangle>{canonical_triangle(k.p, k.q, {0.875, 0.9})});
     ASSERT_EQ(m.vertices[0], k.p);
     m.vertices.insert(m.vertices.begin() + 1, k.mid);  // mid sorts between p and the rest
@@ -229,6 +233,21 @@ TEST(MeshCheck, TJunctionOnTheBoundary) {
   EXPECT_TRUE(mentions(r, MeshDefect::VertexInEdge));
 }
 
+TEST(MeshCheck, LongEdgesThroughManyVertices) {
+  // A big triangle laid over a 40 x 40 grid: its three edges run through the grid's
+  // vertices on the left side, the top side and (unjittered) the diagonal. Long edges take
+  // the tree search rather than the short scan.
+  const int n = 40;
+  for (const double jitter : {0.0, 0.2}) {
+    std::vector<Triangle> ts = triangles_of(grid(n, jitter, 5));
+    ts.push_back(canonical_triangle({0, 0}, {double(n), double(n)}, {0, double(n)}));
+    const MeshReport r = check_mesh(make_mesh(ts), square(0, 0, n), {});
+    const std::size_t sides = jitter == 0 ? 3 : 2;  // jitter moves the diagonal's vertices off it
+    EXPECT_EQ(count(r, MeshDefect::VertexInEdge), sides * (n - 1)) << "jitter " << jitter;
+    EXPECT_TRUE(r.has(MeshDefect::Area));
+  }
+}
+
 TEST(MeshCheck, MissingInputPoint) {
   const std::vector<Point<2>> inputs = {{1, 1}, {0.5, 0.5}, {0, 0}};
   const MeshReport r = check_mesh(two_triangles(), square(0, 0, 1), inputs);
@@ -248,7 +267,8 @@ TEST(MeshCheck, SliverBelowTheAngleBound) {
   EXPECT_EQ(count(strict, MeshDefect::SmallAngle), 1u);  // the bottom triangle
   // The bound is inclusive: exactly 45 degrees passes a 45-degree bound.
   EXPECT_TRUE(check_mesh(grid(4), square(0, 0, 4), {}, MeshCheckOptions{45, false}).ok());
-  EXPECT_EQ(count(check_mesh(grid(4), square(0, 0, 4), {}, MeshCheckOptions{45.000001, false}), MeshDefect::SmallAngle), 32u);
+  EXPECT_EQ(count(check_mesh(grid(4), square(0, 0, 4), {}, MeshCheckOptions{45.000001, false}), MeshDefect::SmallAngle),
+            32u);
 }
 
 TEST(MeshCheck, NonDelaunayDiagonal) {

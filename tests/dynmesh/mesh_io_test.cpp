@@ -1,5 +1,7 @@
 // mesh_io_test.cpp — mesh_io.hpp: exact text of small meshes, .node/.ele round trips,
 // VTK/MSH structure, the SVG picture, statistics and the change feed.
+#include "dynmesh/mesh_io.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,7 +15,6 @@
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh.hpp"
-#include "dynmesh/mesh_io.hpp"
 
 namespace {
 
@@ -86,10 +87,9 @@ TEST(MeshIo, UpperBoxSidesUseTheRoundedSum) {
   // fl(0.1 + 0.7) = 0.7999999999999999 is the upper side; 0.8 would be outside.
   const Box<2> box = square(0.1, 0.1, 0.7);
   const double hi = 0.1 + 0.7;
-  const std::vector<Triangle> ts = {canonical_triangle({0.1, 0.1}, {hi, 0.1}, {0.45, 0.45}),
-                                    canonical_triangle({hi, 0.1}, {hi, hi}, {0.45, 0.45}),
-                                    canonical_triangle({hi, hi}, {0.1, hi}, {0.45, 0.45}),
-                                    canonical_triangle({0.1, hi}, {0.1, 0.1}, {0.45, 0.45})};
+  const std::vector<Triangle> ts = {
+      canonical_triangle({0.1, 0.1}, {hi, 0.1}, {0.45, 0.45}), canonical_triangle({hi, 0.1}, {hi, hi}, {0.45, 0.45}),
+      canonical_triangle({hi, hi}, {0.1, hi}, {0.45, 0.45}), canonical_triangle({0.1, hi}, {0.1, 0.1}, {0.45, 0.45})};
   const std::vector<std::string> lines = lines_of(format_node(make_mesh(ts), box));
   ASSERT_EQ(lines.size(), 6u);
   EXPECT_EQ(lines[3], "3 0.45000000000000001 0.45000000000000001 0");
@@ -206,7 +206,7 @@ TEST(MeshIo, SvgDrawsEachEdgeOnceWithYUp) {
   // (0, 0) is the lower left corner: pixel (10, 110); (1, 1) the upper right: (110, 10).
   EXPECT_NE(d.find("10 110"), std::string::npos) << d;
   EXPECT_NE(d.find("110 10"), std::string::npos) << d;
-  EXPECT_EQ(occurrences(svg, "<circle"), 2u);  // the repeated input point is drawn once
+  EXPECT_EQ(occurrences(svg, "<circle"), 2u);                     // the repeated input point is drawn once
   EXPECT_NE(svg.find("cx=\"35\" cy=\"35\""), std::string::npos);  // (0.25, 0.75)
 
   opt.max_marked_inputs = 2;

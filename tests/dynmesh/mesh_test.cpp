@@ -1,11 +1,11 @@
 // mesh_test.cpp — mesh.hpp: canonical triangles, the canonical Mesh, apply_change.
+#include "dynmesh/mesh.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 #include <vector>
-
-#include "dynmesh/mesh.hpp"
 
 namespace {
 
@@ -37,7 +37,7 @@ TEST(MeshCanonical, TriangleStartsAtSmallestCornerAndKeepsOrientation) {
 
 TEST(MeshCanonical, BoxSplitByDiagonal) {
   const Point<2> o{0, 0}, x{1, 0}, y{0, 1}, xy{1, 1};
-  const std::vector<Triangle> ts = {canonical_triangle(xy, o, y), canonical_triangle(x, xy, o)};
+  const std::vector<Triangle> ts = {canonical_triangle(xy, y, o), canonical_triangle(x, xy, o)};
   const Mesh m = make_mesh(ts);
   EXPECT_EQ(m.vertices, (std::vector<Point<2>>{o, y, x, xy}));
   using Tri = std::array<std::uint32_t, 3>;

@@ -25,15 +25,16 @@
 //   NotDelaunay    (with MeshCheckOptions::delaunay) the vertex opposite an interior edge is
 //                  strictly inside the circumcircle of the triangle across it (exact
 //                  incircle). Locally Delaunay everywhere implies globally Delaunay.
-// Orientation, matched edges, boundary edges on the sides and the box's area together say
-// the triangles cover B exactly once; VertexInEdge is the direct statement of "no vertex
-// inside an edge" that the contract makes.
+// Orientation, matched edges and lone edges on the sides make the triangles cover B a whole
+// number of times, and the area makes it once; VertexInEdge states "no vertex inside an
+// edge" directly, as the contract does.
 //
 // Invariants: the report depends only on the arguments; problems lists at most
 // max_problems messages (in check order), counts every defect found.
-// Complexity: O((t + p) log t) for t triangles and p input points. VertexInEdge walks a
-// bounding-volume tree over the vertices in Morton order, pruned by the edge's bounding
-// box and line: O(log t) per edge for graded meshes. About a second for 10^6 triangles.
+// Complexity: O((t + p) log t) for t triangles and p input points. VertexInEdge sorts the
+// vertices along a Z-order curve; the vertices in an edge's bounding box lie in one run of
+// that order, scanned when short and otherwise searched in a bounding-volume tree pruned by
+// the edge's box and line: O(log t) per edge for graded meshes.
 // Paper: none (the contract is DESIGN.md's; the exact predicates are Shewchuk's via CGAL).
 #pragma once
 
@@ -77,10 +78,10 @@ struct MeshCheckOptions {
 };
 
 struct MeshReport {
-  std::vector<std::string> problems;  // "<defect name>: <details>", at most max_problems
-  bool truncated = false;             // more defects were found than problems lists
+  std::vector<std::string> problems;                   // "<defect name>: <details>", at most max_problems
+  bool truncated = false;                              // more defects were found than problems lists
   std::array<std::size_t, kMeshDefectKinds> counts{};  // defects found, per kind, all of them
-  double min_angle_deg = 0;           // over all well-formed triangles (0 when none)
+  double min_angle_deg = 0;                            // over all well-formed triangles (0 when none)
   double max_angle_deg = 0;
 
   bool ok() const noexcept;

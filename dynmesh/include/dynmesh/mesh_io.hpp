@@ -44,14 +44,15 @@ std::string format_vtk(const Mesh& mesh);
 std::string format_msh(const Mesh& mesh);
 
 /// Parses the output of format_node and format_ele (and Triangle's own files: numbering from
-/// 0 or 1, `#` comments, attributes and markers ignored) back into a Mesh, in file order.
-/// InputError (Malformed, Count, NotFinite) naming "node" or "ele" and the line otherwise.
+/// 0 or 1, `#` comments, attributes and markers ignored) back into a Mesh, in file order,
+/// not re-canonicalized. InputError (Malformed, Count, NotFinite: also a number beyond the
+/// range of double) naming "node" or "ele" and the line otherwise.
 Mesh read_node_ele(const std::string& node_text, const std::string& ele_text);
 
 struct SvgMeshOptions {
-  double width_px = 1000.0;    // side of the square drawing of the box, in pixels
-  double margin_px = 10.0;     // blank border around it
-  double stroke_px = 0.0;      // edge width; 0 picks one from the mean edge length on screen
+  double width_px = 1000.0;  // side of the square drawing of the box, in pixels
+  double margin_px = 10.0;   // blank border around it
+  double stroke_px = 0.0;    // edge width; 0 picks one from the mean edge length on screen
   double point_radius_px = 1.5;
   std::size_t max_marked_inputs = 20000;  // more input points than this: none are marked
 };
