@@ -496,7 +496,10 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
         });
         continue;
       }
-      const auto [reverse, across] = edges.count(v, u);
+      // Plain variables, not a structured binding: the lambdas below capture them.
+      const std::pair<std::size_t, Index> back = edges.count(v, u);
+      const std::size_t reverse = back.first;
+      const Index across = back.second;
       if (reverse == 0) {
         if (!domain.on_one_side(vs[u], vs[v]))
           record.add(MeshDefect::OpenEdge, [&] {
@@ -523,7 +526,8 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
 
   // No vertex strictly inside an edge (edges with a non-finite end are reported elsewhere).
   const VertexTree tree(mesh, domain);
-  for (const auto& [u, v] : undirected) {
+  for (const auto& edge : undirected) {
+    const Index u = edge.first, v = edge.second;
     const Point<2>&a = vs[u], &b = vs[v];
     if (!std::isfinite(a[0]) || !std::isfinite(a[1]) || !std::isfinite(b[0]) || !std::isfinite(b[1])) continue;
     tree.vertices_inside(mesh, u, v, [&](Index w) {

@@ -354,11 +354,12 @@ TEST(MeshCheck, EmptyMesh) {
   EXPECT_TRUE(r.has(MeshDefect::Area));
 }
 
-TEST(MeshCheck, LargeJitteredGridIsQuick) {
-  // 2·300^2 = 180k triangles. The time is recorded, not asserted: the machine is shared.
-  const Mesh m = grid(300, 0.2, 3);
+TEST(MeshCheck, LargeJitteredGrid) {
+  // 2·150^2 = 45k triangles, sized for sanitizer builds. The time is recorded, not asserted:
+  // the machine is shared.
+  const Mesh m = grid(150, 0.2, 3);
   const auto start = std::chrono::steady_clock::now();
-  const MeshReport r = check_mesh(m, square(0, 0, 300), {});
+  const MeshReport r = check_mesh(m, square(0, 0, 150), {});
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_TRUE(r.ok()) << r.summary();
   RecordProperty("check_seconds", std::to_string(seconds));
