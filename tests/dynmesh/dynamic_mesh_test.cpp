@@ -123,7 +123,7 @@ void run_differential(Distribution dist, std::size_t n, std::size_t updates, std
   }
 }
 
-std::size_t scaled(std::size_t n) { return kSlowBuild ? std::max<std::size_t>(n / 4, 8) : n; }
+std::size_t scaled(std::size_t n) { return kSlowBuild ? std::max<std::size_t>(n / 10, 6) : n; }
 
 TEST(DynamicMeshDifferential, Uniform) { run_differential(Distribution::Uniform, 200, scaled(120), 11); }
 TEST(DynamicMeshDifferential, Clusters) { run_differential(Distribution::Clusters, 200, scaled(120), 12); }
