@@ -210,22 +210,8 @@ void DynamicMesh::check_invariants() const {
                           });
   std::sort(tree.begin(), tree.end());
   require_valid_tree<2>(qs, tree);
-  // T': every point leaf has its block of same-size leaves; the blocks tile the box.
-  const auto leaves = refined_leaves();
-  detail::CellTable<2> leaf_set(leaves.size());
-  std::size_t holding = 0;
-  for (const Leaf<2>& l : leaves)
-    if (!leaf_set.try_emplace(l.cell).second) throw InvariantError("dynmesh: leaf " + to_string(l.cell) + " meshed twice");
-  for (const Leaf<2>& l : leaves) {
-    if (l.npoints == 0) continue;
-    ++holding;
-    for_each_neighbour(l.cell, [&](const CellId<2>& nb) {
-      if (!leaf_set.contains(nb))
-        throw InvariantError("dynmesh: point leaf " + to_string(l.cell) + " has a neighbour " + to_string(nb) +
-                             " that is not a leaf of its size");
-    });
-  }
-  if (holding != size()) throw InvariantError("dynmesh: the refined tree lost a point leaf");
+  // T': every point leaf has its block of same-size leaves.
+  require_refined_tree(refined_leaves(), size());
 }
 
 }  // namespace dynmesh

@@ -121,12 +121,12 @@ QuadtreeMesh::QuadtreeMesh(const Box<2>& box, std::span<const Point<2>> points)
   std::sort(triangles_.begin(), triangles_.end());
 }
 
-void QuadtreeMesh::check_invariants() const {
-  // Every point's leaf has its 3x3 block of same-size leaves.
-  CellTable<2> leaf_set(leaves_.size());
-  for (const Leaf<2>& l : leaves_) leaf_set.try_emplace(l.cell);
+void require_refined_tree(std::span<const Leaf<2>> leaves, std::size_t npoints) {
+  CellTable<2> leaf_set(leaves.size());
+  for (const Leaf<2>& l : leaves)
+    if (!leaf_set.try_emplace(l.cell).second) throw InvariantError("dynmesh: leaf " + to_string(l.cell) + " meshed twice");
   std::size_t holding = 0;
-  for (const Leaf<2>& l : leaves_) {
+  for (const Leaf<2>& l : leaves) {
     if (l.npoints == 0) continue;
     ++holding;
     for_each_neighbour(l.cell, [&](const CellId<2>& nb) {
@@ -135,7 +135,9 @@ void QuadtreeMesh::check_invariants() const {
                              " that is not a leaf of its size");
     });
   }
-  if (holding != points_.size()) throw InvariantError("dynmesh: the refined tree lost a point leaf");
+  if (holding != npoints) throw InvariantError("dynmesh: the refined tree lost a point leaf");
 }
+
+void QuadtreeMesh::check_invariants() const { require_refined_tree(leaves_, points_.size()); }
 
 }  // namespace dynmesh

@@ -27,6 +27,11 @@ namespace dynmesh {
 /// stated with the margin the checker uses.
 inline constexpr double kQuadtreeMinAngle = 18.4;
 
+/// The closure rule of T' (detail/quadtree_mesh_rules.hpp) on its sorted leaves: no leaf
+/// twice, exactly `npoints` leaves hold a point, and each of them has its 3x3 block of
+/// same-size leaves. Throws InvariantError. Shared by both meshers' check_invariants().
+void require_refined_tree(std::span<const Leaf<2>> leaves, std::size_t npoints);
+
 class QuadtreeMesh {
  public:
   /// Validates (InputError as DynamicMesh reports it, naming point indices) and meshes.
