@@ -25,6 +25,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bench_stats.hpp"
+
 #include "dynmesh/box.hpp"
 #include "dynmesh/distributions.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
@@ -33,25 +35,10 @@
 namespace {
 
 using namespace dynmesh;
-using Clock = std::chrono::steady_clock;
 
-template <class F>
-double seconds(F&& f) {
-  const auto t0 = Clock::now();
-  f();
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
-}
-double mean(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return v.empty() ? 0 : s / static_cast<double>(v.size());
-}
+using bench::mean;
+using bench::median;
+using bench::seconds;
 
 struct Row {
   int dim = 2;
