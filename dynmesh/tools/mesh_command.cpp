@@ -21,6 +21,7 @@
 
 #include "atomic_file.hpp"
 #include "commands.hpp"
+#include "input_labels.hpp"
 #include "dynmesh/box.hpp"
 #include "dynmesh/dynamic_mesh.hpp"
 #include "dynmesh/errors.hpp"
@@ -35,72 +36,6 @@ namespace dynmesh::tool {
 namespace {
 
 using Kind = InputError::Kind;
-
-// An error raised without a file name gets `file` (and `line` when it has none).
-[[noreturn]] void rethrow_in(const InputError& e, const std::string& file, std::size_t line = 0) {
-  if (!e.file().empty()) throw e;
-  throw InputError(e.kind(), e.text(), file, e.line() != 0 ? e.line() : line);
-}
-
-Box<2> box_from_option(const std::vector<double>& values) {
-  if (values.size() != 3)
-    throw InputError(Kind::Malformed, "--box needs 3 numbers (o1 o2 L) for 2D points, got " +
-                                          std::to_string(values.size()));
-  Box<2> box;
-  box.origin[0] = values[0];
-  box.origin[1] = values[1];
-  box.side = values[2];
-  validate_box(box);
-  return box;
-}
-
-// The error of edit i of the script as "FILE:LINE: insert (x, y): why" (the point only
-// once; an "edit K: " prefix from a batch dropped, the line names the edit).
-InputError edit_error(const EditScript<2>& script, std::size_t i, const InputError& err) {
-  const Edit<2>& e = script.edits[i];
-  std::string why = err.text();
-  if (why.rfind("edit ", 0) == 0)
-    if (const auto colon = why.find(": "); colon != std::string::npos) why.erase(0, colon + 2);
-  const std::string point = to_string<2>(e.point);
-  std::string text = e.op == EditOp::Insert ? "insert" : "delete";
-  if (why.find(point) == std::string::npos) text += " " + point;
-  return InputError(err.kind(), text + ": " + why, script.name, script.lines[i]);
-}
-
-// The mesh's constructor names point indices (e.g. a pair closer than the resolution);
-// re-label them with the lines of the point file.
-[[noreturn]] void rethrow_construction_error(const InputError& e, const PointFile<2>& file,
-                                             const std::vector<Position<2>>& located) {
-  auto line_of = [&](std::size_t i) { return i < file.lines.size() ? file.lines[i] : std::size_t{0}; };
-  std::vector<std::size_t> idx = e.point_indices();
-  if (idx.empty()) rethrow_in(e, file.name);
-  if (e.kind() == Kind::Resolution && idx.size() == 1 && idx[0] < located.size()) {
-    // Name the partner too: a point within one grid unit per axis.
-    for (std::size_t j = 0; j < located.size(); ++j) {
-      bool near = j != idx[0];
-      for (std::size_t a = 0; a < 2 && near; ++a) {
-        const std::uint64_t x = located[j][a], y = located[idx[0]][a];
-        near = (x > y ? x - y : y - x) <= 1;
-      }
-      if (near) {
-        idx.push_back(j);
-        break;
-      }
-    }
-  }
-  std::sort(idx.begin(), idx.end());
-  std::string text = e.text();
-  for (const std::size_t i : idx) {
-    const std::string prefix = "point " + std::to_string(i) + ": ";
-    if (text.compare(0, prefix.size(), prefix) == 0) text.erase(0, prefix.size());
-  }
-  if (idx.size() > 1) {
-    text += " (lines";
-    for (std::size_t k = 0; k < idx.size(); ++k) text += (k ? ", " : " ") + std::to_string(line_of(idx[k]));
-    text += ")";
-  }
-  throw InputError(e.kind(), text, file.name, line_of(idx.back()));
-}
 
 std::string angle_text(double deg) {
   char buf[32];
@@ -147,7 +82,7 @@ int run_mesh(const MeshCommandOptions& o) {
       rethrow_in(e, file.name);
     }
   } else {
-    box = box_from_option(o.box);
+    box = box_from_option<2>(o.box);
   }
   // Outside the box, NaN, duplicates: named by line here, before the mesh sees the points.
   const std::vector<Position<2>> located = locate_points<2>(file, box);
@@ -161,7 +96,7 @@ int run_mesh(const MeshCommandOptions& o) {
   try {
     built.emplace(box, std::span<const Point<2>>(file.points), mesh_options);
   } catch (const InputError& e) {
-    rethrow_construction_error(e, file, located);
+    rethrow_construction_error<2>(e, file, located);
   }
   DynamicMesh& dm = *built;
 
@@ -186,7 +121,7 @@ int run_mesh(const MeshCommandOptions& o) {
           else
             dm.erase(e.point);
         } catch (const InputError& err) {
-          throw edit_error(script, i, err);
+          throw edit_error<2>(script, i, err);
         }
         record();
         progress.tick(i + 1);
@@ -199,7 +134,7 @@ int run_mesh(const MeshCommandOptions& o) {
         } catch (const InputError& err) {
           // apply() names the failing edit by its index in the batch.
           if (err.point_indices().empty()) rethrow_in(err, o.edits);
-          throw edit_error(script, i + err.point_indices().back(), err);
+          throw edit_error<2>(script, i + err.point_indices().back(), err);
         }
         record();
         progress.tick(i + k);
