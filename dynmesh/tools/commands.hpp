@@ -51,6 +51,9 @@ struct MeshCommandOptions {
 
 struct StabilityOptions {
   int dim = 2;
+  std::string postprocess;       // --postprocess none|quadtree|hpu (empty: none, the tree alone)
+  double min_angle = 0;          // --min-angle DEG (checked on the final mesh)
+  bool min_angle_given = false;  // --min-angle appeared
   std::string dist;
   std::size_t n = 0;
   double spread = 0x1p20;

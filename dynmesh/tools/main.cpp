@@ -5,7 +5,7 @@
 //                [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F] [--msh F] [--svg F]
 //                [--check] [--stats]
 //   dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]
-//                     --csv OUT.csv [--plot OUT.svg]
+//                     [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv [--plot OUT.svg]
 //   dynmesh demo [--n N] [--updates U] [--seed X] [--svg OUT.svg]
 // Exit status: 0 on success; 1 with exactly one line `dynmesh: <message>` on stderr on any
 // error; 2 for a command line CLI11 rejects (also one line).
@@ -88,6 +88,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   stability->add_option("--updates", s.updates, "updates measured")->capture_default_str();
   stability->add_option("--seed", s.seed, "random seed")->capture_default_str();
+  stability->add_option("--postprocess", s.postprocess,
+                        "none (the default: the quadtree alone), quadtree (2D: the quadtree mesh too) or hpu; "
+                        "with a mesh, trace_distance and seconds count the whole update, tree and mesh");
+  CLI::Option* stability_angle_opt = stability->add_option(
+      "--min-angle", s.min_angle, "with a mesh: the smallest angle checked on the final mesh (quadtree: <= 18.4)");
   stability->add_option("--csv", s.csv, "output CSV (appended to; header written when new or empty)")->required();
   stability->add_option("--plot", s.plot, "also plot every row of the CSV with gnuplot (SVG)");
 
@@ -116,7 +121,10 @@ int main(int argc, char** argv) {
       me.min_angle_given = min_angle_opt->count() > 0;
       return run_mesh(me);
     }
-    if (*stability) return run_stability(s);
+    if (*stability) {
+      s.min_angle_given = stability_angle_opt->count() > 0;
+      return run_stability(s);
+    }
     if (*demo) return run_demo(m);
   } catch (const std::exception& e) {
     std::fflush(stdout);

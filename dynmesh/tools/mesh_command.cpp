@@ -22,6 +22,7 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "input_labels.hpp"
+#include "postprocess_option.hpp"
 #include "dynmesh/box.hpp"
 #include "dynmesh/dynamic_mesh.hpp"
 #include "dynmesh/errors.hpp"
@@ -31,33 +32,17 @@
 #include "dynmesh/mesh_io.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
 #include "progress.hpp"
+#include "verify.hpp"
 
 namespace dynmesh::tool {
 namespace {
 
 using Kind = InputError::Kind;
 
-std::string angle_text(double deg) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", deg);
-  return buf;
-}
-
 // The postprocess and angle options, checked before any file is read.
 void check_mesh_options(const MeshCommandOptions& o) {
-  if (o.postprocess.empty() || o.postprocess == "hpu")
-    throw InputError(Kind::Malformed,
-                     "the hpu postprocess is not available yet (it is the default; pass --postprocess quadtree)");
-  if (o.postprocess != "quadtree")
-    throw InputError(Kind::Malformed, "unknown --postprocess '" + o.postprocess + "' (hpu or quadtree)");
-  if (o.min_angle_given) {
-    if (!std::isfinite(o.min_angle) || o.min_angle < 0)
-      throw InputError(Kind::Malformed, "--min-angle must be a finite angle of at least 0 degrees");
-    if (o.min_angle > kQuadtreeMinAngle)
-      throw InputError(Kind::Malformed, "--min-angle " + angle_text(o.min_angle) +
-                                            " is above the quadtree mesh's bound of " +
-                                            angle_text(kQuadtreeMinAngle) + " degrees");
-  }
+  check_postprocess(o.postprocess, /*allow_none=*/false,
+                    o.min_angle_given ? std::optional<double>(o.min_angle) : std::nullopt);
   if (o.outbase.empty()) throw InputError(Kind::Malformed, "-o needs a non-empty OUTBASE");
 }
 
@@ -149,17 +134,8 @@ int run_mesh(const MeshCommandOptions& o) {
 
   if (o.check) {
     // Everything is checked before any output is written: a failed check leaves old files.
-    dm.check_invariants();
-    MeshCheckOptions check_options;
-    check_options.min_angle_deg = bound;
-    const MeshReport report = check_mesh(mesh, box, inputs, check_options);
-    if (!report.ok()) throw InvariantError("--check failed: " + report.summary());
-    const QuadtreeMesh scratch(box, inputs);
-    const Mesh fresh = scratch.mesh();
-    if (format_node(fresh, box) != node_text || format_ele(fresh) != ele_text)
-      throw InvariantError("--check failed: the dynamic mesh differs from a from-scratch mesh of the final " +
-                           std::to_string(inputs.size()) + " points (" + std::to_string(mesh.num_triangles()) +
-                           " vs " + std::to_string(fresh.num_triangles()) + " triangles)");
+    const Verification v = verify(dm, bound);
+    if (!v.ok) throw InvariantError("--check failed: " + v.problem);
   }
 
   AtomicOutputs out;

@@ -1,7 +1,9 @@
 // `dynmesh stability`: the trace-distance experiment of shared/FORMATS.md. Builds the tree on
 // N points of a distribution, then measures U single-point updates (alternating deletions of
 // a present point and insertions of a new point of the same distribution, one propagation
-// each) and appends one CSV row per update.
+// each) and appends one CSV row per update. With `--postprocess quadtree` (2D) the structure
+// is a DynamicMesh: QuadTreeRefine and the quadtree mesh run in one trace, so each row's
+// trace_distance and seconds are the whole update, tree and mesh (FORMATS.md).
 //
 // The N initial points and the insertion pool come from one call generate(dist, N + U, seed,
 // spread): the generators return their points in a seeded random order, so the first N are
@@ -15,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -22,8 +25,10 @@
 #include "commands.hpp"
 #include "dynmesh/box.hpp"
 #include "dynmesh/distributions.hpp"
+#include "dynmesh/dynamic_mesh.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/errors.hpp"
+#include "postprocess_option.hpp"
 #include "progress.hpp"
 #include "update_driver.hpp"
 #include "verify.hpp"
@@ -66,16 +71,32 @@ std::ofstream open_csv(const std::string& path) {
   return out;
 }
 
+// The structure a run measures: the tree alone, or the tree and its mesh.
 template <std::size_t d>
-int run(const StabilityOptions& o, Distribution dist) {
+DynamicQuadtree<d> build(const Box<d>& box, std::span<const Point<d>> pts, const DynamicQuadtree<d>*) {
+  return DynamicQuadtree<d>(box, pts);
+}
+inline DynamicMesh build(const Box<2>& box, std::span<const Point<2>> pts, const DynamicMesh*) {
+  MeshOptions options;
+  options.postprocess = Postprocess::Quadtree;
+  return DynamicMesh(box, pts, options);
+}
+
+template <std::size_t d>
+Verification verify_final(const DynamicQuadtree<d>& tree, double) {
+  return verify(tree);
+}
+inline Verification verify_final(const DynamicMesh& mesh, double min_angle) { return verify(mesh, min_angle); }
+
+template <std::size_t d, class Structure>
+int run(const StabilityOptions& o, Distribution dist, const char* what) {
   std::vector<Point<d>> all = generate<d>(dist, o.n + o.updates, o.seed, o.spread);
   std::vector<Point<d>> pool(all.begin() + static_cast<std::ptrdiff_t>(o.n), all.end());
   all.resize(o.n);
   const Box<d> box = derive_box<d>(all);
-  DynamicQuadtree<d> tree(box, std::span<const Point<d>>(all));
-  UpdateDriver<d> driver(tree, std::move(pool), o.seed);
+  Structure structure = build(box, std::span<const Point<d>>(all), static_cast<const Structure*>(nullptr));
+  UpdateDriver<d, Structure> driver(structure, std::move(pool), o.seed);
   const double initial_spread = driver.log2_spread();
-
   const std::string prefix =
       std::string(distribution_name(dist)) + ',' + std::to_string(d) + ',' + std::to_string(o.n) + ',';
   std::string rows;
@@ -100,14 +121,14 @@ int run(const StabilityOptions& o, Distribution dist) {
   if (!csv) throw InputError(Kind::Io, "write error", o.csv);
   csv.close();
 
-  // History independence on every run: the updated tree must equal a from-scratch build on
-  // the final points (the rows are written first, so a failure keeps them for inspection).
-  const Verification v = verify(tree);
+  // History independence on every run: the updated structure must equal a from-scratch build
+  // on the final points (the rows are written first, so a failure keeps them for inspection).
+  const Verification v = verify_final(structure, o.min_angle_given ? o.min_angle : kQuadtreeMinAngle);
   if (!v.ok) throw InvariantError("verification failed after the updates: " + v.problem);
 
-  std::printf("stability: %s %zuD, n = %zu, log2(L/s) = %.2f, %zu updates, mean trace distance %.1f, "
+  std::printf("stability: %s, %s %zuD, n = %zu, log2(L/s) = %.2f, %zu updates, mean trace distance %.1f, "
               "verified against a from-scratch build; rows appended to %s\n",
-              std::string(distribution_name(dist)).c_str(), d, o.n, initial_spread, o.updates,
+              what, std::string(distribution_name(dist)).c_str(), d, o.n, initial_spread, o.updates,
               o.updates ? static_cast<double>(total_distance) / static_cast<double>(o.updates) : 0.0,
               o.csv.c_str());
   if (!o.plot.empty()) {
@@ -126,7 +147,12 @@ int run_stability(const StabilityOptions& o) {
   if (o.n < 2) throw InputError(Kind::Count, "--n must be at least 2 (the spread needs a closest pair)");
   if (!(std::isfinite(o.spread) && o.spread >= 2))
     throw InputError(Kind::Malformed, "--spread must be a finite number >= 2");
-  return o.dim == 3 ? run<3>(o, *dist) : run<2>(o, *dist);
+  const PostprocessChoice choice = check_postprocess(
+      o.postprocess, /*allow_none=*/true, o.min_angle_given ? std::optional<double>(o.min_angle) : std::nullopt);
+  if (choice == PostprocessChoice::None)
+    return o.dim == 3 ? run<3, DynamicQuadtree<3>>(o, *dist, "quadtree") : run<2, DynamicQuadtree<2>>(o, *dist, "quadtree");
+  if (o.dim != 2) throw InputError(Kind::Malformed, "--postprocess " + o.postprocess + " meshes in 2D only (--dim 2)");
+  return run<2, DynamicMesh>(o, *dist, "quadtree mesh");
 }
 
 }  // namespace dynmesh::tool

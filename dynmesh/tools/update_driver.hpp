@@ -1,6 +1,8 @@
 // dynmesh/tools/update_driver.hpp — the single-point update sequence of `stability` and `demo`.
 //
-// Purpose: drives a DynamicQuadtree through alternating updates, one propagation each:
+// Purpose: drives a DynamicQuadtree<d> or a DynamicMesh (any `Structure` with points(),
+// insert(p) -> PointId, erase(id), last_update() and box()) through alternating updates, one
+// propagation each:
 // even steps delete a present point chosen uniformly (Rng::below), odd steps insert the
 // next point of an insertion pool drawn from the same distribution as the initial points.
 // A pool point the tree rejects (outside the box, a duplicate, closer than the resolution
@@ -44,17 +46,17 @@
 
 namespace dynmesh::tool {
 
-template <std::size_t d>
+template <std::size_t d, class Structure = DynamicQuadtree<d>>
 class UpdateDriver {
  public:
   struct Step {
     EditOp op;
-    UpdateStats stats;  // the tree's last_update() of this step
+    UpdateStats stats;  // the structure's last_update() of this step
     double log2_spread;
   };
 
   /// Starts from the tree's current points; `pool` supplies the insertions, in order.
-  UpdateDriver(DynamicQuadtree<d>& tree, std::vector<Point<d>> pool, std::uint64_t seed)
+  UpdateDriver(Structure& tree, std::vector<Point<d>> pool, std::uint64_t seed)
       : tree_(tree), pool_(std::move(pool)), rng_(seed ^ 0x7570'6461'7465'7321ULL) {
     for (auto& entry : tree_.points()) present_.push_back(entry);
     std::vector<Point<d>> pts = coordinates();
@@ -140,7 +142,7 @@ class UpdateDriver {
     }
   }
 
-  DynamicQuadtree<d>& tree_;
+  Structure& tree_;
   std::vector<Point<d>> pool_;
   std::size_t next_pool_ = 0;
   std::deque<Point<d>> deleted_;

@@ -1,6 +1,6 @@
 // dynmesh/tools/verify.hpp — checking a dynamic tree against a from-scratch static build.
 //
-// Purpose: `quadtree --check` and `demo` verify the dynamic tree after its updates:
+// Purpose: `quadtree --check`, `stability` and `demo` verify the dynamic tree after its updates:
 //   1. the static oracle StaticQuadtree::from_points on the tree's final points, in the
 //      same box, must give the same `.cells` text (format_cells, byte for byte);
 //   2. check_tree on the dynamic leaves and the located points must pass
@@ -22,9 +22,12 @@
 
 #include <sac/errors.hpp>
 
+#include "dynmesh/dynamic_mesh.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/io.hpp"
+#include "dynmesh/mesh_check.hpp"
+#include "dynmesh/quadtree_mesh.hpp"
 #include "dynmesh/static_quadtree.hpp"
 
 namespace dynmesh::tool {
@@ -89,6 +92,44 @@ Verification verify(const DynamicQuadtree<d>& tree) {
     return v;
   } catch (const sac::InvariantError& e) {
     v.problem = "runtime invariant check failed: " + one_line(e.what());
+    return v;
+  }
+  v.ok = true;
+  return v;
+}
+
+/// The mesh's counterpart, for `mesh --check` and `stability --postprocess`: the engine and
+/// T' invariants, check_mesh with `min_angle_deg` on the final mesh, then the static twin on
+/// the final points must give the same canonical mesh.
+inline Verification verify(const DynamicMesh& dm, double min_angle_deg) {
+  Verification v;
+  std::vector<Point<2>> pts;
+  for (const auto& entry : dm.points()) pts.push_back(entry.second);
+  const Mesh mesh = dm.mesh();
+  try {
+    dm.check_invariants();
+  } catch (const dynmesh::InvariantError& e) {
+    v.problem = "invariant check failed: " + one_line(e.what());
+    return v;
+  } catch (const sac::InvariantError& e) {
+    v.problem = "runtime invariant check failed: " + one_line(e.what());
+    return v;
+  }
+  MeshCheckOptions check_options;
+  check_options.min_angle_deg = min_angle_deg;
+  const MeshReport report = check_mesh(mesh, dm.box(), pts, check_options);
+  if (!report.ok()) {
+    v.problem = "mesh check failed: " + one_line(report.summary());
+    return v;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const QuadtreeMesh scratch(dm.box(), pts);
+  v.static_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const Mesh fresh = scratch.mesh();
+  if (fresh != mesh) {
+    v.problem = "the dynamic mesh differs from a from-scratch mesh of the final " + std::to_string(pts.size()) +
+                " points (" + std::to_string(mesh.num_triangles()) + " vs " + std::to_string(fresh.num_triangles()) +
+                " triangles)";
     return v;
   }
   v.ok = true;

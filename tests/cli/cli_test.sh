@@ -122,6 +122,24 @@ case $case_name in
       !(($1 == "uniform" && $2 == 2 && $3 == 300) || ($1 == "shrinking" && $2 == 3 && $3 == 300)) { bad = 1; print }
       END { exit bad }' || fail "malformed rows"
     [[ $(grep -c ',delete,' s.csv) -eq 25 && $(grep -c ',insert,' s.csv) -eq 25 ]] || fail "not half deletions"
+    # --postprocess quadtree: the same updates (same seed) measured through tree and mesh, so
+    # every row's trace distance includes the tree's, and the run verifies the final mesh.
+    run "$dynmesh" stability --dim 2 --dist clusters --n 400 --updates 40 --seed 3 --csv tree.csv
+    run "$dynmesh" stability --dim 2 --dist clusters --n 400 --updates 40 --seed 3 --postprocess quadtree \
+      --min-angle 18.4 --csv mesh.csv
+    grep -q 'quadtree mesh, clusters 2D' out.txt || fail "the mesh run did not say it measured the mesh"
+    [[ $(wc -l <mesh.csv) -eq 41 ]] || fail "mesh CSV: expected header + 40 rows"
+    paste -d, <(tail -n +2 tree.csv) <(tail -n +2 mesh.csv) | awk -F, '$4 != $11 || $5 != $12 || $13 <= $6 { bad = 1; print }
+      END { exit bad }' || fail "mesh rows do not follow the tree rows (same ops and spreads, larger distances)"
+    expect_error 1 'hpu postprocess is not available yet' "$dynmesh" stability --dim 2 --dist uniform --n 50 \
+      --postprocess hpu --csv e.csv
+    expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess quadtree \
+      --csv e.csv
+    expect_error 1 '--min-angle needs a mesh' "$dynmesh" stability --dim 2 --dist uniform --n 50 --min-angle 10 \
+      --csv e.csv
+    expect_error 1 'above the quadtree' "$dynmesh" stability --dim 2 --dist uniform --n 50 --postprocess quadtree \
+      --min-angle 30 --csv e.csv
+    [[ ! -e e.csv ]] || fail "a refused stability run wrote its CSV"
     if command -v gnuplot >/dev/null; then
       run "$dynmesh" stability --dim 2 --dist clusters --n 300 --updates 10 --csv s.csv --plot plot.svg
       head -c 200 plot.svg | grep -q '<svg\|<?xml' || fail "plot.svg is not SVG"

@@ -1,0 +1,64 @@
+// dynmesh/tools/postprocess_option.hpp — the `--postprocess` and `--min-angle` options of
+// `dynmesh mesh` and `dynmesh stability` (shared/FORMATS.md), checked in one place.
+//
+// Purpose: both commands name a postprocess and may ask for an angle bound; the names, the
+// "not available yet" refusal of hpu and the bound each postprocess guarantees are stated
+// once here so the two commands cannot drift apart.
+// Invariants: check_postprocess either returns a choice whose bound is >= the requested
+// angle, or throws InputError (Malformed) before any file is read.
+// Complexity: O(1).
+// Paper: Acar & Hudson, Section 5 (the postprocesses); Bern, Eppstein & Gilbert (the
+// quadtree mesh's arctan(1/3) bound).
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <optional>
+#include <string>
+
+#include "dynmesh/errors.hpp"
+#include "dynmesh/quadtree_mesh.hpp"
+
+namespace dynmesh::tool {
+
+enum class PostprocessChoice { None, Quadtree, Hpu };
+
+inline std::string angle_text(double deg) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", deg);
+  return buf;
+}
+
+/// `name` is the option's value ("" is the command's default: `hpu` for mesh, `none` for
+/// stability, as `allow_none` says); `min_angle` is --min-angle when given.
+inline PostprocessChoice check_postprocess(const std::string& name, bool allow_none,
+                                           std::optional<double> min_angle) {
+  using Kind = InputError::Kind;
+  const std::string value = name.empty() ? (allow_none ? "none" : "hpu") : name;
+  const std::string known = allow_none ? "none, quadtree or hpu" : "hpu or quadtree";
+  PostprocessChoice choice;
+  if (value == "hpu") {
+    throw InputError(Kind::Malformed,
+                     std::string("the hpu postprocess is not available yet") +
+                         (name.empty() ? " (it is the default; pass --postprocess quadtree)" : ""));
+  } else if (value == "quadtree") {
+    choice = PostprocessChoice::Quadtree;
+  } else if (value == "none" && allow_none) {
+    choice = PostprocessChoice::None;
+  } else {
+    throw InputError(Kind::Malformed, "unknown --postprocess '" + value + "' (" + known + ")");
+  }
+  if (min_angle) {
+    if (choice == PostprocessChoice::None)
+      throw InputError(Kind::Malformed, "--min-angle needs a mesh: pass --postprocess quadtree");
+    if (!std::isfinite(*min_angle) || *min_angle < 0)
+      throw InputError(Kind::Malformed, "--min-angle must be a finite angle of at least 0 degrees");
+    if (*min_angle > kQuadtreeMinAngle)
+      throw InputError(Kind::Malformed, "--min-angle " + angle_text(*min_angle) +
+                                            " is above the quadtree mesh's bound of " +
+                                            angle_text(kQuadtreeMinAngle) + " degrees");
+  }
+  return choice;
+}
+
+}  // namespace dynmesh::tool
