@@ -590,6 +590,7 @@ void Engine::check_invariants() const {
   std::uint64_t events = 0;
   std::size_t nkeyed = 0, nmemo = 0;
   std::unordered_set<const ModBase*> mods;
+  std::unordered_set<const ReadNode*> reads;
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     switch (s->kind()) {
       case StampKind::ReadStart: {
@@ -598,13 +599,12 @@ void Engine::check_invariants() const {
         if (r->flags & detail::kReadDead) fail("dead read in the trace");
         if (!(r->flags & detail::kReadEndLinked)) fail("read without end stamp");
         if (!r->end.linked() || !order_.less(&r->start, &r->end)) fail("read end not after start");
-        // Attached to the version visible at its start.
-        const VersionBase* vis = visible(*r->mod, &r->start);
-        if (!vis) fail("read of a modifiable with no visible version");
-        bool found = false;
-        for (const ReadNode* x = vis->readers; x; x = x->rnext)
-          if (x == r) found = true;
-        if (!found) fail("read not attached to the version visible at its time");
+        // Attachment to the version visible at its start is checked below, from the
+        // version side: scanning the visible version's readers here would be quadratic in
+        // a modifiable's fan-out (a coarse cell is read by every point's descent).
+        if (!visible(*r->mod, &r->start)) fail("read of a modifiable with no visible version");
+        reads.insert(r);
+        mods.insert(r->mod);
         if (r->qpos != kNotQueued) fail("read still queued");
         stack.push_back({&r->end, false});
         break;
@@ -657,8 +657,10 @@ void Engine::check_invariants() const {
   if (nkeyed != allocs_.size()) fail("allocation table size mismatch");
   if (nmemo != memos_.size()) fail("memo table size mismatch");
 
-  // Versions of every written modifiable: strictly decreasing time, base last, readers
-  // between this version and the next newer one.
+  // Versions of every written or read modifiable: strictly decreasing time, base last,
+  // readers between this version and the next newer one (so each reader hangs on the version
+  // visible at its time), and every reader a live read of the trace, each exactly once.
+  std::size_t attached = 0;
   for (const ModBase* m : mods) {
     const VersionBase* newer = nullptr;
     for (const VersionBase* v = m->newest_; v; v = v->older()) {
@@ -673,10 +675,13 @@ void Engine::check_invariants() const {
         if (r->mod != m) fail("reader of another modifiable");
         if (!v->is_base() && !order_.less(&v->stamp, &r->start)) fail("reader before its version");
         if (newer && !order_.less(&r->start, &newer->stamp)) fail("reader after the next version");
+        if (!reads.count(r)) fail("a version's reader is not a live read of the trace");
+        ++attached;
       }
       newer = v;
     }
   }
+  if (attached != reads.size()) fail("read not attached to the version visible at its time");
   allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops->hash(n); },
                            [&](const AllocNode* n) {
                              if (!n->stamp.linked()) fail("allocation table holds an undone record");
