@@ -19,18 +19,26 @@ deps() {
   echo "dev.sh: installing missing packages: ${missing[*]}" >&2
   local sudo=""
   [[ $(id -u) -eq 0 ]] || sudo=sudo
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get update
-  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends "${missing[@]}" </dev/null
+  # Wait (up to 10 minutes) for another apt or unattended-upgrades to release the dpkg lock
+  # instead of failing at once.
+  local lock=(-o DPkg::Lock::Timeout=600)
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get "${lock[@]}" update
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get "${lock[@]}" install -y --no-install-recommends "${missing[@]}" </dev/null
 }
 
-# build DIR [cmake args...]: configure with Ninja and build.
+# build DIR [cmake args...]: configure with Ninja and build everything (tests, benchmarks).
 build() {
   local dir=$1; shift
   cmake -S "$ROOT" -B "$dir" -G Ninja "$@"
   cmake --build "$dir" -j "$JOBS"
 }
 
-build_release() { build build/release -DCMAKE_BUILD_TYPE=Release; }
+# build_release TARGET...: configure build/release (Release) and build only the TARGETs a
+# job runs, not every test and benchmark.
+build_release() {
+  cmake -S "$ROOT" -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release
+  cmake --build build/release -j "$JOBS" --target "$@"
+}
 
 # has_opt NAME ARGS...: true if ARGS contain NAME or NAME=...
 has_opt() {
@@ -63,7 +71,7 @@ bench_job() {
   build/release/bin/dynmesh_bench --dim 3 --n 1000,10000,100000 --updates 1000 --reps 3 "$@"
 }
 
-cmd_run() { deps; build_release; main_job "$@"; }
+cmd_run() { deps; build_release dynmesh_cli; main_job "$@"; }  # dynmesh_cli: bin/dynmesh
 
 cmd_test() {
   deps
@@ -82,16 +90,16 @@ cmd_asan() {
     ctest --test-dir build/asan --output-on-failure --no-tests=error -j "$JOBS" -LE '^bench$'
 }
 
-cmd_bench() { deps; build_release; bench_job "$@"; }
+cmd_bench() { deps; build_release sac_suite dynmesh_bench; bench_job "$@"; }  # what bench_job runs
 
 usage() {
   cat >&2 <<'USAGE'
 usage: bash dev.sh COMMAND [args]
   deps         install missing Debian packages (apt-get; sudo when not root)
-  run [args]   Release build into build/release, then the main job (dynmesh demo [args])
+  run [args]   Release build of bin/dynmesh into build/release, then the main job (dynmesh demo [args])
   test         RelWithDebInfo build (asserts on, -Werror) into build/debug, then every ctest test
   asan         Debug build with ASan+UBSan (clang++ if present) into build/asan, then ctest
-  bench        Release build, then sac_suite at the README sizes
+  bench        Release build of the benchmarks, then sac_suite and dynmesh_bench at the README sizes
 USAGE
 }
 

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <istream>
 #include <limits>
@@ -28,27 +29,39 @@ std::string quoted(std::string_view tok) {
   return s;
 }
 
-/// Reads a file line by line, strips comments ('#' to the end of the line) and splits the
-/// rest on whitespace. Keeps the current 1-based line number for error messages.
+/// How fields are separated: whitespace only (`.node`, `.cells`), or also a ',' or ';' with
+/// optional whitespace around it (plain point files and edit scripts, which spreadsheets and
+/// CSV exports write).
+enum class Separators { Whitespace, Lists };
+
+/// Reads a file line by line, skips a UTF-8 byte order mark at its start, strips comments
+/// ('#' to the end of the line) and splits the rest into fields. Keeps the current 1-based
+/// line number for error messages.
 class LineReader {
  public:
-  LineReader(std::istream& in, const std::string& name) : in_(in), name_(name) {}
+  LineReader(std::istream& in, const std::string& name, Separators separators = Separators::Whitespace)
+      : in_(in), name_(name), separators_(separators) {}
 
   /// The fields of the next line that has any (blank and comment-only lines are skipped).
   /// With comments = false, '#' is an ordinary character and blank lines are returned too
   /// (used for the strict `.cells` reader). False at the end of the input.
   bool next(std::vector<std::string_view>& fields, bool comments = true) {
+    errno = 0;
     while (std::getline(in_, buf_)) {
       ++line_;
+      if (line_ == 1 && buf_.starts_with(kBom)) buf_.erase(0, kBom.size());  // editors on Windows
       if (!buf_.empty() && buf_.back() == '\r') buf_.pop_back();  // CRLF files
       std::string_view text = buf_;
       if (comments) {
         if (const auto hash = text.find('#'); hash != std::string_view::npos) text = text.substr(0, hash);
       }
-      split(text, fields);
+      if (separators_ == Separators::Lists)
+        split_lists(text, fields);
+      else
+        split(text, fields);
       if (!fields.empty() || !comments) return true;
     }
-    if (in_.bad()) fail(Kind::Io, "read error");
+    if (in_.bad()) fail(Kind::Io, std::string("read error") + (errno ? std::string(": ") + std::strerror(errno) : ""));
     return false;
   }
 
@@ -98,18 +111,72 @@ class LineReader {
     return v;
   }
 
+  /// With Separators::Lists: the separators after fields first .. first + count − 1 (those
+  /// the line has) must be all whitespace or all ',' / ';'. A mix is most likely a decimal
+  /// comma ("1,5 2" is not the point (1, 5)), so it is an error naming the token.
+  void require_one_separator_kind(const std::vector<std::string_view>& fields, std::size_t first,
+                                  std::size_t count) const {
+    std::size_t listed = 0, spaced = 0, first_listed = 0;
+    for (std::size_t k = first; k < std::min(listed_.size(), first + count); ++k) {
+      if (listed_[k] && listed++ == 0) first_listed = k;
+      spaced += !listed_[k];
+    }
+    if (listed == 0 || spaced == 0) return;
+    // The whitespace-delimited token around that ',' or ';' (e.g. "1,5").
+    const std::string_view text = buf_;
+    const auto field_end = static_cast<std::size_t>(fields[first_listed].data() - text.data()) +
+                           fields[first_listed].size();
+    const std::size_t sep = text.find_first_of(",;", field_end);
+    const std::size_t before = text.find_last_of(kSpace, sep);
+    const std::size_t from = before == std::string_view::npos ? 0 : before + 1;
+    const std::size_t to = std::min(text.find_first_of(kSpace, sep), text.size());
+    fail(Kind::Malformed, "malformed number " + quoted(text.substr(from, to - from)) +
+                              ": separate the coordinates by whitespace alone or by ',' or ';' throughout the "
+                              "line (a decimal comma?)");
+  }
+
  private:
+  static constexpr std::string_view kBom = "\xEF\xBB\xBF";
+  static constexpr std::string_view kSpace = " \t\r\v\f";
+
   static void split(std::string_view text, std::vector<std::string_view>& fields) {
     fields.clear();
-    constexpr std::string_view ws = " \t\r\v\f";
     std::size_t i = 0;
     while (true) {
-      i = text.find_first_not_of(ws, i);
+      i = text.find_first_not_of(kSpace, i);
       if (i == std::string_view::npos) break;
-      std::size_t j = text.find_first_of(ws, i);
+      std::size_t j = text.find_first_of(kSpace, i);
       if (j == std::string_view::npos) j = text.size();
       fields.push_back(text.substr(i, j - i));
       i = j;
+    }
+  }
+
+  /// Splits on whitespace and on ',' / ';' (whitespace around them allowed); listed_[k] says
+  /// whether a ',' or ';' separates field k from field k + 1. An empty field (",," or a ','
+  /// at either end) is an error.
+  void split_lists(std::string_view text, std::vector<std::string_view>& fields) {
+    constexpr std::string_view kSeparators = " \t\r\v\f,;";
+    auto is_list = [](char c) { return c == ',' || c == ';'; };
+    auto empty_field = [&] { fail(Kind::Malformed, "empty field: a ',' or ';' without a number on one side"); };
+    fields.clear();
+    listed_.clear();
+    std::size_t i = text.find_first_not_of(kSpace);
+    if (i == std::string_view::npos) return;
+    if (is_list(text[i])) empty_field();
+    while (true) {
+      std::size_t j = text.find_first_of(kSeparators, i);
+      if (j == std::string_view::npos) j = text.size();
+      fields.push_back(text.substr(i, j - i));
+      std::size_t k = text.find_first_not_of(kSpace, j);
+      if (k == std::string_view::npos) break;
+      const bool listed = is_list(text[k]);
+      if (listed) {
+        k = text.find_first_not_of(kSpace, k + 1);
+        if (k == std::string_view::npos || is_list(text[k])) empty_field();
+      }
+      listed_.push_back(listed);
+      i = k;
     }
   }
 
@@ -148,13 +215,22 @@ class LineReader {
 
   std::istream& in_;
   const std::string& name_;
+  Separators separators_;
   std::string buf_;
   std::size_t line_ = 0;
+  std::vector<bool> listed_;  // Lists: listed_[k] iff a ',' or ';' follows field k
 };
 
 std::ifstream open_input(const std::string& path) {
+  // A directory opens as a stream on Linux and only fails at the first read; say so up front.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(Kind::Io, "cannot read: is a directory", path);
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(Kind::Io, std::string("cannot open file: ") + std::strerror(errno), path);
+  if (!in) {
+    const int err = errno;  // the OS reason of the failed open (libstdc++ opens with fopen)
+    throw InputError(Kind::Io, std::string("cannot open file: ") + (err ? std::strerror(err) : "unknown reason"), path);
+  }
   return in;
 }
 
@@ -287,11 +363,12 @@ PointFile<d> read_node(std::istream& in, const std::string& name) {
 
 template <std::size_t d>
 PointFile<d> read_plain(std::istream& in, const std::string& name) {
-  LineReader r(in, name);
+  LineReader r(in, name, Separators::Lists);
   PointFile<d> out;
   out.name = name;
   std::vector<std::string_view> f;
   while (r.next(f)) {
+    r.require_one_separator_kind(f, 0, d);  // up to the separator after the last coordinate
     if (f.size() < d)
       r.fail(Kind::Count, "expected " + std::to_string(d) + " coordinates, found " + std::to_string(f.size()));
     Point<d> p;
@@ -349,14 +426,44 @@ std::vector<Position<d>> locate_points(const PointFile<d>& file, const Box<d>& b
       orig = order[first];
     }
   }
-  if (dup != n)
+  if (dup == n) return q;
+  if (file.points[dup] == file.points[orig])
     throw InputError(Kind::Duplicate,
                      "duplicate point " + to_string<d>(file.points[dup]) +
                          ": it has the same located position as the point on line " + std::to_string(line_of(orig)) +
                          " " + to_string<d>(file.points[orig]),
                      file.name, line_of(dup))
         .with_points({orig, dup});
-  return q;
+  // Different points that the grid cannot tell apart: the spread is beyond the resolution.
+  throw InputError(Kind::Resolution,
+                   "point " + to_string<d>(file.points[dup]) + " has the same located position as the point on line " +
+                       std::to_string(line_of(orig)) + " " + to_string<d>(file.points[orig]) + ": " +
+                       spread_text<d>(box, file.points[dup], file.points[orig]) + " exceeds the resolution of 2^52",
+                   file.name, line_of(dup))
+      .with_points({orig, dup});
+}
+
+template <std::size_t d>
+std::size_t drop_duplicate_points(PointFile<d>& file) {
+  const std::size_t n = file.points.size();
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  // Stable by index within equal coordinates, so the first copy in file order is kept.
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return file.points[a] != file.points[b] ? file.points[a] < file.points[b] : a < b;
+  });
+  std::vector<bool> drop(n, false);
+  for (std::size_t k = 1; k < n; ++k) drop[order[k]] = file.points[order[k]] == file.points[order[k - 1]];
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (drop[i]) continue;
+    file.points[kept] = file.points[i];
+    if (i < file.lines.size()) file.lines[kept] = file.lines[i];
+    ++kept;
+  }
+  file.points.resize(kept);
+  if (file.lines.size() > kept) file.lines.resize(kept);
+  return n - kept;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -364,11 +471,12 @@ std::vector<Position<d>> locate_points(const PointFile<d>& file, const Box<d>& b
 
 template <std::size_t d>
 EditScript<d> read_edits(std::istream& in, const std::string& name) {
-  LineReader r(in, name);
+  LineReader r(in, name, Separators::Lists);
   EditScript<d> out;
   out.name = name;
   std::vector<std::string_view> f;
   while (r.next(f)) {
+    r.require_one_separator_kind(f, 1, d);  // the sign stands apart; the coordinates agree
     EditOp op;
     if (f[0] == "+")
       op = EditOp::Insert;
@@ -499,6 +607,7 @@ CellsFile<d> read_cells_file(const std::string& path) {
   template PointFile<D> read_plain<D>(std::istream&, const std::string&);                            \
   template PointFile<D> read_points_file<D>(const std::string&, PointFormat);                        \
   template std::vector<Position<D>> locate_points<D>(const PointFile<D>&, const Box<D>&);            \
+  template std::size_t drop_duplicate_points<D>(PointFile<D>&);                                      \
   template EditScript<D> read_edits<D>(std::istream&, const std::string&);                           \
   template EditScript<D> read_edits_file<D>(const std::string&);                                     \
   template std::string format_cells<D>(const Box<D>&, std::span<const Leaf<D>>);                     \

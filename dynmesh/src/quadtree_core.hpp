@@ -252,10 +252,24 @@ class QuadtreeCore {
                            (noun.empty() ? std::string("points") : noun + "s") + " " + std::to_string(a->second) +
                                " and " + std::to_string(i) + " have the same located position")
               .with_points({a->second, i});
-        if (present(q))
-          fail(InputError::Kind::Duplicate, "point " + to_string<d>(e.point) +
-                                                " has the same located position as a point in the set");
-        check_resolution(q, present, [&](const std::string& text) { fail(InputError::Kind::Resolution, text); });
+        if (present(q)) {
+          // A different point at the same position is a spread beyond the resolution; say so.
+          const auto a = added.find(q);
+          const Point<d>& other = a != added.end() ? edits[a->second].point : by_pos.at(q)->point;
+          fail(InputError::Kind::Duplicate,
+               "point " + to_string<d>(e.point) + " has the same located position as a point in the set" +
+                   (other == e.point ? std::string{}
+                                     : " " + to_string<d>(other) + ": " + spread_text<d>(box, e.point, other) +
+                                           " exceeds the resolution of 2^52"));
+        }
+        check_resolution(q, present, [&](const Position<d>& near) {
+          // Name the near point and the spread the pair gives.
+          const auto a = added.find(near);
+          const Point<d>& other = a != added.end() ? edits[a->second].point : by_pos.at(near)->point;
+          fail(InputError::Kind::Resolution,
+               "point " + to_string<d>(e.point) + " lies within one grid unit (L/2^52) of " + to_string<d>(other) +
+                   ": " + spread_text<d>(box, e.point, other) + " exceeds the resolution of 2^52");
+        });
         extra.insert(q, e.point, [&](const std::string& text) { fail(InputError::Kind::Resolution, text); });
         added.emplace(q, i);
       } else {
@@ -274,15 +288,15 @@ class QuadtreeCore {
   }
 
   /// A level-52 cell would be crowded: another located point within one grid unit of q per
-  /// axis (q's level-52 neighbourhood): spread beyond the resolution.
+  /// axis (q's level-52 neighbourhood): spread beyond the resolution. `fail(near)` gets the
+  /// located position of that other point.
   template <class Present, class Fail>
   static void check_resolution(const Position<d>& q, Present&& present, Fail&& fail) {
-    bool near = false;
+    std::optional<Position<d>> near;
     for_each_neighbour(cell_of(q, kMaxLevel), [&](const CellId<d>& nb) {
-      if (!near && present(nb.index)) near = true;
+      if (!near && present(nb.index)) near = nb.index;
     });
-    if (near)
-      fail("another point lies within one grid unit (L/2^52): spread beyond the resolution of 2^52");
+    if (near) fail(*near);
   }
 
   // ------------------------------------------------------------------ building and updating

@@ -252,6 +252,8 @@ StaticQuadtree<d>::StaticQuadtree(std::span<const Position<d>> points) : points_
                                " (duplicate point)")
               .with_points({o->first, o->second});
       }
+      // Only positions are known here: s < 2·sqrt(d)·L/2^52 bounds the spread from below.
+      const std::string spread_floor = d == 2 ? "50.5" : "50.2";
       const CellId<d> c = crowded[kMaxLevel].front();
       const Occupancy* o = occ.find(c);
       std::uint32_t other = o->first;
@@ -264,8 +266,8 @@ StaticQuadtree<d>::StaticQuadtree(std::span<const Position<d>> points) : points_
                            std::to_string(std::max(o->first, other)) +
                            " are within one grid unit of each other (positions " +
                            position_string<d>(points_[o->first]) + " and " + position_string<d>(points_[other]) +
-                           "): a level-52 cell would have to split; the spread is beyond the "
-                           "resolution of 2^52")
+                           "): a level-52 cell would have to split; the spread L/s exceeds 2^" +
+                           spread_floor + " (s < 2·sqrt(d) grid units of L/2^52), beyond the resolution of 2^52")
           .with_points({std::min(o->first, other), std::max(o->first, other)});
     }
     active.swap(next);

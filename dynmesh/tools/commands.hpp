@@ -24,6 +24,7 @@ struct QuadtreeOptions {
   int dim = 2;              // --dim
   bool dim_given = false;   // --dim appeared (else a .node header decides)
   std::vector<double> box;  // --box o1 o2 [o3] L (empty: derive from the initial points)
+  bool skip_duplicates = false;  // --duplicates skip (default error)
   std::string edits;        // --edits FILE
   std::size_t batch = 0;    // --batch K (0: one propagation per edit)
   std::string cells;        // --cells OUT
@@ -35,6 +36,7 @@ struct QuadtreeOptions {
 struct MeshCommandOptions {
   std::string points;            // POINTS: .node or plain text (2D)
   std::vector<double> box;       // --box o1 o2 L (empty: derive from the initial points)
+  bool skip_duplicates = false;  // --duplicates skip (default error)
   std::string postprocess;       // --postprocess hpu|quadtree (empty: the default, hpu)
   double min_angle = 0;          // --min-angle DEG
   bool min_angle_given = false;  // --min-angle appeared

@@ -1,8 +1,8 @@
 // `dynmesh demo`: the README's main job, with an embedded input (no files needed). Builds the
 // dynamic quadtree on N points of the `clusters` distribution (fixed seed), applies U
 // single-point updates (alternating deletions and insertions, one propagation each), prints
-// the figures, verifies the final tree against a from-scratch static build and the checkers,
-// and draws the final tree.
+// the figures (led by the speedup of an update over a static rebuild), verifies the final
+// tree against a from-scratch static build and the checkers, and draws the final tree.
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
@@ -83,6 +83,12 @@ int run_demo(const DemoOptions& o) {
 
   const double mean_s = mean(seconds);
   std::printf("dynmesh demo: a well-graded quadtree kept up to date by change propagation\n");
+  // The headline: what an update saves over the alternative, rebuilding the tree statically
+  // (the self-adjusting build, slower than the static one, would flatter the ratio).
+  if (o.updates > 0 && mean_s > 0)
+    std::printf("  speedup            %.0fx: an update vs a static rebuild (%.3f s static build / %.1f us mean "
+                "update)\n",
+                v.static_seconds / mean_s, v.static_seconds, mean_s * 1e6);
   std::printf("  points             %zu (clusters distribution, 2D, seed %llu), log2(L/s) = %.1f\n", o.n,
               static_cast<unsigned long long>(o.seed), spread);
   std::printf("  leaves             %zu\n", leaves.size());
@@ -94,9 +100,7 @@ int run_demo(const DemoOptions& o) {
     std::printf("  update time        mean %.1f us, median %.1f us\n", mean_s * 1e6, median(seconds) * 1e6);
     std::printf("  trace distance     mean %.0f, median %.0f per update\n", mean(distances), median(distances));
     if (mean_s > 0)
-      std::printf("  speedup            %.0fx (self-adjusting build / mean update), "
-                  "%.0fx (static build / mean update)\n",
-                  build_s / mean_s, v.static_seconds / mean_s);
+      std::printf("  vs own build       %.0fx (self-adjusting build / mean update)\n", build_s / mean_s);
   }
   std::printf("  live trace         %.0f bytes per point\n",
               static_cast<double>(tree.trace_bytes()) / static_cast<double>(std::max<std::size_t>(1, tree.size())));

@@ -1,14 +1,12 @@
 // input_labels.hpp (private to the command) — the library's errors re-labelled with the
 // file and line they come from. The library names point or edit indices (InputError::
 // point_indices()); the commands know the lines, so they turn indices into "FILE:LINE".
-// Shared by `quadtree` and `mesh`.
+// Shared by `quadtree` and `mesh` (construction errors: initial_points.hpp).
 // Invariants: every error thrown here names a file; a line when one is known.
-// Complexity: O(1), except the resolution partner search, O(n) once on failure.
+// Complexity: O(1).
 #pragma once
 
-#include <algorithm>
 #include <cstddef>
-#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -50,42 +48,6 @@ InputError edit_error(const EditScript<d>& script, std::size_t i, const InputErr
   std::string text = e.op == EditOp::Insert ? "insert" : "delete";
   if (why.find(point) == std::string::npos) text += " " + point;
   return InputError(err.kind(), text + ": " + why, script.name, script.lines[i]);
-}
-
-/// A constructor's error naming point indices, re-labelled with the point file's lines; a
-/// resolution error also names the partner within one grid unit.
-template <std::size_t d>
-[[noreturn]] void rethrow_construction_error(const InputError& e, const PointFile<d>& file,
-                                             const std::vector<Position<d>>& located) {
-  auto line_of = [&](std::size_t i) { return i < file.lines.size() ? file.lines[i] : std::size_t{0}; };
-  std::vector<std::size_t> idx = e.point_indices();
-  if (idx.empty()) rethrow_in(e, file.name);
-  if (e.kind() == InputError::Kind::Resolution && idx.size() == 1 && idx[0] < located.size()) {
-    for (std::size_t j = 0; j < located.size(); ++j) {
-      bool near = j != idx[0];
-      for (std::size_t a = 0; a < d && near; ++a) {
-        const std::uint64_t x = located[j][a], y = located[idx[0]][a];
-        near = (x > y ? x - y : y - x) <= 1;
-      }
-      if (near) {
-        idx.push_back(j);
-        break;
-      }
-    }
-  }
-  std::sort(idx.begin(), idx.end());
-  std::string text = e.text();
-  // "point I: ..." names an index; the line number replaces it.
-  for (const std::size_t i : idx) {
-    const std::string prefix = "point " + std::to_string(i) + ": ";
-    if (text.compare(0, prefix.size(), prefix) == 0) text.erase(0, prefix.size());
-  }
-  if (idx.size() > 1) {
-    text += " (lines";
-    for (std::size_t k = 0; k < idx.size(); ++k) text += (k ? ", " : " ") + std::to_string(line_of(idx[k]));
-    text += ")";
-  }
-  throw InputError(e.kind(), text, file.name, line_of(idx.back()));
 }
 
 }  // namespace dynmesh::tool

@@ -1,21 +1,25 @@
 // dynmesh — the command-line tool of the dynmesh library (shared/FORMATS.md):
-//   dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--edits FILE] [--batch K]
-//                   --cells OUT [--check] [--svg OUT.svg]
-//   dynmesh mesh POINTS [--box o1 o2 L] [--postprocess hpu|quadtree] [--min-angle DEG]
-//                [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F] [--msh F] [--svg F]
-//                [--check] [--stats]
+//   dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--duplicates error|skip]
+//                   [--edits FILE] [--batch K] --cells OUT [--check] [--svg OUT.svg]
+//   dynmesh mesh POINTS [--box o1 o2 L] [--duplicates error|skip] [--postprocess hpu|quadtree]
+//                [--min-angle DEG] [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F]
+//                [--msh F] [--svg F] [--check] [--stats]
 //   dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]
 //                     [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv [--plot OUT.svg]
 //   dynmesh demo [--n N] [--updates U] [--seed X] [--svg OUT.svg]
 // Exit status: 0 on success; 1 with exactly one line `dynmesh: <message>` on stderr on any
 // error; 2 for a command line CLI11 rejects (also one line).
+#include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "number_options.hpp"
 #include "verify.hpp"
 
 int main(int argc, char** argv) {
@@ -23,13 +27,12 @@ int main(int argc, char** argv) {
   CLI::App app{"dynmesh: dynamic well-graded quadtrees (and, later, meshes) of changing point sets"};
   app.require_subcommand(1);
 
-  const CLI::Validator at_least_one(
-      [](std::string& value) -> std::string {
-        const bool digits = value.find_first_not_of("0123456789") == std::string::npos;
-        const bool nonzero = value.find_first_not_of('0') != std::string::npos;
-        return digits && nonzero ? std::string{} : "must be a whole number of at least 1, got '" + value + "'";
-      },
-      "K>=1");
+  // Whole-number options: digits only, within range (number_options.hpp).
+  const CLI::Validator at_least_one = whole_number(1, std::numeric_limits<std::size_t>::max());
+  const CLI::Validator any_seed = whole_number(0, std::numeric_limits<std::uint64_t>::max());
+  constexpr std::uint64_t kMaxCount = 1'000'000'000;  // points or updates: beyond memory anyway
+  const char* const duplicates_help =
+      "error (the default): a repeated point is an error; skip: drop later copies of a point and say how many";
 
   QuadtreeOptions q;
   CLI::App* quadtree = app.add_subcommand(
@@ -42,6 +45,10 @@ int main(int argc, char** argv) {
   quadtree->add_option("--box", q.box, "domain box: origin and side length (default: derived from the initial points)")
       ->expected(3, 4)
       ->type_name("o1 o2 [o3] L");
+  quadtree
+      ->add_option_function<std::string>(
+          "--duplicates", [&q](const std::string& v) { q.skip_duplicates = v == "skip"; }, duplicates_help)
+      ->check(CLI::IsMember({"error", "skip"}));
   quadtree->add_option("--edits", q.edits, "edit script: '+ x y [z]' inserts, '- x y [z]' deletes, one per line");
   quadtree->add_option("--batch", q.batch, "propagate K consecutive edits together (default: each edit alone)")
       ->check(at_least_one);
@@ -56,10 +63,14 @@ int main(int argc, char** argv) {
   mesh->add_option("--box", me.box, "domain box: origin and side length (default: derived from the initial points)")
       ->expected(3)
       ->type_name("o1 o2 L");
+  mesh->add_option_function<std::string>(
+          "--duplicates", [&me](const std::string& v) { me.skip_duplicates = v == "skip"; }, duplicates_help)
+      ->check(CLI::IsMember({"error", "skip"}));
   mesh->add_option("--postprocess", me.postprocess,
                    "hpu (the default; not available yet) or quadtree (the quadtree mesh, angles >= 18.4)");
   CLI::Option* min_angle_opt =
-      mesh->add_option("--min-angle", me.min_angle, "smallest angle in degrees (quadtree: at most 18.4)");
+      mesh->add_option("--min-angle", me.min_angle, "smallest angle in degrees (quadtree: at most 18.4)")
+          ->check(CLI::Range(0.0, 60.0));  // no triangle has a smallest angle above 60
   mesh->add_option("--edits", me.edits, "edit script: '+ x y' inserts, '- x y' deletes, one per line");
   mesh->add_option("--batch", me.batch, "propagate K consecutive edits together (default: each edit alone)")
       ->check(at_least_one);
@@ -83,11 +94,15 @@ int main(int argc, char** argv) {
   stability
       ->add_option("--dist", s.dist, "distribution: uniform, clusters, spiral, shrinking, grid, collinear, boundary")
       ->required();
-  stability->add_option("--n", s.n, "number of points the tree is built on")->required();
+  stability->add_option("--n", s.n, "number of points the tree is built on")
+      ->required()
+      ->check(whole_number(2, kMaxCount));
   stability->add_option("--spread", s.spread, "target spread L/s of the 'shrinking' distribution")
       ->capture_default_str();
-  stability->add_option("--updates", s.updates, "updates measured")->capture_default_str();
-  stability->add_option("--seed", s.seed, "random seed")->capture_default_str();
+  stability->add_option("--updates", s.updates, "updates measured")
+      ->capture_default_str()
+      ->check(whole_number(0, kMaxCount));
+  stability->add_option("--seed", s.seed, "random seed")->capture_default_str()->check(any_seed);
   stability->add_option("--postprocess", s.postprocess,
                         "none (the default: the quadtree alone), quadtree (2D: the quadtree mesh too) or hpu; "
                         "with a mesh, trace_distance and seconds count the whole update, tree and mesh");
@@ -99,9 +114,13 @@ int main(int argc, char** argv) {
   DemoOptions m;
   CLI::App* demo = app.add_subcommand(
       "demo", "Build the quadtree on an embedded clustered point set, time single-point updates, verify, draw");
-  demo->add_option("--n", m.n, "number of points")->capture_default_str();
-  demo->add_option("--updates", m.updates, "updates (alternating deletions and insertions)")->capture_default_str();
-  demo->add_option("--seed", m.seed, "random seed of the point set and of the updates")->capture_default_str();
+  demo->add_option("--n", m.n, "number of points")->capture_default_str()->check(whole_number(2, kMaxCount));
+  demo->add_option("--updates", m.updates, "updates (alternating deletions and insertions)")
+      ->capture_default_str()
+      ->check(whole_number(0, kMaxCount));
+  demo->add_option("--seed", m.seed, "random seed of the point set and of the updates")
+      ->capture_default_str()
+      ->check(any_seed);
   demo->add_option("--svg", m.svg, "picture of the final tree (empty: none)")->capture_default_str();
 
   try {

@@ -21,9 +21,11 @@
 
 #include "atomic_file.hpp"
 #include "commands.hpp"
+#include "initial_points.hpp"
 #include "input_labels.hpp"
 #include "postprocess_option.hpp"
 #include "dynmesh/box.hpp"
+#include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/dynamic_mesh.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/io.hpp"
@@ -58,19 +60,9 @@ int run_mesh(const MeshCommandOptions& o) {
   check_mesh_options(o);
   const double bound = o.min_angle_given ? o.min_angle : kQuadtreeMinAngle;
 
-  const PointFile<2> file = read_points_file<2>(o.points);
-  Box<2> box;
-  if (o.box.empty()) {
-    try {
-      box = derive_box<2>(file.points);
-    } catch (const InputError& e) {
-      rethrow_in(e, file.name);
-    }
-  } else {
-    box = box_from_option<2>(o.box);
-  }
-  // Outside the box, NaN, duplicates: named by line here, before the mesh sees the points.
-  const std::vector<Position<2>> located = locate_points<2>(file, box);
+  const InitialPoints<2> initial = read_initial_points<2>(o.points, o.box, o.skip_duplicates);
+  const PointFile<2>& file = initial.file;
+  const Box<2>& box = initial.box;
   // Read the whole script before meshing, so a malformed script fails fast.
   const EditScript<2> script = o.edits.empty() ? EditScript<2>{} : read_edits_file<2>(o.edits);
   const std::vector<Edit<2>>& edits = script.edits;
@@ -81,7 +73,9 @@ int run_mesh(const MeshCommandOptions& o) {
   try {
     built.emplace(box, std::span<const Point<2>>(file.points), mesh_options);
   } catch (const InputError& e) {
-    rethrow_construction_error<2>(e, file, located);
+    // The mesh resolves points only down to its level R (none below 2: the box is unusable).
+    const int level = dynmesh::detail::MeshGrid::resolution_level(box);
+    rethrow_construction_error<2>(e, initial, level >= 2 ? level : -1);
   }
   DynamicMesh& dm = *built;
 
@@ -148,6 +142,7 @@ int run_mesh(const MeshCommandOptions& o) {
   out.commit();
 
   // After the outputs are in place, so that a failed run prints only its error line.
+  if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", initial.duplicates_skipped);
   if (o.stats) {
     const std::string report = format_stats(mesh_stats(mesh));
     std::fflush(stdout);

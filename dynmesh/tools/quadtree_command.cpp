@@ -1,10 +1,13 @@
 // `dynmesh quadtree`: build T* on a point file, apply an edit script dynamically, write the
 // final leaves as `.cells` (shared/FORMATS.md). Every error names the file and line it
 // comes from; the tree's own errors (which name point indices or nothing) are re-labelled
-// here with the line of the point file or of the edit script.
+// here with the line of the point file or of the edit script. The point file is read,
+// stripped of later copies on request (--duplicates skip) and located by initial_points.hpp,
+// shared with `dynmesh mesh`.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <span>
 #include <string>
@@ -12,6 +15,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "initial_points.hpp"
 #include "input_labels.hpp"
 #include "dynmesh/box.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
@@ -32,19 +36,9 @@ int run(const QuadtreeOptions& o) {
     throw InputError(Kind::Malformed, "--svg draws 2D trees only; " + o.points + " holds " + std::to_string(d) +
                                           "D points");
 
-  const PointFile<d> file = read_points_file<d>(o.points);
-  Box<d> box;
-  if (o.box.empty()) {
-    try {
-      box = derive_box<d>(file.points);
-    } catch (const InputError& e) {
-      rethrow_in(e, file.name);
-    }
-  } else {
-    box = box_from_option<d>(o.box);
-  }
-  // Outside the box, NaN, duplicates: named by line here, before the tree sees the points.
-  const std::vector<Position<d>> located = locate_points<d>(file, box);
+  const InitialPoints<d> initial = read_initial_points<d>(o.points, o.box, o.skip_duplicates);
+  const PointFile<d>& file = initial.file;
+  const Box<d>& box = initial.box;
   // Read the whole script before building, so a malformed script fails fast.
   const EditScript<d> script = o.edits.empty() ? EditScript<d>{} : read_edits_file<d>(o.edits);
   const std::vector<Edit<d>>& edits = script.edits;
@@ -53,7 +47,7 @@ int run(const QuadtreeOptions& o) {
   try {
     built.emplace(box, std::span<const Point<d>>(file.points));
   } catch (const InputError& e) {
-    rethrow_construction_error<d>(e, file, located);
+    rethrow_construction_error<d>(e, initial);
   }
   DynamicQuadtree<d>& tree = *built;
 
@@ -101,6 +95,7 @@ int run(const QuadtreeOptions& o) {
     const Verification v = verify<d>(tree);
     if (!v.ok) throw InvariantError("--check failed: " + v.problem);
   }
+  if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", initial.duplicates_skipped);
   return 0;
 }
 

@@ -160,6 +160,9 @@ case $case_name in
     run "$dynmesh" demo --n 1000 --updates 100 --svg demo.svg
     grep -q '^verified: yes' out.txt || { cat out.txt; fail "demo not verified"; }
     grep -q 'trace distance' out.txt || fail "demo lacks the trace distance figure"
+    # The first figure is the speedup of an update over a static rebuild.
+    sed -n 2p out.txt | grep -q '^  speedup  *[0-9]*x: an update vs a static rebuild' ||
+      fail "demo does not lead with the speedup over a static rebuild: $(sed -n 2p out.txt)"
     head -c 5 demo.svg | grep -q '^<?xml\|^<svg' || fail "demo.svg is not SVG"
     ;;
 
@@ -224,6 +227,176 @@ case $case_name in
     cmp old.feed saved.feed || fail "a failed run changed old.feed"
     [[ -z $(find . -name '.*.tmp-*') ]] || fail "temporary files left behind: $(find . -name '.*.tmp-*')"
     expect_error 2 '-o' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}"
+    ;;
+
+  quirks) # a byte order mark, ',' and ';' separators; a directory or unreadable file named as such
+    # The same points and edits with a BOM and list separators give the same tree and mesh.
+    { printf '\xef\xbb\xbf'; awk '/^#/ { print; next } { print (NR % 2 ? $1 "," $2 : $1 "; " $2) }' \
+      "$data/final2d.txt"; } >final2d.csv
+    run "$dynmesh" quadtree "$data/final2d.txt" --cells plain.cells
+    run "$dynmesh" quadtree final2d.csv --cells csv.cells --check
+    cmp plain.cells csv.cells || fail "BOM and ',' / ';' separators: a different tree"
+    run "$dynmesh" mesh "$data/final2d.txt" --postprocess quadtree -o plain
+    run "$dynmesh" mesh final2d.csv --postprocess quadtree -o csv
+    cmp plain.node csv.node || fail "BOM and ',' / ';' separators: a different mesh"
+    { printf '\xef\xbb\xbf'; awk '/^[+-]/ { print $1 " " $2 "," $3; next } { print }' "$data/edits2d.txt"; } >edits.csv
+    run "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits2d.txt" --cells e1.cells
+    run "$dynmesh" quadtree "$data/points2d.node" --edits edits.csv --cells e2.cells
+    cmp e1.cells e2.cells || fail "an edit script with a BOM and commas: a different tree"
+    { printf '\xef\xbb\xbf'; cat "$data/points2d.node"; } >bom.node
+    run "$dynmesh" quadtree "$data/points2d.node" --cells node.cells
+    run "$dynmesh" quadtree bom.node --cells bom.cells
+    cmp node.cells bom.cells || fail ".node with a BOM: a different tree"
+    # Genuinely malformed lines keep their errors.
+    expect_error 1 "decimal_comma.txt:3: malformed number '1,5'" "$dynmesh" quadtree "$data/decimal_comma.txt" \
+      --cells e.cells
+    printf '0.5,,0.25\n' >empty.csv
+    expect_error 1 'empty.csv:1: empty field' "$dynmesh" quadtree empty.csv --cells e.cells
+    printf '0,0\n1;nan\n' >nan.csv
+    expect_error 1 "nan.csv:2: NaN or infinite coordinate 'nan'" "$dynmesh" quadtree nan.csv --cells e.cells
+    # A directory, or a file that cannot be read, is named as such (not "read error").
+    mkdir -p adir adir.node
+    expect_error 1 'adir: cannot read: is a directory' "$dynmesh" quadtree adir --cells e.cells
+    expect_error 1 'adir.node: cannot read: is a directory' "$dynmesh" quadtree adir.node --cells e.cells
+    expect_error 1 'adir: cannot read: is a directory' "$dynmesh" mesh adir --postprocess quadtree -o e
+    expect_error 1 'adir: cannot read: is a directory' "$dynmesh" quadtree "$data/grid.txt" --edits adir \
+      --cells e.cells
+    cp "$data/grid.txt" locked.txt && chmod 000 locked.txt
+    if [[ $(id -u) -ne 0 ]]; then
+      expect_error 1 'locked.txt: cannot open file: Permission denied' "$dynmesh" quadtree locked.txt --cells e.cells
+    elif command -v setpriv >/dev/null && setpriv --reuid=65534 --regid=65534 --clear-groups test -x "$dynmesh"; then
+      # root reads anything: run as nobody
+      expect_error 1 'locked.txt: cannot open file: Permission denied' \
+        setpriv --reuid=65534 --regid=65534 --clear-groups "$dynmesh" quadtree locked.txt --cells e.cells
+    else
+      echo "running as root without setpriv: the unreadable-file error is not tested"
+    fi
+    [[ ! -e e.cells && ! -e e.node ]] || fail "a failed run wrote its output file"
+    ;;
+
+  spread) # a spread beyond the resolution is reported as that, with L/s, naming the point
+    # A far-out point stretches the derived box: it is named (line 6), not a "duplicate".
+    for cmd in "quadtree --cells e.cells" "mesh --postprocess quadtree -o e"; do
+      # shellcheck disable=SC2086  # $cmd is several words
+      expect_error 1 'far_point.txt:6: point (1e+17, 4100000) makes the spread exceed the resolution' \
+        "$dynmesh" $cmd "$data/far_point.txt"
+      grep -q 'spread L/s = [0-9.e+]* (log2 5[0-9]\.[0-9]) with L = 3e+17' err.txt || fail "no spread: $(cat err.txt)"
+      grep -qF 'the points on lines 3 and 4' err.txt || fail "the colliding pair is not named: $(cat err.txt)"
+      ! grep -qi 'duplicate' err.txt || fail "misreported as a duplicate: $(cat err.txt)"
+    done
+    # Without such a point, the later point of the too-close pair, with both lines.
+    expect_error 1 'resolution.txt:4: point (0, 9.0000000000000003e-16) makes the spread exceed the resolution' \
+      "$dynmesh" quadtree "$data/resolution.txt" --cells e.cells
+    grep -qF 'spread L/s = 3.33e+15 (log2 51.6) with L = 3 and s = 9e-16 (lines 2, 4)' err.txt ||
+      fail "resolution.txt: $(cat err.txt)"
+    expect_error 1 'resolution.txt:4: point (0, 9.0000000000000003e-16) makes the spread exceed the resolution' \
+      "$dynmesh" mesh "$data/resolution.txt" --postprocess quadtree -o e
+    # A pair the mesh cannot resolve at its coarser level, though the tree can.
+    printf '0 0\n1 1\n0.5 0.5\n0.500000000001 0.5\n' >mesh_near.txt
+    run "$dynmesh" quadtree mesh_near.txt --cells near.cells
+    expect_error 1 'mesh_near.txt:4: point (0.50000000000099998, 0.5) makes the spread exceed the resolution L/2^' \
+      "$dynmesh" mesh mesh_near.txt --postprocess quadtree -o e
+    grep -qF '(lines 3, 4)' err.txt || fail "mesh_near.txt: the pair is not named: $(cat err.txt)"
+    # Two points with one located position but different coordinates are not duplicates.
+    printf '0 0\n1 1\n0.5 0.5\n1e-20 0\n' >same_q.txt
+    expect_error 1 'same_q.txt:4: point (9.9999999999999995e-21, 0) makes the spread exceed the resolution' \
+      "$dynmesh" quadtree same_q.txt --cells e.cells
+    grep -qF '(log2 68.0)' err.txt || fail "same_q.txt: $(cat err.txt)"
+    # Exact copies still are.
+    expect_error 1 'duplicate.txt:5: duplicate point' "$dynmesh" quadtree "$data/duplicate.txt" --cells e.cells
+    [[ ! -e e.cells && ! -e e.node ]] || fail "a failed run wrote its output file"
+    ;;
+
+  duplicates) # --duplicates error|skip
+    awk '!seen[$0]++' "$data/duplicates_many.txt" >unique.txt
+    run "$dynmesh" quadtree unique.txt --cells unique.cells
+    run "$dynmesh" quadtree "$data/duplicates_many.txt" --duplicates skip --cells skip.cells --check
+    grep -qx 'duplicates: skipped 2 later copies' out.txt || fail "quadtree skip count: $(cat out.txt)"
+    cmp unique.cells skip.cells || fail "--duplicates skip: not the tree of the unique points"
+    run "$dynmesh" quadtree unique.txt --duplicates skip --cells none.cells
+    grep -qx 'duplicates: skipped 0 later copies' out.txt || fail "skip count without copies: $(cat out.txt)"
+    run "$dynmesh" mesh unique.txt --postprocess quadtree -o unique
+    run "$dynmesh" mesh "$data/duplicates_many.txt" --postprocess quadtree --duplicates skip -o skip --check
+    grep -qx 'duplicates: skipped 2 later copies' out.txt || fail "mesh skip count: $(cat out.txt)"
+    cmp unique.node skip.node && cmp unique.ele skip.ele || fail "--duplicates skip: not the mesh of the unique points"
+    # error is the default.
+    for policy in "" "--duplicates error"; do
+      # shellcheck disable=SC2086  # $policy is zero or two words
+      expect_error 1 'duplicates_many.txt:5: duplicate point' "$dynmesh" quadtree "$data/duplicates_many.txt" \
+        $policy --cells e.cells
+      # shellcheck disable=SC2086
+      expect_error 1 'duplicates_many.txt:5: duplicate point' "$dynmesh" mesh "$data/duplicates_many.txt" \
+        --postprocess quadtree $policy -o e
+    done
+    expect_error 2 '--duplicates' "$dynmesh" quadtree "$data/grid.txt" --duplicates drop --cells e.cells
+    # skip drops copies only: a spread beyond the resolution is still an error, and so is an
+    # edit that inserts a present point.
+    expect_error 1 'far_point.txt:6: ' "$dynmesh" quadtree "$data/far_point.txt" --duplicates skip --cells e.cells
+    expect_error 1 'edits_present.txt:2: ' "$dynmesh" quadtree "$data/points2d.node" --duplicates skip \
+      --edits "$data/edits_present.txt" --cells e.cells
+    [[ ! -e e.cells && ! -e e.node ]] || fail "a failed run wrote its output file"
+    ;;
+
+  options) # numeric options are range-checked before anything runs: exit 2, one line
+    for bad in 0 -1 18446744073709551616 99999999999999999999 0x10 1.5 +3 1e3; do
+      expect_error 2 "--batch: must be a whole number from 1 to" "$dynmesh" quadtree "$data/grid.txt" \
+        --cells e.cells --batch "$bad"
+    done
+    expect_error 2 '--batch' "$dynmesh" mesh "$data/points2d.node" --postprocess quadtree -o e --batch -1
+    # The largest size_t is a valid batch (one batch); leading zeros are decimal, not octal.
+    run "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits2d.txt" --cells one.cells \
+      --batch 18446744073709551615 --check
+    run "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits2d.txt" --cells ten.cells --batch 010 --check
+    for bad in -1 61 1e9 x; do
+      expect_error 2 '--min-angle' "$dynmesh" mesh "$data/points2d.node" --postprocess quadtree -o e --min-angle "$bad"
+    done
+    expect_error 2 '--n: must be a whole number from 2 to' "$dynmesh" demo --n -5
+    expect_error 2 '--n' "$dynmesh" demo --n 1
+    expect_error 2 '--n' "$dynmesh" demo --n 1000000001
+    expect_error 2 '--updates' "$dynmesh" demo --updates -1
+    expect_error 2 '--updates' "$dynmesh" demo --updates 0x10
+    expect_error 2 '--seed' "$dynmesh" demo --seed -1
+    expect_error 2 '--n' "$dynmesh" stability --dim 2 --dist uniform --n -5 --csv e.csv
+    expect_error 2 '--updates' "$dynmesh" stability --dim 2 --dist uniform --n 50 --updates 18446744073709551616 \
+      --csv e.csv
+    [[ ! -e e.cells && ! -e e.node && ! -e e.csv ]] || fail "a refused run wrote its output file"
+    ;;
+
+  dev_sh) # dev.sh with stub tools: `run` builds only bin/dynmesh, `bench` only what it runs,
+    # `test` everything; apt-get waits for the dpkg lock.
+    mkdir -p fake stub/build/release/bin
+    cp "$data/../../../dev.sh" stub/dev.sh || fail "no dev.sh"
+    log=$PWD/calls.log
+    # stub PATH [BODY]: an executable that logs "NAME ARGS" to calls.log, then runs BODY.
+    stub() {
+      printf '#!/usr/bin/env bash\necho "%s $*" >>%q\n%s\n' "$(basename "$1")" "$log" "${2:-}" >"$1"
+      chmod +x "$1"
+    }
+    for tool in cmake ctest apt-get; do stub "fake/$tool"; done
+    stub fake/sudo '"$@"'
+    # Every package installed but ninja-build.
+    stub fake/dpkg-query '[[ ${*: -1} == ninja-build ]] || echo "install ok installed"'
+    for prog in dynmesh sac_suite dynmesh_bench; do stub "stub/build/release/bin/$prog"; done
+    dev() {
+      PATH="$PWD/fake:$PATH" JOBS=1 bash stub/dev.sh "$@" >out.txt 2>err.txt || { cat err.txt >&2; fail "dev.sh $*"; }
+    }
+    dev run --n 10
+    grep -qx 'cmake --build build/release -j 1 --target dynmesh_cli' calls.log || fail "run: $(cat calls.log)"
+    [[ $(grep -c '^cmake --build' calls.log) -eq 1 ]] || fail "run builds more than bin/dynmesh: $(cat calls.log)"
+    grep -qx 'dynmesh demo --n 10 --svg build/dynmesh-demo.svg' calls.log || fail "run: no demo: $(cat calls.log)"
+    grep -qx 'apt-get -o DPkg::Lock::Timeout=600 update' calls.log || fail "apt-get update: $(cat calls.log)"
+    grep -qx 'apt-get -o DPkg::Lock::Timeout=600 install -y --no-install-recommends ninja-build' calls.log ||
+      fail "apt-get install: $(cat calls.log)"
+    : >calls.log
+    dev bench --csv
+    grep -qx 'cmake --build build/release -j 1 --target sac_suite dynmesh_bench' calls.log ||
+      fail "bench: $(cat calls.log)"
+    [[ $(grep -c '^sac_suite .*--csv$' calls.log) -eq 2 && $(grep -c '^dynmesh_bench .*--csv$' calls.log) -eq 2 ]] ||
+      fail "bench does not run its programs: $(cat calls.log)"
+    : >calls.log
+    dev test
+    grep -qx 'cmake --build build/debug -j 1' calls.log || fail "test does not build everything: $(cat calls.log)"
+    grep -q '^ctest --test-dir build/debug' calls.log || fail "test runs no ctest: $(cat calls.log)"
     ;;
 
   *)

@@ -129,6 +129,18 @@ TEST(ReadNode, Errors) {
   expect_error([&] { node<2>("2 2 0 0\n1 0 0\n1.0 1 1\n", n); }, Kind::Malformed, n, 3);
 }
 
+TEST(ReadNode, ByteOrderMarkIsSkippedButCommasAreNotSeparators) {
+  const auto f = node<2>("\xEF\xBB\xBF# exported on Windows\r\n2 2 0 0\r\n1 0 0\r\n2 1 1\r\n");
+  ASSERT_EQ(f.points.size(), 2u);
+  EXPECT_EQ(f.points[1], (Point<2>{1, 1}));
+  const auto g = node<2>("\xEF\xBB\xBF" "1 2 0 0\n1 0.5 0.25\n");
+  EXPECT_EQ(g.points[0], (Point<2>{0.5, 0.25}));
+  // Triangle's format has whitespace-separated fields only.
+  expect_error([] { node<2>("1 2 0 0\n1 0.5,0.25\n", "c.node"); }, Kind::Count, "c.node", 2);
+  // A byte order mark anywhere but at the start is not skipped.
+  expect_error([] { node<2>("1 2 0 0\n\xEF\xBB\xBF" "1 0 0\n", "m.node"); }, Kind::Malformed, "m.node", 2);
+}
+
 TEST(ReadNode, UnderflowIsTheRoundedZero) {
   const auto f = node<2>("1 2 0 0\n1 1e-999 -1e-400\n");
   EXPECT_EQ(f.points[0][0], 0.0);
@@ -148,6 +160,49 @@ TEST(ReadPlain, FirstDimNumbersAndIgnoredColumns) {
   EXPECT_EQ(f.lines, (std::vector<std::size_t>{1, 4, 5}));
   const auto g = plain<2>("1 2 3\n4 5 6\n");
   EXPECT_EQ(g.points[1], (Point<2>{4, 5}));
+}
+
+TEST(ReadPlain, ByteOrderMark) {
+  const auto f = plain<2>("\xEF\xBB\xBF" "0.5 0.25\n1 2\n");
+  ASSERT_EQ(f.points.size(), 2u);
+  EXPECT_EQ(f.points[0], (Point<2>{0.5, 0.25}));
+  const auto g = plain<2>("\xEF\xBB\xBF# header comment\n3 4\n");
+  EXPECT_EQ(g.lines, (std::vector<std::size_t>{2}));
+}
+
+TEST(ReadPlain, CommasAndSemicolonsSeparateFields) {
+  const auto f = plain<2>("0.5,0.25\n0.5; 0.25\n1 , 2\n-3;+4;extra,columns\n5,6 # comment, with commas\n7;8;\t9\n");
+  ASSERT_EQ(f.points.size(), 6u);
+  EXPECT_EQ(f.points[0], (Point<2>{0.5, 0.25}));
+  EXPECT_EQ(f.points[1], (Point<2>{0.5, 0.25}));
+  EXPECT_EQ(f.points[2], (Point<2>{1, 2}));
+  EXPECT_EQ(f.points[3], (Point<2>{-3, 4}));
+  EXPECT_EQ(f.points[4], (Point<2>{5, 6}));
+  EXPECT_EQ(f.points[5], (Point<2>{7, 8}));
+  const auto g = plain<3>("1,2,3,0.1,0.2,0.3\n4;5;6\n");
+  EXPECT_EQ(g.points[0], (Point<3>{1, 2, 3}));
+  EXPECT_EQ(g.points[1], (Point<3>{4, 5, 6}));
+  // Whitespace between the coordinates and commas among the ignored columns is fine.
+  EXPECT_EQ(plain<2>("1 2 r,g,b\n").points[0], (Point<2>{1, 2}));
+}
+
+TEST(ReadPlain, CommaErrors) {
+  const std::string n = "c.csv";
+  // A decimal comma: the separators up to the last coordinate mix ',' and whitespace.
+  expect_error([&] { plain<2>("1 2,5\n", n); }, Kind::Malformed, n, 1, "'2,5'");
+  expect_error([&] { plain<2>("1,5 2,5\n", n); }, Kind::Malformed, n, 1, "decimal comma");
+  expect_error([&] { plain<3>("1,2 3\n", n); }, Kind::Malformed, n, 1, "'1,2'");
+  // Empty fields.
+  expect_error([&] { plain<2>("0.5,,0.25\n", n); }, Kind::Malformed, n, 1, "empty field");
+  expect_error([&] { plain<2>(",0.5,0.25\n", n); }, Kind::Malformed, n, 1, "empty field");
+  expect_error([&] { plain<2>("1 2\n0.5,0.25,\n", n); }, Kind::Malformed, n, 2, "empty field");
+  // The number rules are unchanged.
+  expect_error([&] { plain<2>("1,nan\n", n); }, Kind::NotFinite, n, 1, "'nan'");
+  expect_error([&] { plain<2>("1;-inf\n", n); }, Kind::NotFinite, n, 1);
+  expect_error([&] { plain<2>("1,1e999\n", n); }, Kind::NotFinite, n, 1);
+  expect_error([&] { plain<2>("1,x\n", n); }, Kind::Malformed, n, 1, "'x'");
+  expect_error([&] { plain<2>("0.5\n", n); }, Kind::Count, n, 1, "expected 2 coordinates, found 1");
+  expect_error([&] { plain<3>("1,2\n", n); }, Kind::Count, n, 1);
 }
 
 TEST(ReadPlain, Errors) {
@@ -194,21 +249,33 @@ TEST_F(TempDir, ReadPointsFileChoosesTheFormatByExtension) {
                (dir_ / "e.node").string(), 2);
   const std::string missing = (dir_ / "missing.node").string();
   expect_error([&] { read_points_file<2>(missing); }, Kind::Io, missing, 0, "cannot open");
+  expect_error([&] { read_points_file<2>(missing); }, Kind::Io, missing, 0, "No such file or directory");
 }
 
-TEST(LocatePoints, DuplicatesAreEqualLocatedPositions) {
+TEST_F(TempDir, ADirectoryIsNamedAsSuch) {
+  const std::string dir = dir_.string();
+  expect_error([&] { read_points_file<2>(dir); }, Kind::Io, dir, 0, "is a directory");
+  expect_error([&] { read_edits_file<2>(dir); }, Kind::Io, dir, 0, "is a directory");
+  expect_error([&] { node_file_dimension(dir); }, Kind::Io, dir, 0, "is a directory");
+}
+
+TEST(LocatePoints, EqualPositionsAreDuplicatesOrASpreadBeyondTheResolution) {
   // 0 and 1e-20 differ as doubles but have the same located q in the box o = −1, L = 3
-  // (x − o rounds to 1 for both): the fourth point is a duplicate of the first.
+  // (x − o rounds to 1 for both): not a duplicate but a spread L/s = 3e20 the grid cannot
+  // resolve.
   const auto f = plain<2>("0 0\n1 1\n# c\n0.5 0.5\n1e-20 0\n", "dup.txt");
   const Box<2> box = derive_box<2>(f.points);
   try {
     (void)locate_points(f, box);
     ADD_FAILURE() << "no error";
   } catch (const InputError& e) {
-    EXPECT_EQ(e.kind(), Kind::Duplicate);
+    EXPECT_EQ(e.kind(), Kind::Resolution);
     EXPECT_EQ(e.file(), "dup.txt");
     EXPECT_EQ(e.line(), 5u);
-    EXPECT_NE(std::string(e.what()).find("line 1"), std::string::npos) << e.what();
+    const std::string what = e.what();
+    EXPECT_NE(what.find("line 1"), std::string::npos) << what;
+    EXPECT_NE(what.find("spread L/s = 3e+20 (log2 68.0)"), std::string::npos) << what;
+    EXPECT_NE(what.find("exceeds the resolution"), std::string::npos) << what;
     EXPECT_EQ(e.point_indices(), (std::vector<std::size_t>{0, 3}));
   }
   // Exact repeats too; the first repeat in file order is reported.
@@ -216,6 +283,37 @@ TEST(LocatePoints, DuplicatesAreEqualLocatedPositions) {
   expect_error([&] { (void)locate_points(g, derive_box<2>(g.points)); }, Kind::Duplicate, "dup2.txt", 4);
   const auto ok = plain<2>("0 0\n1 1\n");
   EXPECT_EQ(locate_points(ok, derive_box<2>(ok.points)).size(), 2u);
+}
+
+TEST(LocatePoints, DropDuplicatePointsKeepsTheFirstCopy) {
+  auto f = plain<2>("0 0\n5 5\n1 1\n1.0 1e0\n# c\n5 5\n-0 0\n2 2\n");
+  EXPECT_EQ(drop_duplicate_points(f), 3u);
+  EXPECT_EQ(f.points, (std::vector<Point<2>>{{0, 0}, {5, 5}, {1, 1}, {2, 2}}));
+  EXPECT_EQ(f.lines, (std::vector<std::size_t>{1, 2, 3, 8}));
+  EXPECT_EQ(locate_points(f, derive_box<2>(f.points)).size(), 4u);
+  EXPECT_EQ(drop_duplicate_points(f), 0u);
+  // Different points with one located position stay: that is not a duplicate.
+  auto g = plain<2>("0 0\n1 1\n1e-20 0\n");
+  EXPECT_EQ(drop_duplicate_points(g), 0u);
+  expect_error([&] { (void)locate_points(g, derive_box<2>(g.points)); }, Kind::Resolution, "in.xyz", 3);
+}
+
+TEST(SpreadMessages, StretchingPointAndSpreadText) {
+  // Terrain coordinates with one stray far-out point: it alone stretches the derived box.
+  const std::vector<Point<2>> terrain = {
+      {500000, 4100000}, {500012.5, 4100003}, {1e17, 4100000}, {500050, 4100050}};
+  const auto stretch = stretching_point<2>(terrain);
+  ASSERT_TRUE(stretch);
+  EXPECT_EQ(stretch->index, 2u);
+  EXPECT_EQ(stretch->side_without, 150.0);  // 3 · 50
+  const std::vector<Point<3>> low = {{0, 0, -1e9}, {1, 1, 1}, {0.5, 0.5, 0.5}};
+  EXPECT_EQ(stretching_point<3>(low)->index, 0u);
+  EXPECT_EQ(stretching_point<3>(low)->side_without, 1.5);  // 3 · 0.5
+  EXPECT_FALSE(stretching_point<2>(std::vector<Point<2>>{{0, 0}, {1, 1}}));
+  const Box<2> box{{-1, -1}, 3};
+  EXPECT_EQ(spread_text<2>(box, {0, 0}, {0, 1e-20}), "spread L/s = 3e+20 (log2 68.0) with L = 3 and s = 1e-20");
+  EXPECT_EQ(spread_text<2>(box, {0, 0}, {3e-300, 4e-300}),
+            "spread L/s = 6e+299 (log2 995.8) with L = 3 and s = 5e-300");
 }
 
 TEST(LocatePoints, OutsideTheGivenBox) {
@@ -237,6 +335,25 @@ TEST(ReadEdits, Basic) {
   EXPECT_EQ(e[2].point, (Point<2>{3, 4}));
   const auto e3 = edits<3>("- 1 2 3\n");
   EXPECT_EQ(e3.edits[0].point, (Point<3>{1, 2, 3}));
+}
+
+TEST(ReadEdits, ByteOrderMarkCommasAndSemicolons) {
+  const auto script = edits<2>("\xEF\xBB\xBF+ 0.5,0.25\n- 0.5; 0.25\n+,1,2\n-\t3 ;4\n");
+  const auto& e = script.edits;
+  ASSERT_EQ(e.size(), 4u);
+  EXPECT_EQ(e[0].op, EditOp::Insert);
+  EXPECT_EQ(e[0].point, (Point<2>{0.5, 0.25}));
+  EXPECT_EQ(e[1].op, EditOp::Delete);
+  EXPECT_EQ(e[1].point, (Point<2>{0.5, 0.25}));
+  EXPECT_EQ(e[2].point, (Point<2>{1, 2}));
+  EXPECT_EQ(e[3].point, (Point<2>{3, 4}));
+  EXPECT_EQ(edits<3>("+ 1,2,3\n").edits[0].point, (Point<3>{1, 2, 3}));
+  const std::string n = "ed.csv";
+  expect_error([&] { edits<2>("+ 1,5 2\n", n); }, Kind::Malformed, n, 1, "'1,5'");
+  expect_error([&] { edits<2>("+ 1,,2\n", n); }, Kind::Malformed, n, 1, "empty field");
+  expect_error([&] { edits<2>("+ 1,2,3\n", n); }, Kind::Count, n, 1, "exactly 2");
+  expect_error([&] { edits<2>("+1,2\n", n); }, Kind::Malformed, n, 1, "'+1'");
+  expect_error([&] { edits<2>("- 1;nan\n", n); }, Kind::NotFinite, n, 1);
 }
 
 TEST(ReadEdits, Errors) {

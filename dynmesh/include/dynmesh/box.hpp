@@ -13,16 +13,21 @@
 // This file must not be compiled with -ffast-math or -ffp-contract=fast semantics changing
 // these expressions (GCC does not contract a subtraction followed by a multiplication).
 //
+// For messages about a spread beyond the resolution: spread_text() states L/s for a pair of
+// points, and stretching_point() finds the point that, far from the rest, stretches a derived
+// box (a stray 1e17 among terrain coordinates makes L so large that near points collide).
 // Invariants: validate_box() accepts only boxes with finite origin, finite L > 0 and finite
 // 2^52 / L; locate() on such a box returns q with every coordinate < 2^52.
-// Complexity: derive_box O(n·d); locate O(d).
+// Complexity: derive_box and stretching_point O(n·d); locate and spread_text O(d).
 // Paper: Acar & Hudson, Section 2 ("an initial bounding box of the point set, with side
 // length L").
 #pragma once
 
+#include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -94,6 +99,65 @@ Box<d> derive_box(std::span<const Point<d>> points) {
   box.side = 3 * w;
   validate_box(box);
   return box;
+}
+
+/// The point whose removal shrinks the box derive_box() gives the most, and the side L that
+/// box would have without it. Only a point extreme on some axis can shrink it, so each
+/// axis' two lowest and two highest coordinates decide. std::nullopt for fewer than three
+/// points. Coordinates must be finite.
+struct BoxStretch {
+  std::size_t index = 0;    // into the points
+  double side_without = 0;  // L of the box derived from the other points
+};
+template <std::size_t d>
+std::optional<BoxStretch> stretching_point(std::span<const Point<d>> points) {
+  if (points.size() < 3) return std::nullopt;
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  struct End {
+    double value[2] = {inf, inf};  // the best two (lowest of x, or of −x for the high end)
+    std::size_t index = 0;         // of value[0]
+    void add(double x, std::size_t i) {
+      if (x < value[0]) {
+        value[1] = value[0];
+        value[0] = x;
+        index = i;
+      } else if (x < value[1]) {
+        value[1] = x;
+      }
+    }
+  };
+  End lo[d], hi[d];
+  for (std::size_t i = 0; i < points.size(); ++i)
+    for (std::size_t a = 0; a < d; ++a) {
+      lo[a].add(points[i][a], i);
+      hi[a].add(-points[i][a], i);
+    }
+  std::optional<BoxStretch> best;
+  for (std::size_t a = 0; a < d; ++a)
+    for (const std::size_t c : {lo[a].index, hi[a].index}) {
+      double w = 0.0;
+      for (std::size_t b = 0; b < d; ++b)
+        w = std::fmax(w, -hi[b].value[hi[b].index == c] - lo[b].value[lo[b].index == c]);
+      const double side = 3 * (w == 0.0 ? 1.0 : w);  // as derive_box
+      if (!best || side < best->side_without) best = BoxStretch{c, side};
+    }
+  return best;
+}
+
+/// "spread L/s = 3.33e+15 (log2 51.6) with L = 3 and s = 9e-16" for two points of the box at
+/// Euclidean distance s (log2 computed as log2 L − log2 s, so neither overflows), for
+/// messages about a spread beyond the resolution.
+template <std::size_t d>
+std::string spread_text(const Box<d>& box, const Point<d>& p, const Point<d>& q) {
+  double m = 0.0, sum = 0.0;  // s = m·sqrt(sum), scaled so that no square under- or overflows
+  for (std::size_t a = 0; a < d; ++a) m = std::fmax(m, std::fabs(p[a] - q[a]));
+  for (std::size_t a = 0; a < d && m > 0.0; ++a) sum += ((p[a] - q[a]) / m) * ((p[a] - q[a]) / m);
+  const double lg = m > 0.0 ? std::log2(box.side) - std::log2(m) - 0.5 * std::log2(sum)
+                            : std::numeric_limits<double>::infinity();
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, lg, std::chars_format::fixed, 1);
+  return "spread L/s = " + format_brief(std::exp2(lg), 3) + " (log2 " + std::string(buf, r.ptr) +
+         ") with L = " + format_brief(box.side) + " and s = " + format_brief(m * std::sqrt(sum));
 }
 
 /// The location rule. Returns std::nullopt when the point is outside the box (some q outside

@@ -8,22 +8,27 @@
 //     `#` starts a comment anywhere on a line; blank lines are skipped. Attributes and the
 //     marker, when present, must be numbers and are otherwise ignored; further fields are
 //     ignored.
-//   * plain text (any other name): one point per non-blank line, whitespace-separated; the
-//     first d fields are the coordinates and further columns are ignored (not parsed). `#`
-//     comments are allowed here too.
-//   * edit scripts: `+ x y [z]` / `- x y [z]`, exactly d coordinates, blank lines and `#`
-//     comments ignored. The sign must be a token of its own.
+//   * plain text (any other name): one point per non-blank line, fields separated by
+//     whitespace or by ',' / ';' (whitespace around them allowed: "0.5,0.25", "0.5; 0.25");
+//     the first d fields are the coordinates and further columns are ignored (not parsed).
+//     The separators up to the last coordinate's must be of one kind, so that a decimal
+//     comma ("1,5 2") is an error rather than the point (1, 5); an empty field (",,") is an
+//     error. `#` comments are allowed here too.
+//   * edit scripts: `+ x y [z]` / `- x y [z]`, exactly d coordinates separated as in plain
+//     text, blank lines and `#` comments ignored. The sign must be a token of its own.
 //   * `.cells`: "# dynmesh cells v1", "# dim D", "# box o1 o2 [o3] L" (numbers printed as
 //     %.17g in the C locale), then one line `level i j [k] npoints` per leaf, sorted by
 //     (level, i, j, k); '\n' line ends.
+// Every reader skips a UTF-8 byte order mark at the start of the file and accepts CRLF.
 // Numbers are read with std::from_chars (locale-independent, correctly rounded): decimal or
 // scientific notation with an optional leading '+' or '-'; hexadecimal floats are not
 // accepted. A decimal overflow (1e999) is an infinity and an error; a decimal underflow
 // (1e-999) is the correctly rounded signed zero.
 // Every error is an InputError whose message names the file and the 1-based line:
 // Malformed (bad number or line shape), NotFinite (NaN, infinity), Count (too few or too many
-// fields or vertices), Duplicate (two points with equal located q, see locate_points),
-// OutsideBox, Io (cannot open or read).
+// fields or vertices), Duplicate (two equal points), Resolution (two different points with
+// equal located q, see locate_points), OutsideBox, Io (cannot open or read: a directory, or
+// the OS reason such as "Permission denied").
 //
 // Invariants: PointFile::lines[i] is the line of points[i]; points keep file order. A
 // successful read never returns a NaN or infinite coordinate.
@@ -71,11 +76,19 @@ PointFile<d> read_points_file(const std::string& path, PointFormat format = Poin
 int node_file_dimension(const std::string& path);
 
 /// Locates every point in `box`, in file order. Throws InputError(OutsideBox) naming the
-/// line of the first point outside the box, or InputError(Duplicate) naming the line of the
-/// first point (in file order) whose located q equals that of an earlier point, and that
-/// earlier line. The exception's point_indices() are the indices into file.points.
+/// line of the first point outside the box; for the first point (in file order) whose
+/// located q equals that of an earlier point, naming its line and that earlier line,
+/// InputError(Duplicate) when the two are equal and InputError(Resolution) (with the spread
+/// L/s of the pair) when they differ: the grid cannot tell them apart. The exception's
+/// point_indices() are the indices into file.points.
 template <std::size_t d>
 std::vector<Position<d>> locate_points(const PointFile<d>& file, const Box<d>& box);
+
+/// Drops every point equal to an earlier one (file order), with its line, keeping the first
+/// copy; returns how many were dropped (`--duplicates skip`). Coordinates must be finite, as
+/// the readers return them. O(n log n).
+template <std::size_t d>
+std::size_t drop_duplicate_points(PointFile<d>& file);
 
 /// An edit script: the edits in order and, for each, its 1-based line in the file.
 template <std::size_t d>

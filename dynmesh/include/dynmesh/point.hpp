@@ -47,6 +47,14 @@ inline std::string format_exact(double x) {
   return std::string(buf, r.ptr);
 }
 
+/// A double to `digits` significant digits (%g style, C locale), for sizes and ratios in
+/// messages where every digit of format_exact would only get in the way.
+inline std::string format_brief(double x, int digits = 6) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, digits);
+  return std::string(buf, r.ptr);
+}
+
 /// "(x, y[, z])" with format_exact coordinates, for messages.
 template <std::size_t d>
   requires SupportedDim<d>
