@@ -17,10 +17,12 @@
 //   * T' is written into the same `split` modifiables as T*, as later versions: QuadTreeRefine
 //     reads earlier in the trace and never sees them, the postprocess reads T' (see
 //     kRefineSplit). Marks are leaf values of `split` (low bits 0), read by emit anyway.
-//   * p's T* level is found by reading the point lists down p's path: cell_of(q, l).pts is
-//     non-empty exactly when T* split its parent (QuadTreeRefine's partition wrote it). No
-//     postprocess write lands there before p's own descent (c_t.pts is p's alone), so the
-//     descent sees T* whatever the order of the points.
+//   * p's T* level is found by reading the `split` values down p's path and testing only
+//     their T* bit (tree_split): postprocess writes land only on cells T* left unsplit and
+//     never set that bit, so the descent sees T* whatever the order of the points. (Reading
+//     the point lists instead, as an earlier version did, re-ran every descent through a
+//     cell whose list head changed: about one per level per deletion, each re-running its
+//     whole tail.)
 //   * T' is the least closure of the seeds, a set: the order in which the points add to it
 //     changes the trace, not the result. Each point's work is memoized on its list node,
 //     so an insertion or deletion re-runs only its own place() and what reads the cells it
@@ -104,16 +106,17 @@ struct QuadtreeMeshProgram {
   // ------------------------------------------------------------------ the points
   static void place(sac::Engine& r, Node* n, QuadtreeMeshProgram* cx) {
     if (!n) return;
-    r.memo(sac::fn<&descend>(cx, n, 1));
+    r.memo(sac::fn<&descend>(cx, n, 0));
     r.memo_read(n->next, sac::fn<&place>(cx));
   }
 
-  /// Reads cell_of(q, l).pts: non-empty iff T* split its parent.
+  /// Reads cell_of(q, l).split; only its T* bit steers (tree_split), which no postprocess
+  /// write changes.
   static void descend(sac::Engine& r, QuadtreeMeshProgram* cx, Node* n, int l) {
-    if (l > kMaxLevel) return settle(r, cx, n, kMaxLevel);
-    r.read(cx->slot(r, cell_of(n->q, l)).pts, [cx, n, l](sac::Engine& e, Node* head) {
-      if (head) descend(e, cx, n, l + 1);
-      else settle(e, cx, n, l - 1);
+    if (l >= kMaxLevel) return settle(r, cx, n, kMaxLevel);
+    r.read(cx->slot(r, cell_of(n->q, l)).split, [cx, n, l](sac::Engine& e, std::uint8_t v) {
+      if (tree_split(v)) descend(e, cx, n, l + 1);
+      else settle(e, cx, n, l);
     });
   }
 
