@@ -11,7 +11,13 @@
 # gnuplot pictures. Everything lands in docs/data/ and docs/figures/; the tables are
 # printed as Markdown for docs/EXPERIMENTS.md.
 #
-# Usage: bash bench/stability_experiments.sh [--quick]   (after `bash dev.sh run`, which builds)
+# With `--postprocess quadtree` the same experiments measure the whole update of the 2D
+# quadtree mesh (DynamicMesh: tree and mesh in one trace), into docs/data/mesh_* and
+# docs/figures/mesh_*; the spread sweep stops at 2^36, the deepest a mesh of derived-box
+# coordinates resolves (mesh_resolution_level).
+#
+# Usage: bash bench/stability_experiments.sh [--quick] [--postprocess quadtree]
+#        (after `bash dev.sh run`, which builds)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
@@ -20,30 +26,44 @@ DATA=docs/data
 FIG=docs/figures
 mkdir -p "$DATA" "$FIG"
 QUICK=0
-[[ ${1:-} == --quick ]] && QUICK=1
+PP=none
+while (($#)); do
+  case $1 in
+    --quick) QUICK=1 ;;
+    --postprocess) PP=${2:?--postprocess needs a value}; shift ;;
+    *) echo "usage: $0 [--quick] [--postprocess quadtree]" >&2; exit 2 ;;
+  esac
+  shift
+done
 U=400
 ((QUICK)) && U=60
+if [[ $PP == none ]]; then
+  P=stability_ FP= DIMS="2 3" KMAX=40 PPARGS=() WHAT="the quadtree"
+else
+  P=mesh_stability_ FP=mesh_ DIMS=2 KMAX=36 PPARGS=(--postprocess "$PP") WHAT="the $PP mesh"
+fi
 
-SPREAD_CSV=$DATA/stability_spread.csv
-DIST_CSV=$DATA/stability_distributions.csv
-SIZE_CSV=$DATA/stability_size.csv
+SPREAD_CSV=$DATA/${P}spread.csv
+DIST_CSV=$DATA/${P}distributions.csv
+SIZE_CSV=$DATA/${P}size.csv
 rm -f "$SPREAD_CSV" "$DIST_CSV" "$SIZE_CSV"
 
-RUNS=$DATA/run_means.dat  # one line per run: series log2_spread mean_distance n mean_us
+RUNS=$DATA/${FP}run_means.dat  # one line per run: series log2_spread mean_distance n mean_us
 rm -f "$RUNS"
 # run ARGS...: one `dynmesh stability` run; its rows are the last U of the CSV (the last
 # argument), whose means go to $RUNS.
 run() {
-  echo "+ $BIN stability $*" >&2
-  "$BIN" stability "$@"
+  echo "+ $BIN stability $* ${PPARGS[*]}" >&2
+  "$BIN" stability "$@" "${PPARGS[@]}"
   local csv=${*: -1}
   tail -n "$U" "$csv" | awk -F, '{ x += $4; y += $6; t += $7; k++; s = $1 "-" $2 "d"; n = $3 }
     END { printf "%s %.3f %.2f %s %.2f\n", s, x / k, y / k, n, t / k * 1e6 }' >> "$RUNS"
 }
 
 # 1. Trace distance against the spread, at fixed n.
-for dim in 2 3; do
+for dim in $DIMS; do
   for k in 8 12 16 20 24 28 32 36 40; do
+    ((k > KMAX)) && continue
     ((QUICK)) && ((k % 8 != 0)) && continue
     run --dim $dim --dist shrinking --n 4096 --spread $((2 ** k)) --updates $U --seed 1 --csv "$SPREAD_CSV"
   done
@@ -58,7 +78,7 @@ for dist in uniform clusters spiral; do
 done
 
 # 3. No dependence on n at a fixed spread.
-for dim in 2 3; do
+for dim in $DIMS; do
   for n in 1000 10000 100000; do
     ((QUICK)) && ((n > 10000)) && continue
     run --dim $dim --dist shrinking --n $n --spread $((2 ** 20)) --updates $U --seed 1 --csv "$SIZE_CSV"
@@ -99,46 +119,57 @@ awk -F, 'FNR > 1 { k = $2 "," $3; n[k]++; td[k] += $6; t[k] += $7; v[k] = v[k] "
 
 # ---------------------------------------------------------------- pictures
 # Per-run means (series, log2 spread, distance) for the spread plot; size means per dim.
-grep -v '^shrinking' "$RUNS" > "$DATA/spread_means.dat" || true
+grep -v '^shrinking' "$RUNS" > "$DATA/${FP}spread_means.dat" || true
 # The spread sweep's runs are the shrinking runs at n = 4096.
-awk '$1 ~ /^shrinking/ && $4 == 4096' "$RUNS" >> "$DATA/spread_means.dat"
-sort -k1,1 -k2,2n -o "$DATA/spread_means.dat" "$DATA/spread_means.dat"
+awk '$1 ~ /^shrinking/ && $4 == 4096' "$RUNS" >> "$DATA/${FP}spread_means.dat"
+sort -k1,1 -k2,2n -o "$DATA/${FP}spread_means.dat" "$DATA/${FP}spread_means.dat"
 awk -F, 'FNR > 1 { k = $2 "d," $3; n[k]++; s[k] += $7; td[k] += $6 }
   END { for (k in n) { split(k, p, ","); print p[1], p[2], s[k] / n[k] * 1e6, td[k] / n[k] } }' "$SIZE_CSV" |
-  sort -k1,1 -k2,2n > "$DATA/size_means.dat"
+  sort -k1,1 -k2,2n > "$DATA/${FP}size_means.dat"
 
 if command -v gnuplot >/dev/null; then
-  series=$(cut -d' ' -f1 "$DATA/spread_means.dat" | sort -u)
+  series=$(cut -d' ' -f1 "$DATA/${FP}spread_means.dat" | sort -u)
   {
     echo "set terminal svg size 900,600 dynamic font 'sans,13'"
-    echo "set output '$FIG/trace_distance_vs_spread.svg'"
-    echo "set title 'Mean trace distance per update against log2(L/s) (one point per run)'"
+    echo "set output '$FIG/${FP}trace_distance_vs_spread.svg'"
+    echo "set title 'Trace distance per update, $WHAT (mean of each run)'"
     echo "set xlabel 'log2(L/s)'; set ylabel 'trace events created + undone'"
-    echo "set key left top; set grid; set yrange [0:*]"
+    echo "set key right bottom; set grid; set yrange [0:*]"
     printf "plot "
     first=1
     for s in $series; do
       ((first)) || printf ", "
       first=0
-      printf "'< grep \"^%s \" %s' using 2:3 with linespoints title '%s'" "$s" "$DATA/spread_means.dat" "$s"
+      printf "'< grep \"^%s \" %s' using 2:3 with linespoints title '%s'" "$s" "$DATA/${FP}spread_means.dat" "$s"
     done
+    # The mesh's figure also shows the tree alone (from a tree run of this script), dashed.
+    if [[ -n $FP && -s $DATA/spread_means.dat ]]; then
+      printf ", '< grep \"^shrinking-2d \" %s' using 2:3 with linespoints dt 2 title 'shrinking-2d, tree alone'" \
+        "$DATA/spread_means.dat"
+    fi
     echo
-  } > "$DATA/spread.gp"
-  gnuplot "$DATA/spread.gp"
+  } > "$DATA/${FP}spread.gp"
+  gnuplot "$DATA/${FP}spread.gp"
   {
     echo "set terminal svg size 900,600 dynamic font 'sans,13'"
-    echo "set output '$FIG/update_time_vs_n.svg'"
-    echo "set title 'Mean update time and trace distance against n (shrinking, L/s = 2^{20})'"
+    echo "set output '$FIG/${FP}update_time_vs_n.svg'"
+    echo "set title 'Update time and trace distance, $WHAT (shrinking, L/s = 2^{20})'"
     echo "set xlabel 'n'; set logscale x; set ylabel 'mean update time (µs)'; set y2label 'mean trace distance'"
-    echo "set y2tics; set ytics nomirror; set key left top; set grid"
-    echo "plot '< grep \"^2d \" $DATA/size_means.dat' using 2:3 with linespoints title '2D time', \\"
-    echo "     '< grep \"^3d \" $DATA/size_means.dat' using 2:3 with linespoints title '3D time', \\"
-    echo "     '< grep \"^2d \" $DATA/size_means.dat' using 2:4 axes x1y2 with linespoints dt 2 title '2D distance', \\"
-    echo "     '< grep \"^3d \" $DATA/size_means.dat' using 2:4 axes x1y2 with linespoints dt 2 title '3D distance'"
-  } > "$DATA/size.gp"
-  gnuplot "$DATA/size.gp"
+    echo "set y2tics; set ytics nomirror; set key left bottom; set grid; set yrange [0:*]; set y2range [0:*]"
+    printf "plot "
+    first=1
+    for dim in $DIMS; do
+      ((first)) || printf ", "
+      first=0
+      printf "'< grep \"^%sd \" %s' using 2:3 with linespoints title '%sD time', " "$dim" "$DATA/${FP}size_means.dat" "$dim"
+      printf "'< grep \"^%sd \" %s' using 2:4 axes x1y2 with linespoints dt 2 title '%sD distance'" \
+        "$dim" "$DATA/${FP}size_means.dat" "$dim"
+    done
+    echo
+  } > "$DATA/${FP}size.gp"
+  gnuplot "$DATA/${FP}size.gp"
   echo
-  echo "pictures: $FIG/trace_distance_vs_spread.svg $FIG/update_time_vs_n.svg"
+  echo "pictures: $FIG/${FP}trace_distance_vs_spread.svg $FIG/${FP}update_time_vs_n.svg"
 else
   echo "gnuplot not found: no pictures (bash dev.sh deps installs it)" >&2
 fi
