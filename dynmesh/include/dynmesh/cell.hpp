@@ -30,11 +30,19 @@
 #include <cstdint>
 #include <string>
 
-#include <sac/hash.hpp>
-
 #include "dynmesh/point.hpp"
 
 namespace dynmesh {
+
+namespace detail {
+/// The splitmix64 finaliser, for cell hashes; stated here (as sac::mix64 states it) so that
+/// the geometry headers stand alone, without sac-runtime.
+constexpr std::uint64_t mix64(std::uint64_t x) noexcept {
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+}  // namespace detail
 
 template <std::size_t d>
   requires SupportedDim<d>
@@ -51,10 +59,11 @@ struct CellId {
     return true;
   }
   /// (level, i, j, k) lexicographic: the order of `.cells` files.
-  /// For sac::Hash, so that a cell can key a keyed allocation or a memoized call.
+  /// The `.hash()` member sac::Hash looks for, so that a cell can key a keyed allocation
+  /// or a memoized call (duck-typed: this header needs nothing from sac/).
   constexpr std::size_t hash() const noexcept {
-    std::uint64_t h = sac::mix64(static_cast<std::uint64_t>(level) + 0x9e3779b97f4a7c15ULL);
-    for (std::size_t k = 0; k < d; ++k) h = sac::mix64(h ^ index[k]);
+    std::uint64_t h = detail::mix64(static_cast<std::uint64_t>(level) + 0x9e3779b97f4a7c15ULL);
+    for (std::size_t k = 0; k < d; ++k) h = detail::mix64(h ^ index[k]);
     return static_cast<std::size_t>(h);
   }
 
@@ -248,7 +257,7 @@ struct CellHash {
     for (std::size_t a = 0; a < d; ++a) h = mix(h ^ (c.index[a] + 0x632be59bd9b4e019ULL * static_cast<std::uint64_t>(a + 1)));
     return static_cast<std::size_t>(h);
   }
-  static constexpr std::uint64_t mix(std::uint64_t x) noexcept { return sac::mix64(x); }
+  static constexpr std::uint64_t mix(std::uint64_t x) noexcept { return detail::mix64(x); }
 };
 
 /// "level:(i,j[,k])", for messages.
