@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# dev.sh: the project's entry point. Usage: bash dev.sh {deps|run [args]|test|asan|bench}
+# dev.sh: the project's entry point. Usage: bash dev.sh {deps|run [args]|test|asan|bench|fuzz [seconds]}
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 cd "$ROOT"
@@ -92,6 +92,25 @@ cmd_asan() {
 
 cmd_bench() { deps; build_release sac_suite dynmesh_bench; bench_job "$@"; }  # what bench_job runs
 
+# The libFuzzer targets of tests/fuzz/ (keep in step with tests/fuzz/CMakeLists.txt).
+FUZZ_TARGETS=(fuzz_point_readers fuzz_edit_reader fuzz_dynamic_quadtree fuzz_dynamic_mesh)
+
+# fuzz [SECONDS]: clang build of the libraries and the fuzz targets only (no tests, tools or
+# benchmarks) into build/fuzz, then each target for SECONDS (default 60) through its ctest
+# test: a scratch corpus under build/fuzz seeded from tests/fuzz/corpus/<target>/, which is
+# only read. Fails on any finding; the input is saved under build/fuzz/tests/fuzz/artifacts/.
+cmd_fuzz() {
+  local seconds=${1:-60}
+  [[ $seconds =~ ^[1-9][0-9]*$ ]] || { echo "dev.sh fuzz: SECONDS must be a positive integer, got '$seconds'" >&2; exit 2; }
+  deps
+  cmake -S "$ROOT" -B build/fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DDYNMESH_FUZZ=ON -DDYNMESH_FUZZ_SECONDS="$seconds" \
+    -DSAC_BUILD_TESTS=OFF -DSAC_BUILD_BENCH=OFF -DSAC_BUILD_EXAMPLES=OFF -DDYNMESH_BUILD_TOOLS=OFF
+  cmake --build build/fuzz -j "$JOBS" --target "${FUZZ_TARGETS[@]}"
+  # One target at a time: each is a single process on one core.
+  ctest --test-dir build/fuzz -L '^fuzz$' --output-on-failure --no-tests=error
+}
+
 usage() {
   cat >&2 <<'USAGE'
 usage: bash dev.sh COMMAND [args]
@@ -100,6 +119,7 @@ usage: bash dev.sh COMMAND [args]
   test         RelWithDebInfo build (asserts on, -Werror) into build/debug, then every ctest test
   asan         Debug build with ASan+UBSan (clang++ if present) into build/asan, then ctest
   bench        Release build of the benchmarks, then sac_suite and dynmesh_bench at the README sizes
+  fuzz [secs]  clang libFuzzer build into build/fuzz, then each fuzz target for secs (default 60)
 USAGE
 }
 
@@ -111,6 +131,7 @@ case "$cmd" in
   test) cmd_test ;;
   asan) cmd_asan ;;
   bench) cmd_bench "$@" ;;
+  fuzz) cmd_fuzz "$@" ;;
   -h|--help|help) usage ;;
   *) usage; exit 2 ;;
 esac

@@ -41,8 +41,15 @@ struct MeshChecks {
   void erase(const Position<2>& q) { --delta[cell_of(q, level())]; }
 };
 
+/// The box, validated before MeshGrid computes with it (its resolution level takes ilogb of
+/// the side, which overflows for 0 or NaN): `log` is built before `core` validates.
+const Box<2>& validated(const Box<2>& box) {
+  validate_box(box);
+  return box;
+}
+
 struct MeshState {
-  MeshState(const Box<2>& box, MeshOptions opts) : options(opts), log(MeshGrid(box)), core(box) {
+  MeshState(const Box<2>& box, MeshOptions opts) : options(opts), log(MeshGrid(validated(box))), core(box) {
     program.dir = &core.dir;
     program.input = &core.head;
     program.log = &log;
@@ -99,6 +106,19 @@ struct MeshState {
   }
 };
 
+/// Applies validated edits with one propagation. Built with the CMake option
+/// SAC_DEBUG_CHECKS, every checker of the tree and the mesh then runs (the engine's ran at
+/// the end of propagate()).
+std::vector<PointId> checked_update(const DynamicMesh& mesh, MeshState& s, std::span<const Edit<2>> edits) {
+  std::vector<PointId> ids = s.update(edits);
+#ifdef SAC_DEBUG_CHECKS
+  mesh.check_invariants();
+#else
+  (void)mesh;
+#endif
+  return ids;
+}
+
 }  // namespace detail
 
 DynamicMesh::DynamicMesh(const Box<2>& box, std::span<const Point<2>> points, MeshOptions options)
@@ -109,6 +129,7 @@ DynamicMesh::DynamicMesh(const Box<2>& box, std::span<const Point<2>> points, Me
   edits.reserve(points.size());
   for (const Point<2>& p : points) edits.push_back(Edit<2>{EditOp::Insert, p});
   s_->validate(edits, "point");
+  validate_mesh_box(box);
   auto* program = &s_->program;
   s_->core.build(points, [program](sac::Engine& rt) { detail::QuadtreeMeshProgram::main(rt, program); });
   s_->count(edits);
@@ -123,23 +144,23 @@ DynamicMesh& DynamicMesh::operator=(DynamicMesh&&) noexcept = default;
 PointId DynamicMesh::insert(const Point<2>& p) {
   const Edit<2> e{EditOp::Insert, p};
   s_->validate({&e, 1}, "");
-  return s_->update({&e, 1}).front();
+  return detail::checked_update(*this, *s_, {&e, 1}).front();
 }
 
 void DynamicMesh::erase(PointId id) {
   const Edit<2> e = s_->core.erase_edit(id);
-  s_->update({&e, 1});
+  detail::checked_update(*this, *s_, {&e, 1});
 }
 
 void DynamicMesh::erase(const Point<2>& p) {
   const Edit<2> e{EditOp::Delete, p};
   s_->validate({&e, 1}, "");
-  s_->update({&e, 1});
+  detail::checked_update(*this, *s_, {&e, 1});
 }
 
 std::vector<PointId> DynamicMesh::apply(std::span<const Edit<2>> edits) {
   s_->validate(edits, "edit");
-  return s_->update(edits);
+  return detail::checked_update(*this, *s_, edits);
 }
 
 const Box<2>& DynamicMesh::box() const noexcept { return s_->core.box; }

@@ -1,5 +1,5 @@
-// dynamic_quadtree.cpp — DynamicQuadtree: QuadtreeCore running QuadTreeRefine alone, and
-// the tree read out of the directory's slots.
+// dynamic_quadtree.cpp — DynamicQuadtree: the public API over its DynamicState
+// (dynamic_quadtree_state.hpp: QuadtreeCore running QuadTreeRefine alone).
 #include "dynmesh/dynamic_quadtree.hpp"
 
 #include <algorithm>
@@ -7,30 +7,11 @@
 #include <string>
 #include <utility>
 
+#include "dynamic_quadtree_state.hpp"
 #include "dynmesh/detail/touching_leaves.hpp"
-#include "quadtree_core.hpp"
 
 namespace dynmesh {
 namespace detail {
-
-template <std::size_t d>
-struct DynamicState : QuadtreeCore<d> {
-  using QuadtreeCore<d>::QuadtreeCore;
-
-  template <class F>
-  void for_each_leaf(F&& f) const {
-    this->for_each_leaf_of([&](const CellId<d>& c) { return this->is_split(c); },
-                           [&](const CellId<d>& c) { f(c, this->points_in(c)); });
-  }
-  bool is_leaf(const CellId<d>& c) const {
-    return valid(c) && (c.level == 0 || this->is_split(parent(c))) && !this->is_split(c);
-  }
-  CellId<d> leaf_at(const Position<d>& q) const {
-    CellId<d> c = CellId<d>::root();
-    while (this->is_split(c)) c = cell_of(q, c.level + 1);
-    return c;
-  }
-};
 
 template <std::size_t d>
 std::vector<Edit<d>> inserts_of(std::span<const Point<d>> points) {
@@ -38,6 +19,21 @@ std::vector<Edit<d>> inserts_of(std::span<const Point<d>> points) {
   edits.reserve(points.size());
   for (const Point<d>& p : points) edits.push_back(Edit<d>{EditOp::Insert, p});
   return edits;
+}
+
+/// Applies validated edits with one propagation. Built with the CMake option
+/// SAC_DEBUG_CHECKS, every checker of the tree then runs (the engine's ran at the end of
+/// propagate()).
+template <std::size_t d>
+std::vector<PointId> checked_update(const DynamicQuadtree<d>& tree, DynamicState<d>& s,
+                                    std::span<const Edit<d>> edits) {
+  std::vector<PointId> ids = s.update(edits);
+#ifdef SAC_DEBUG_CHECKS
+  tree.check_invariants();
+#else
+  (void)tree;
+#endif
+  return ids;
 }
 
 }  // namespace detail
@@ -65,14 +61,14 @@ template <std::size_t d>
 PointId DynamicQuadtree<d>::insert(const Point<d>& p) {
   const Edit<d> e{EditOp::Insert, p};
   s_->validate({&e, 1}, "");
-  return s_->update({&e, 1}).front();
+  return detail::checked_update<d>(*this, *s_, {&e, 1}).front();
 }
 
 template <std::size_t d>
   requires SupportedDim<d>
 void DynamicQuadtree<d>::erase(PointId id) {
   const Edit<d> e = s_->erase_edit(id);
-  s_->update({&e, 1});
+  detail::checked_update<d>(*this, *s_, {&e, 1});
 }
 
 template <std::size_t d>
@@ -80,14 +76,14 @@ template <std::size_t d>
 void DynamicQuadtree<d>::erase(const Point<d>& p) {
   const Edit<d> e{EditOp::Delete, p};
   s_->validate({&e, 1}, "");
-  s_->update({&e, 1});
+  detail::checked_update<d>(*this, *s_, {&e, 1});
 }
 
 template <std::size_t d>
   requires SupportedDim<d>
 std::vector<PointId> DynamicQuadtree<d>::apply(std::span<const Edit<d>> edits) {
   s_->validate(edits, "edit");
-  return s_->update(edits);
+  return detail::checked_update<d>(*this, *s_, edits);
 }
 
 template <std::size_t d>

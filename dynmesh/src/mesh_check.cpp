@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
 #include <utility>
 
 #include "dynmesh/errors.hpp"
@@ -377,7 +378,13 @@ Index opposite(const Tri& tri, Index u, Index v) noexcept {
 }  // namespace
 
 double corner_angle_deg(const Point<2>& at, const Point<2>& p, const Point<2>& q) noexcept {
-  const double ux = p[0] - at[0], uy = p[1] - at[1], vx = q[0] - at[0], vy = q[1] - at[1];
+  double ux = p[0] - at[0], uy = p[1] - at[1], vx = q[0] - at[0], vy = q[1] - at[1];
+  // Scaled by a power of two (exact, and the angle does not change) so that the products
+  // neither overflow in a box of side near 1e308 nor underflow to 0 in one near 1e-300.
+  if (const double m = std::max({std::abs(ux), std::abs(uy), std::abs(vx), std::abs(vy)}); m > 0 && std::isfinite(m)) {
+    const int e = std::ilogb(m);
+    ux = std::ldexp(ux, -e), uy = std::ldexp(uy, -e), vx = std::ldexp(vx, -e), vy = std::ldexp(vy, -e);
+  }
   const double cross = ux * vy - uy * vx, dot = ux * vx + uy * vy;
   return std::atan2(std::abs(cross), dot) * (180.0 / std::numbers::pi);
 }
@@ -423,7 +430,11 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
     if (!is_vertex(c))
       record.add(MeshDefect::MissingCorner, [&] { return "box corner " + to_string(c) + " is not a vertex"; });
 
-  // Per triangle: indices, canonical rotation and order, orientation, area, angles.
+  // Per triangle: indices, canonical rotation and order, orientation, area, angles. Areas are
+  // in units of 2^(2k) with 2^k <= L < 2^(k+1) (exact scaling), so that neither the box's
+  // nor a triangle's overflows or underflows in a box of extreme size.
+  const int side_exponent = std::isfinite(box.side) && box.side > 0 ? std::ilogb(box.side) : 0;
+  auto scaled = [&](double length) { return std::ldexp(length, -side_exponent); };
   std::vector<char> well_formed(nt, 0), ccw(nt, 0);
   double area = 0, area_compensation = 0;  // Neumaier summation: 10^6 terms of mixed sizes
   double min_angle = std::numeric_limits<double>::infinity(), max_angle = 0;
@@ -449,7 +460,8 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
         return describe_triangle(mesh, t) + (turn < 0 ? " is clockwise" : " is degenerate (collinear corners)");
       });
     }
-    const double twice = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    const double twice =
+        scaled(b[0] - a[0]) * scaled(c[1] - a[1]) - scaled(b[1] - a[1]) * scaled(c[0] - a[0]);
     const double sum = area + twice;
     area_compensation += std::abs(area) >= std::abs(twice) ? (area - sum) + twice : (twice - sum) + area;
     area = sum;
@@ -469,11 +481,13 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
     report.max_angle_deg = max_angle;
   }
 
-  const double box_area = (domain.x1 - domain.x0) * (domain.y1 - domain.y0);
+  const double box_area = scaled(domain.x1 - domain.x0) * scaled(domain.y1 - domain.y0);
   const double mesh_area = (area + area_compensation) / 2;
   if (!(std::abs(mesh_area - box_area) <= 1e-9 * box_area))
     record.add(MeshDefect::Area, [&] {
-      return "the triangles' area " + format_exact(mesh_area) + " differs from the box's " + format_exact(box_area);
+      const std::string unit = side_exponent == 0 ? "" : " (in units of 2^" + std::to_string(2 * side_exponent) + ")";
+      return "the triangles' area " + format_exact(mesh_area) + " differs from the box's " + format_exact(box_area) +
+             unit;
     });
 
   // Edges: matched in opposite directions inside, on a side of the box when used once.

@@ -3,6 +3,8 @@
 #include "dynmesh/quadtree_mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdlib>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -60,6 +62,7 @@ QuadtreeMesh::QuadtreeMesh(const Box<2>& box, std::span<const Point<2>> points)
   const MeshGrid grid(box);
   const auto qs = tree_.points();
   check_resolution(grid, points, qs);
+  validate_mesh_box(box);
 
   // T': T*'s split cells, then every point's seeds and what grading forces.
   CellTable<2> split(tree_.num_split() * 2);
@@ -119,6 +122,17 @@ QuadtreeMesh::QuadtreeMesh(const Box<2>& box, std::span<const Point<2>> points)
   }
   std::sort(leaves_.begin(), leaves_.end());
   std::sort(triangles_.begin(), triangles_.end());
+}
+
+void validate_mesh_box(const Box<2>& box) {
+  if (std::abs(std::ilogb(box.side)) > kMeshSideExponent)
+    throw InputError(InputError::Kind::Resolution,
+                     "the domain box's side L = " + format_brief(box.side) + " is beyond what the mesh computes in double "
+                     "precision (2^-" + std::to_string(kMeshSideExponent) + " <= L < 2^" +
+                         std::to_string(kMeshSideExponent + 1) + ")");
+  if (MeshGrid(box).level_limit < 2)
+    throw InputError(InputError::Kind::Resolution,
+                     "the domain box is too small for its offset: double coordinates cannot resolve its cells");
 }
 
 void require_refined_tree(std::span<const Leaf<2>> leaves, std::size_t npoints) {

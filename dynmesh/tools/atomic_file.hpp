@@ -6,11 +6,16 @@
 // the text to a temporary file beside its target (same directory, so rename() cannot cross
 // file systems), flushes it to disk and closes it, checking every step; commit() then
 // renames all temporaries into place. Writing everything before renaming anything means a
-// write failure (disk full, unwritable directory) leaves every old file intact.
+// write failure (disk full, a file size limit, unwritable directory) leaves every old file
+// intact. A target that exists but is not a regular file (a directory, a device such as
+// /dev/stdout, a FIFO) is refused: renaming would replace it rather than write into it.
+// An append (the stability CSV) is a rewrite: read_existing() gives the old content, and the
+// old content plus the new goes through add().
 // Invariants: a temporary is removed unless it was renamed (the destructor removes the
 // leftovers of a run that failed or never committed); errors are InputError(Io) naming the
 // target path and the OS reason (strerror).
-// Complexity: linear in the bytes written; one fsync per file.
+// Complexity: linear in the bytes written (an append rewrites the whole file); one fsync per
+// file.
 // Paper: none.
 #pragma once
 
@@ -19,6 +24,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -48,6 +54,8 @@ class AtomicOutputs {
     const std::string dir = slash == std::string::npos ? std::string{} : path.substr(0, slash + 1);
     const std::string base = slash == std::string::npos ? path : path.substr(slash + 1);
     if (base.empty()) fail(path, "not a file name", 0);
+    struct ::stat st;
+    if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) fail(path, "not a regular file", 0);
     std::string temp = dir + "." + base + ".tmp-XXXXXX";
     const int fd = ::mkstemp(temp.data());
     if (fd < 0) fail(path, "cannot create a temporary file beside it", errno);
@@ -79,6 +87,37 @@ class AtomicOutputs {
     if (::close(fd) != 0) fail(path, "write error on close", errno);
   }
 
+  /// The content of the file at `path`, or std::nullopt when there is none; InputError(Io)
+  /// with the OS reason when it exists but cannot be read, and, as add(), when it is not a
+  /// regular file (opened without blocking, so a FIFO or a terminal cannot hang the read).
+  static std::optional<std::string> read_existing(const std::string& path) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOCTTY);
+    if (fd < 0) {
+      if (errno == ENOENT) return std::nullopt;
+      fail_read(path, errno);
+    }
+    struct ::stat st;
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+      ::close(fd);
+      fail(path, "not a regular file", 0);
+    }
+    std::string text;
+    char buf[1 << 16];
+    while (true) {
+      const ::ssize_t n = ::read(fd, buf, sizeof buf);
+      if (n == 0) break;
+      if (n < 0) {
+        if (errno == EINTR) continue;
+        const int err = errno;
+        ::close(fd);
+        fail_read(path, err);
+      }
+      text.append(buf, static_cast<std::size_t>(n));
+    }
+    ::close(fd);
+    return text;
+  }
+
   /// Renames every temporary into place, in the order added.
   void commit() {
     for (std::size_t i = 0; i < pending_.size(); ++i) {
@@ -101,6 +140,9 @@ class AtomicOutputs {
     std::string text = "cannot write output: " + what;
     if (err != 0) text += std::string(": ") + std::strerror(err);
     throw InputError(InputError::Kind::Io, text, path);
+  }
+  [[noreturn]] static void fail_read(const std::string& path, int err) {
+    throw InputError(InputError::Kind::Io, std::string("cannot read: ") + std::strerror(err), path);
   }
 
   std::vector<Pending> pending_;

@@ -2,7 +2,9 @@
 // stability CSV (so runs appended by earlier invocations are plotted too). One line per
 // (distribution, dimension); each point is the mean trace distance of the rows whose
 // log2_spread rounds to the same multiple of 0.5. Drawn by gnuplot's svg terminal; the script
-// goes to gnuplot's stdin, with the data inline, so nothing but the picture is written.
+// goes to gnuplot's stdin, with the data inline. gnuplot draws into a scratch file beside the
+// picture; the picture then goes through AtomicOutputs (atomic_file.hpp) like every other
+// output, so a failed plot leaves an earlier picture whole and nothing else behind.
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -10,7 +12,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -21,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "atomic_file.hpp"
 #include "commands.hpp"
 #include "dynmesh/errors.hpp"
 
@@ -67,6 +69,30 @@ struct Bucket {
   std::size_t count = 0;
 };
 
+/// An empty file beside `path` (same directory, so a full or unwritable file system shows
+/// up here already) for another program to write; removed when this goes out of scope.
+class ScratchFile {
+ public:
+  explicit ScratchFile(const std::string& path) {
+    const auto slash = path.find_last_of('/');
+    const std::string dir = slash == std::string::npos ? std::string{} : path.substr(0, slash + 1);
+    name_ = dir + "." + path.substr(slash == std::string::npos ? 0 : slash + 1) + ".plot-XXXXXX";
+    const int fd = ::mkstemp(name_.data());
+    if (fd < 0)
+      throw InputError(Kind::Io, std::string("cannot write output: cannot create a scratch file beside it: ") +
+                                     std::strerror(errno),
+                       path);
+    ::close(fd);
+  }
+  ScratchFile(const ScratchFile&) = delete;
+  ScratchFile& operator=(const ScratchFile&) = delete;
+  ~ScratchFile() { ::unlink(name_.c_str()); }
+  const std::string& name() const noexcept { return name_; }
+
+ private:
+  std::string name_;
+};
+
 }  // namespace
 
 void plot_stability_csv(const std::string& csv_path, const std::string& svg_path) {
@@ -109,9 +135,10 @@ void plot_stability_csv(const std::string& csv_path, const std::string& svg_path
   if (!on_path("gnuplot"))
     throw InputError(Kind::Io, "--plot needs gnuplot, which is not on PATH (bash dev.sh deps installs it)");
 
+  const ScratchFile drawn(svg_path);
   std::ostringstream gp;
   gp << "set terminal svg size 900,600 dynamic background rgb 'white' font 'Sans,12'\n"
-     << "set output " << gp_quote(svg_path) << "\n"
+     << "set output " << gp_quote(drawn.name()) << "\n"
      << "set title 'dynmesh stability: trace distance of single-point updates'\n"
      << "set xlabel 'log_2(L/s) of the point set (rounded to 0.5)'\n"
      << "set ylabel 'mean trace distance per update'\n"
@@ -137,8 +164,6 @@ void plot_stability_csv(const std::string& csv_path, const std::string& svg_path
   }
   gp << plot << "\nset output\n";
 
-  std::error_code ec;
-  std::filesystem::remove(svg_path, ec);  // so that a stale picture never passes for a new one
   // gnuplot exiting early must not kill us with SIGPIPE.
   const auto old_handler = std::signal(SIGPIPE, SIG_IGN);
   FILE* pipe = ::popen("gnuplot", "w");
@@ -155,8 +180,11 @@ void plot_stability_csv(const std::string& csv_path, const std::string& svg_path
     throw InputError(Kind::Io, "gnuplot failed (exit status " + std::to_string(code) + ") drawing the plot",
                      svg_path);
   }
-  if (!std::filesystem::exists(svg_path, ec) || std::filesystem::file_size(svg_path, ec) == 0)
-    throw InputError(Kind::Io, "gnuplot did not write the plot", svg_path);
+  const std::string picture = AtomicOutputs::read_existing(drawn.name()).value_or(std::string{});
+  if (picture.empty()) throw InputError(Kind::Io, "gnuplot did not write the plot", svg_path);
+  AtomicOutputs out;
+  out.add(svg_path, picture);
+  out.commit();
 }
 
 }  // namespace dynmesh::tool

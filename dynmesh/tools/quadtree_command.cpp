@@ -3,17 +3,21 @@
 // comes from; the tree's own errors (which name point indices or nothing) are re-labelled
 // here with the line of the point file or of the edit script. The point file is read,
 // stripped of later copies on request (--duplicates skip) and located by initial_points.hpp,
-// shared with `dynmesh mesh`.
+// shared with `dynmesh mesh`. As there, --check runs before anything is written, and the
+// outputs (.cells, --svg) are written aside and renamed into place together
+// (atomic_file.hpp), so a failed run leaves the files of an earlier run as they were.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <optional>
 #include <span>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "atomic_file.hpp"
 #include "commands.hpp"
 #include "initial_points.hpp"
 #include "input_labels.hpp"
@@ -82,19 +86,23 @@ int run(const QuadtreeOptions& o) {
     }
   }
 
-  const std::vector<Leaf<d>> leaves = tree.leaves();
-  write_cells_file<d>(o.cells, box, leaves);
-  if constexpr (d == 2) {
-    if (!o.svg.empty()) {
-      std::vector<Point<2>> pts;
-      for (const auto& entry : tree.points()) pts.push_back(entry.second);
-      write_svg_file(o.svg, box, leaves, pts);
-    }
-  }
   if (o.check) {
     const Verification v = verify<d>(tree);
     if (!v.ok) throw InvariantError("--check failed: " + v.problem);
   }
+  const std::vector<Leaf<d>> leaves = tree.leaves();
+  AtomicOutputs out;
+  out.add(o.cells, format_cells<d>(box, leaves));
+  if constexpr (d == 2) {
+    if (!o.svg.empty()) {
+      std::vector<Point<2>> pts;
+      for (const auto& entry : tree.points()) pts.push_back(entry.second);
+      std::ostringstream svg;
+      write_svg(svg, box, leaves, pts);
+      out.add(o.svg, svg.str());
+    }
+  }
+  out.commit();
   if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", initial.duplicates_skipped);
   return 0;
 }

@@ -14,14 +14,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <numeric>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "atomic_file.hpp"
 #include "commands.hpp"
 #include "dynmesh/box.hpp"
 #include "dynmesh/distributions.hpp"
@@ -49,26 +49,27 @@ std::string known_distributions() {
   return s;
 }
 
-// Opens the CSV for appending; writes the header when the file is new or empty, and refuses
-// a non-empty file whose first line is not the header (it is some other file).
-std::ofstream open_csv(const std::string& path) {
-  bool fresh = true;
-  std::error_code ec;
-  if (std::filesystem::exists(path, ec) && std::filesystem::file_size(path, ec) > 0 && !ec) {
-    fresh = false;
-    std::ifstream in(path);
-    std::string first;
-    std::getline(in, first);
-    if (!first.empty() && first.back() == '\r') first.pop_back();
+// Appends the rows to the CSV, with the header first when the file is new or empty, and
+// refuses a non-empty file whose first line is not the header (it is some other file). The
+// old content and the rows are written aside and renamed into place (atomic_file.hpp), so a
+// failed write leaves the old file whole.
+void append_csv(const std::string& path, const std::string& rows) {
+  std::string text = AtomicOutputs::read_existing(path).value_or(std::string{});
+  if (text.empty()) {
+    text = std::string(kCsvHeader) + '\n';
+  } else {
+    std::string_view first = std::string_view(text).substr(0, text.find('\n'));
+    if (first.ends_with('\r')) first.remove_suffix(1);
     if (first != kCsvHeader)
       throw InputError(Kind::Malformed, "exists and is not a stability CSV (its first line is not '" +
                                             std::string(kCsvHeader) + "'); not appending to it",
                        path, 1);
+    if (text.back() != '\n') text += '\n';  // a last row without its line end
   }
-  std::ofstream out(path, std::ios::binary | std::ios::app);
-  if (!out) throw InputError(Kind::Io, "cannot open file for writing", path);
-  if (fresh) out << kCsvHeader << '\n';
-  return out;
+  text += rows;
+  AtomicOutputs out;
+  out.add(path, text);
+  out.commit();
 }
 
 // The structure a run measures: the tree alone, or the tree and its mesh.
@@ -115,11 +116,7 @@ int run(const StabilityOptions& o, Distribution dist, const char* what) {
       progress.tick(u + 1);
     }
   }
-  std::ofstream csv = open_csv(o.csv);
-  csv << rows;
-  csv.flush();
-  if (!csv) throw InputError(Kind::Io, "write error", o.csv);
-  csv.close();
+  append_csv(o.csv, rows);
 
   // History independence on every run: the updated structure must equal a from-scratch build
   // on the final points (the rows are written first, so a failure keeps them for inspection).

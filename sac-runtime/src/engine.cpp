@@ -331,6 +331,11 @@ void Engine::propagate() {
   ++stats_.propagations;
   stats_.last_trace_distance =
       (stats_.events_created - created0) + (stats_.events_undone - undone0);
+#ifdef SAC_DEBUG_CHECKS
+  // The CMake option: every checker after every propagation, O(trace) each (the engine is
+  // left as propagated: a failure is reported, not undone).
+  check_invariants();
+#endif
 }
 
 // ------------------------------------------------------------------ memoization

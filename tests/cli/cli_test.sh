@@ -229,6 +229,65 @@ case $case_name in
     expect_error 2 '-o' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}"
     ;;
 
+  atomic) # a failed write (here EFBIG under a file size limit) names the OS reason and leaves
+    # the old file byte for byte: quadtree .cells and --svg, mesh -o, the stability CSV and
+    # --plot; an existing target that is not a regular file is refused, not replaced.
+    # limited CMD...: CMD under a 1 KiB file size limit, with SIGXFSZ ignored so that the write
+    # fails with EFBIG instead of the signal killing the process.
+    limited() (
+      trap '' XFSZ
+      ulimit -f 1 && exec "$@"
+    )
+    qt=(--postprocess quadtree)
+    run "$dynmesh" quadtree "$data/points2d.node" --cells old.cells --svg old.svg
+    run "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" -o old
+    # The CSV stays below the limit, so that appending in place would write part of the rows.
+    run "$dynmesh" stability --dim 2 --dist uniform --n 300 --updates 5 --csv old.csv
+    (($(wc -c <old.csv) < 1024)) || fail "old.csv is not below the 1 KiB limit"
+    cp old.csv saved.csv
+    for f in old.cells old.svg old.node old.ele; do
+      (($(wc -c <"$f") > 1024)) || fail "$f is too small to exceed the 1 KiB limit"
+      cp "$f" "saved.${f#old.}"
+    done
+    # Without the limit these runs would succeed (and change every file).
+    expect_error 1 'old.cells: cannot write output: write error: File too large' limited "$dynmesh" quadtree \
+      "$data/points2d.node" --edits "$data/edits2d.txt" --cells old.cells --svg old.svg
+    expect_error 1 'old.node: cannot write output: write error: File too large' limited "$dynmesh" mesh \
+      "$data/points2d.node" "${qt[@]}" --edits "$data/edits2d.txt" -o old
+    expect_error 1 'old.csv: cannot write output: write error: File too large' limited "$dynmesh" stability \
+      --dim 2 --dist uniform --n 300 --updates 30 --seed 2 --csv old.csv
+    for f in cells svg node ele csv; do cmp "old.$f" "saved.$f" || fail "a failed write changed old.$f"; done
+    # The CSV append still appends when nothing fails.
+    run "$dynmesh" stability --dim 2 --dist uniform --n 300 --updates 30 --seed 2 --csv old.csv
+    cmp <(head -c "$(wc -c <saved.csv)" old.csv) saved.csv || fail "an append changed the old rows"
+    [[ $(wc -l <old.csv) -eq 36 ]] || fail "append: expected header + 35 rows, got $(wc -l <old.csv) lines"
+    if command -v gnuplot >/dev/null; then
+      run "$dynmesh" stability --dim 2 --dist uniform --n 50 --updates 4 --csv p.csv --plot old.plot.svg
+      cp old.plot.svg saved.plot.svg
+      # A gnuplot that fails after writing half a picture.
+      mkdir -p badplot
+      cat >badplot/gnuplot <<'GNUPLOT'
+#!/usr/bin/env bash
+while IFS= read -r line; do
+  if [[ $line == "set output '"*"'" ]]; then f=${line#set output \'}; echo '<svg' >"${f%\'}"; fi
+done
+exit 3
+GNUPLOT
+      chmod +x badplot/gnuplot
+      expect_error 1 'gnuplot failed' env PATH="$PWD/badplot:$PATH" "$dynmesh" stability --dim 2 --dist uniform \
+        --n 50 --updates 4 --csv p.csv --plot old.plot.svg
+      cmp old.plot.svg saved.plot.svg || fail "a failed plot changed the old picture"
+    fi
+    mkdir -p adir
+    expect_error 1 'adir: cannot write output: not a regular file' "$dynmesh" quadtree "$data/points2d.node" \
+      --cells adir
+    expect_error 1 'adir: cannot write output: not a regular file' "$dynmesh" stability --dim 2 --dist uniform \
+      --n 50 --updates 2 --csv adir
+    [[ -d adir ]] || fail "a directory target was replaced"
+    [[ -z $(find . -name '.*.tmp-*' -o -name '.*.plot-*') ]] ||
+      fail "temporary files left behind: $(find . -name '.*.tmp-*' -o -name '.*.plot-*')"
+    ;;
+
   quirks) # a byte order mark, ',' and ';' separators; a directory or unreadable file named as such
     # The same points and edits with a BOM and list separators give the same tree and mesh.
     { printf '\xef\xbb\xbf'; awk '/^#/ { print; next } { print (NR % 2 ? $1 "," $2 : $1 "; " $2) }' \
@@ -363,7 +422,7 @@ case $case_name in
     ;;
 
   dev_sh) # dev.sh with stub tools: `run` builds only bin/dynmesh, `bench` only what it runs,
-    # `test` everything; apt-get waits for the dpkg lock.
+    # `test` everything, `fuzz` the fuzz targets alone; apt-get waits for the dpkg lock.
     mkdir -p fake stub/build/release/bin
     cp "$data/../../../dev.sh" stub/dev.sh || fail "no dev.sh"
     log=$PWD/calls.log
@@ -397,6 +456,15 @@ case $case_name in
     dev test
     grep -qx 'cmake --build build/debug -j 1' calls.log || fail "test does not build everything: $(cat calls.log)"
     grep -q '^ctest --test-dir build/debug' calls.log || fail "test runs no ctest: $(cat calls.log)"
+    # fuzz: a clang build of the fuzz targets alone, each run through its ctest test.
+    : >calls.log
+    dev fuzz 7
+    grep -q '^cmake -S .* -B build/fuzz .*-DCMAKE_CXX_COMPILER=clang++ .*-DDYNMESH_FUZZ=ON -DDYNMESH_FUZZ_SECONDS=7 ' \
+      calls.log || fail "fuzz: configure: $(cat calls.log)"
+    grep -qx 'cmake --build build/fuzz -j 1 --target fuzz_point_readers fuzz_edit_reader fuzz_dynamic_quadtree fuzz_dynamic_mesh' \
+      calls.log || fail "fuzz builds more or less than the fuzz targets: $(cat calls.log)"
+    grep -q "^ctest --test-dir build/fuzz -L ^fuzz\$ " calls.log || fail "fuzz runs no ctest: $(cat calls.log)"
+    PATH="$PWD/fake:$PATH" bash stub/dev.sh fuzz 1.5 >out.txt 2>err.txt && fail "fuzz accepted 1.5 seconds"
     ;;
 
   *)

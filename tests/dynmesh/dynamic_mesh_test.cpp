@@ -149,6 +149,38 @@ TEST(DynamicMesh, TinySets) {
   }
 }
 
+TEST(DynamicMesh, BoxesItsDoublesCannotMeshAreRefused) {
+  // Found by fuzzing. o + L == o: both box corners on an axis are one number, so even the
+  // empty set would mesh as degenerate triangles (each point was already refused). A side
+  // beyond 2^±440: the triangulation rules' angles overflow or underflow (an angle of 14°,
+  // or no valid triangulation at all).
+  const std::vector<Box<2>> refused = {
+      {{-1.8122712673485284e+145, -8.1249129568850047e+99}, 2.4374738870655016e+100},
+      {{0.0, 0.0}, 0x1p441},
+      {{0.0, 0.0}, 0x1p-441},
+      {{-3.3700738560978761e+305, -4.4934318081305018e+305}, 6.7401477121957522e+305}};
+  for (const Box<2>& box : refused)
+    for (const bool with_point : {false, true}) {
+      SCOPED_TRACE("side " + format_exact(box.side) + (with_point ? ", one point" : ", no points"));
+      std::vector<Point<2>> pts;
+      if (with_point) pts.push_back({box.origin[0] + box.side / 3, box.origin[1] + box.side / 3});
+      try {
+        DynamicMesh dyn(box, pts);
+        ADD_FAILURE() << "DynamicMesh accepted the box";
+      } catch (const InputError& e) {
+        EXPECT_EQ(e.kind(), Kind::Resolution) << e.what();
+      }
+      EXPECT_THROW(QuadtreeMesh(box, pts), InputError);
+    }
+  for (const double side : {0x1p440, 0x1p-440}) {  // the extremes still meshed
+    SCOPED_TRACE("side " + format_exact(side));
+    const Box<2> box{{0.0, 0.0}, side};
+    const std::vector<Point<2>> pts = {{side * 0.3, side * 0.45}, {side * 0.7, side * 0.6}, {side * 0.5, side * 0.5000001}};
+    DynamicMesh dyn(box, pts);
+    EXPECT_TRUE(agrees(dyn, pts));
+  }
+}
+
 TEST(DynamicMesh, BadInputChangesNothing) {
   const auto pts = generate<2>(Distribution::Uniform, 50, 21);
   DynamicMesh dyn(derive_box<2>(pts), pts);

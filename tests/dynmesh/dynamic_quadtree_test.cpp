@@ -3,7 +3,10 @@
 // Differential after every update (single insertions and deletions, by id and by coordinates,
 // and batches through apply()) on every distribution; history independence (an edited tree
 // equals a fresh one, including the size of its trace); a stability smoke test of the trace
-// distance; bad input leaving the state as it was; the query API; empty and tiny sets.
+// distance; bad input leaving the state as it was; the query API; empty and tiny sets; and
+// the checkers themselves: a corrupted directory, tree or point index must fail
+// check_invariants() (through the test-only DynamicQuadtreeTestAccess).
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -28,6 +31,18 @@
 #include "dynmesh/errors.hpp"
 #include "dynmesh/io.hpp"
 #include "dynmesh/static_quadtree.hpp"
+#include "dynamic_quadtree_state.hpp"  // dynmesh/src: the private state, for the hook below
+
+namespace dynmesh {
+
+/// The test-only hook declared in DynamicQuadtree: its program state (engine, directory,
+/// input list and indexes), so that the checker tests below can corrupt one part of it.
+struct DynamicQuadtreeTestAccess {
+  template <std::size_t d>
+  static detail::DynamicState<d>& state(DynamicQuadtree<d>& tree) { return *tree.s_; }
+};
+
+}  // namespace dynmesh
 
 namespace {
 
@@ -402,6 +417,9 @@ TYPED_TEST_SUITE(DynamicQuadtreeHistory, Dims, DimName);
 TYPED_TEST_SUITE(DynamicQuadtreeBadInput, Dims, DimName);
 TYPED_TEST_SUITE(DynamicQuadtreeApi, Dims, DimName);
 TYPED_TEST_SUITE(DynamicQuadtreeTiny, Dims, DimName);
+template <class T>
+class DynamicQuadtreeCheckers : public testing::Test {};
+TYPED_TEST_SUITE(DynamicQuadtreeCheckers, Dims, DimName);
 
 /// The default differential case of dimension d: about 150 points in 2D and 50 in 3D (the
 /// octree of 50 points is as large as the quadtree of 150), 100 and 50 updates. Sizes are set
@@ -1303,6 +1321,128 @@ TYPED_TEST(DynamicQuadtreeTiny, MovedTreeKeepsWorking) {
   c.erase(PointId{3});
   want.erase(3);
   EXPECT_TRUE(consistent(c, want));
+}
+
+// --- the checkers see corruption ------------------------------------------------------------
+//
+// Each test builds a small tree, sees the checkers pass, breaks exactly one thing through
+// DynamicQuadtreeTestAccess, expects InvariantError, and repairs it before the tree goes.
+
+/// 40 clustered points, and one more to insert later.
+template <std::size_t d>
+std::vector<Point<d>> checker_pool() {
+  return generate<d>(Distribution::Clusters, 41, 2300);
+}
+template <std::size_t d>
+DynamicQuadtree<d> checker_tree() {
+  const auto pool = checker_pool<d>();
+  return DynamicQuadtree<d>(derive_box<d>(pool), std::span<const Point<d>>(pool).first(40));
+}
+
+/// The newest `split` value of a cell's slot, writable: a change the engine never sees.
+template <std::size_t d>
+std::uint8_t& split_value(detail::DynamicState<d>& s, const CellId<d>& c) {
+  return const_cast<std::uint8_t&>(s.dir.get(s.rt, c).split.get());
+}
+
+/// The message of the dynmesh::InvariantError that check() throws, or "" if none.
+template <class Check>
+std::string invariant_message(Check&& check) {
+  try {
+    check();
+  } catch (const InvariantError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+using testing::HasSubstr;
+
+TYPED_TEST(DynamicQuadtreeCheckers, DirectorySlotFiledUnderAnotherCell) {
+  constexpr std::size_t d = TypeParam::value;
+  auto tree = checker_tree<d>();
+  auto& s = DynamicQuadtreeTestAccess::state(tree);
+  ASSERT_TRUE(invariants_hold(tree));
+  const CellId<d> leaf = tree.leaves().front().cell;  // a child of a split cell: it has a slot
+  ASSERT_NE(s.dir.find(leaf), nullptr);
+  detail::Slot<d>& slot = s.dir.get(s.rt, leaf);
+  slot.id = parent(leaf);
+  EXPECT_THROW(s.dir.check_invariants(s.rt), InvariantError);
+  EXPECT_THAT(invariant_message([&] { s.dir.check_invariants(s.rt); }), HasSubstr("filed under another cell"));
+  EXPECT_THROW(tree.check_invariants(), InvariantError);
+  slot.id = leaf;
+  EXPECT_TRUE(invariants_hold(tree));
+}
+
+TYPED_TEST(DynamicQuadtreeCheckers, DirectorySplitCellWithoutChildren) {
+  constexpr std::size_t d = TypeParam::value;
+  auto tree = checker_tree<d>();
+  auto& s = DynamicQuadtreeTestAccess::state(tree);
+  ASSERT_TRUE(invariants_hold(tree));
+  // A deepest leaf (the leaves are sorted by level first): nothing named its children.
+  const CellId<d> leaf = tree.leaves().back().cell;
+  for (const CellId<d>& k : children(leaf)) ASSERT_EQ(s.dir.find(k), nullptr) << to_string(k);
+  std::uint8_t& split = split_value(s, leaf);
+  ASSERT_EQ(split, 0);
+  split = detail::kTreeSplit;
+  EXPECT_THROW(s.dir.check_invariants(s.rt), InvariantError);
+  EXPECT_THAT(invariant_message([&] { s.dir.check_invariants(s.rt); }), HasSubstr("has no point list"));
+  EXPECT_THROW(tree.check_invariants(), InvariantError);
+  split = 0;
+  EXPECT_TRUE(invariants_hold(tree));
+}
+
+TYPED_TEST(DynamicQuadtreeCheckers, TreeWithACrowdedCellTurnedLeaf) {
+  constexpr std::size_t d = TypeParam::value;
+  auto tree = checker_tree<d>();
+  auto& s = DynamicQuadtreeTestAccess::state(tree);
+  ASSERT_TRUE(invariants_hold(tree));
+  // The parent of a deepest leaf is split only because it is crowded (no deeper split cell
+  // can force it). As a leaf it breaks the tree's rules, not the directory's.
+  const CellId<d> cell = parent(tree.leaves().back().cell);
+  std::uint8_t& split = split_value(s, cell);
+  ASSERT_TRUE(detail::tree_split(split));
+  const std::uint8_t saved = split;
+  split = 0;
+  EXPECT_NO_THROW(s.dir.check_invariants(s.rt));
+  EXPECT_THROW(tree.check_invariants(), InvariantError);
+  EXPECT_THAT(invariant_message([&] { tree.check_invariants(); }), HasSubstr("quadtree contract violated"));
+  split = saved;
+  EXPECT_TRUE(invariants_hold(tree));
+}
+
+TYPED_TEST(DynamicQuadtreeCheckers, PointIndexMissingAPoint) {
+  constexpr std::size_t d = TypeParam::value;
+  auto tree = checker_tree<d>();
+  auto& s = DynamicQuadtreeTestAccess::state(tree);
+  ASSERT_TRUE(invariants_hold(tree));
+  const auto it = s.by_id.find(PointId{0});
+  ASSERT_NE(it, s.by_id.end());
+  auto* node = it->second;
+  s.by_id.erase(it);
+  EXPECT_THROW(tree.check_invariants(), InvariantError);
+  EXPECT_THAT(invariant_message([&] { tree.check_invariants(); }), HasSubstr("point indexes"));
+  s.by_id.emplace(PointId{0}, node);
+  EXPECT_TRUE(invariants_hold(tree));
+}
+
+TYPED_TEST(DynamicQuadtreeCheckers, UpdatesRunTheCheckersUnderSacDebugChecks) {
+  constexpr std::size_t d = TypeParam::value;
+  auto tree = checker_tree<d>();
+  auto& s = DynamicQuadtreeTestAccess::state(tree);
+  ASSERT_TRUE(invariants_hold(tree));
+  const auto it = s.by_id.find(PointId{0});
+  auto* node = it->second;
+  s.by_id.erase(it);  // survives the update below, which does not touch point 0
+  const Point<d> extra = checker_pool<d>().back();
+  if (test_support::kDebugChecks) {
+    EXPECT_THROW(tree.insert(extra), InvariantError);
+  } else {
+    EXPECT_NO_THROW(tree.insert(extra));
+  }
+  EXPECT_TRUE(tree.find(extra).has_value()) << "the update itself went through";
+  s.by_id.emplace(PointId{0}, node);
+  EXPECT_TRUE(invariants_hold(tree));
 }
 
 }  // namespace

@@ -112,6 +112,22 @@ TEST(MeshCheck, OffsetBoxWithInexactUpperSide) {
   EXPECT_TRUE(r.has(MeshDefect::MissingCorner)) << r.summary();
 }
 
+TEST(MeshCheck, BoxesOfExtremeSizePass) {
+  // Areas and angles in double: the box's area overflows at L = 2^600 and a corner's cross
+  // product underflows at L = 2^-600, yet the mesh is the plain two-triangle box (fuzzing).
+  for (const double side : {0x1p600, 0x1p-600, 3.1223605929922333e+307}) {
+    SCOPED_TRACE(side);
+    const Box<2> box = square(-side / 2, 0, side);
+    const double hi = -side / 2 + side;
+    const std::vector<Triangle> ts = {canonical_triangle({-side / 2, 0}, {hi, 0}, {hi, side}),
+                                      canonical_triangle({-side / 2, 0}, {hi, side}, {-side / 2, side})};
+    const MeshReport r = check_mesh(make_mesh(ts), box, {}, MeshCheckOptions{44, false});
+    EXPECT_TRUE(r.ok()) << r.summary();
+    EXPECT_DOUBLE_EQ(r.min_angle_deg, 45);
+    EXPECT_DOUBLE_EQ(r.max_angle_deg, 90);
+  }
+}
+
 TEST(MeshCheck, JitteredGridPasses) {
   const std::vector<Point<2>> inputs = {{0, 0}, {30, 30}, {0, 30}};
   const MeshReport r = check_mesh(grid(30, 0.2, 7), square(0, 0, 30), inputs);

@@ -5,11 +5,13 @@
 // allocation identity and object lifetimes (constructor/destructor counts), that the live
 // trace after an update has exactly the size of a from-scratch run on the same input
 // (live_events, record_bytes), that misuse gives clear errors, and that check_invariants()
-// passes after every run() and propagate(). Sizes shrink under AddressSanitizer.
+// passes after every run() and propagate() and fails when one part of the trace is corrupted
+// (through the test-only EngineTestAccess). Sizes shrink under AddressSanitizer.
 //
 // Bodies only capture values and pointers to objects that outlive the engine (the test's
 // locals), as the engine's documentation requires; nothing relies on a read's body having run
 // when read() returns.
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -25,7 +27,24 @@
 #include <utility>
 #include <vector>
 
+#include "../sanitized.hpp"
 #include "sac/sac.hpp"
+
+namespace sac {
+
+/// The test-only hook declared in Engine: the private trace, so that the checker tests below
+/// can corrupt one part of it and see check_invariants() fail.
+struct EngineTestAccess {
+  static OrderList& order(Engine& e) { return e.order_; }
+  static Stats& stats(Engine& e) { return e.stats_; }
+  static auto& queue(Engine& e) { return e.queue_; }
+  static auto& allocs(Engine& e) { return e.allocs_; }
+  static auto& memos(Engine& e) { return e.memos_; }
+  static void attach(detail::ReadNode* r, detail::VersionBase* v) { Engine::attach(r, v); }
+  static void detach(detail::ReadNode* r) { Engine::detach(r); }
+};
+
+}  // namespace sac
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SAC_ENGINE_TEST_SANITIZED 1
@@ -1490,6 +1509,221 @@ TEST(EngineDebug, CheckInvariantsAfterMultipleRuns) {
   e.propagate();
   EXPECT_EQ(y.get(), 15);
   expect_healthy(e);
+}
+
+// ================================================================ the checker sees corruption
+//
+// Each test builds a small trace with every kind of record, sees check_invariants() pass,
+// breaks exactly one rule through EngineTestAccess, expects InvariantError naming that rule,
+// and repairs the trace before the engine is destroyed.
+
+using sac::EngineTestAccess;
+using sac::Stamp;
+using sac::StampKind;
+using sac::detail::AllocNode;
+using sac::detail::MemoNode;
+using sac::detail::ReadNode;
+using sac::detail::VersionBase;
+
+/// A trace of one read of `in` whose body writes `acc` three times, makes a keyed allocation,
+/// calls a memoized function and reads `acc` (nested) to write `out`.
+struct SmallTrace {
+  Mod<int> in, acc, out;
+  int calls = 0;
+  Engine e;  // declared last, destroyed first: its records refer to the modifiables above
+
+  SmallTrace() {
+    e.set(in, 1);
+    e.run([this](Engine& en) {
+      en.read(in, [this](Engine& x, int v) {
+        x.write(acc, v);
+        x.write(acc, v + 1);
+        x.write(acc, v + 2);
+        x.alloc<int>(7, v);
+        x.memo(sac::fn<bump>(&calls, 1));
+        x.read(acc, [this](Engine& y, int w) { y.write(out, w); });
+      });
+    });
+  }
+
+  /// The stamps of kind k, in trace order.
+  std::vector<Stamp*> stamps(StampKind k) {
+    std::vector<Stamp*> out_stamps;
+    for (Stamp* s = EngineTestAccess::order(e).base()->next(); s; s = s->next())
+      if (s->kind() == k) out_stamps.push_back(s);
+    return out_stamps;
+  }
+  /// The stamp right before s.
+  Stamp* before(const Stamp* s) {
+    Stamp* p = EngineTestAccess::order(e).base();
+    while (p->next() != s) p = p->next();
+    return p;
+  }
+  /// The three versions of acc, oldest first.
+  std::vector<VersionBase*> acc_versions() {
+    std::vector<VersionBase*> v;
+    for (Stamp* s : stamps(StampKind::Write))
+      if (sac::detail::version_of(s)->mod() == &acc) v.push_back(sac::detail::version_of(s));
+    return v;
+  }
+  /// The nested read (of acc).
+  ReadNode* inner_read() { return sac::detail::read_of_start(stamps(StampKind::ReadStart).at(1)); }
+  /// Moves s (linked) to right after pos.
+  void move_stamp(Stamp* s, Stamp* pos) {
+    const StampKind k = s->kind();
+    EngineTestAccess::order(e).erase(s);
+    EngineTestAccess::order(e).insert_after(pos, s, k);
+  }
+};
+
+/// The message of the sac::InvariantError that e.check_invariants() throws, or "" if none.
+std::string invariant_message(const Engine& e) {
+  try {
+    e.check_invariants();
+  } catch (const sac::InvariantError& err) {
+    return err.what();
+  }
+  return {};
+}
+
+using testing::HasSubstr;
+
+TEST(EngineChecker, ReadDetachedFromItsVersion) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  ReadNode* r = t.inner_read();
+  VersionBase* v = t.acc_versions().at(2);
+  ASSERT_EQ(v->readers, r);
+  EngineTestAccess::detach(r);
+  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("not attached"));
+  EngineTestAccess::attach(r, v);
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, ReadAttachedToAnOlderVersion) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  ReadNode* r = t.inner_read();
+  const std::vector<VersionBase*> v = t.acc_versions();
+  EngineTestAccess::detach(r);
+  EngineTestAccess::attach(r, v.at(1));  // the read comes after v[2], so it must see v[2]
+  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("reader after the next version"));
+  EngineTestAccess::detach(r);
+  EngineTestAccess::attach(r, v.at(2));
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, VersionsOutOfOrder) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  const std::vector<VersionBase*> v = t.acc_versions();
+  ASSERT_EQ(v.size(), 3u);
+  ASSERT_EQ(v[2]->older(), v[1]);
+  // newest v2 -> v1 -> v0 becomes v2 -> v0 -> v1: every version is still in the list.
+  v[2]->set_older(v[0]);
+  v[0]->set_older(v[1]);
+  v[1]->set_oldest_of(&t.acc);
+  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("versions out of order"));
+  v[2]->set_older(v[1]);
+  v[1]->set_older(v[0]);
+  v[0]->set_oldest_of(&t.acc);
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, ReadIntervalsNotWellNested) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  // The nested read's end moves after its parent's end.
+  const std::vector<Stamp*> ends = t.stamps(StampKind::ReadEnd);
+  ASSERT_EQ(ends.size(), 2u);
+  Stamp* inner_end = &t.inner_read()->end;
+  ASSERT_EQ(ends[0], inner_end);
+  Stamp* pred = t.before(inner_end);
+  t.move_stamp(inner_end, ends[1]);
+  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("not well nested"));
+  t.move_stamp(inner_end, pred);
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, LiveEventCountMismatch) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  ++EngineTestAccess::stats(t.e).live_events;
+  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("live event count mismatch"));
+  --EngineTestAccess::stats(t.e).live_events;
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, AllocationMissingFromItsTable) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  AllocNode* n = sac::detail::alloc_of(t.stamps(StampKind::Alloc).at(0));
+  const std::size_t h = n->ops->hash(n);
+  EngineTestAccess::allocs(t.e).erase(n, h);
+  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("allocation table size mismatch"));
+  EngineTestAccess::allocs(t.e).insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, MemoEntryMissingFromItsTable) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  MemoNode* n = sac::detail::memo_of_start(t.stamps(StampKind::MemoStart).at(0));
+  const std::size_t h = n->ops->hash(n);
+  EngineTestAccess::memos(t.e).erase(n, h);
+  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("memo table size mismatch"));
+  EngineTestAccess::memos(t.e).insert(n, h, [](const MemoNode* x) { return x->ops->hash(x); });
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, UndoneAllocationLeftInItsTable) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  // An undo that forgot the table: the record leaves the trace (and the live count) but
+  // stays in the allocation table.
+  Stamp* s = t.stamps(StampKind::Alloc).at(0);
+  Stamp* pred = t.before(s);
+  EngineTestAccess::order(t.e).erase(s);
+  --EngineTestAccess::stats(t.e).live_events;
+  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("allocation table"));
+  EngineTestAccess::order(t.e).insert_after(pred, s, StampKind::Alloc);
+  ++EngineTestAccess::stats(t.e).live_events;
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, ReadLeftInTheQueue) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  ReadNode* r = t.inner_read();
+  EngineTestAccess::queue(t.e).push(r);
+  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("queue not empty"));
+  EngineTestAccess::queue(t.e).remove(r);
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, PropagateRunsTheCheckerUnderSacDebugChecks) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  ++EngineTestAccess::stats(t.e).live_events;  // survives the update: propagate adjusts it
+  t.e.set(t.in, 2);
+  if (test_support::kDebugChecks) {
+    EXPECT_THROW(t.e.propagate(), sac::InvariantError);
+  } else {
+    EXPECT_NO_THROW(t.e.propagate());
+  }
+  EXPECT_FALSE(t.e.poisoned()) << "a failed check reports, it does not poison";
+  EXPECT_EQ(t.out.get(), 4);
+  --EngineTestAccess::stats(t.e).live_events;
+  EXPECT_NO_THROW(t.e.check_invariants());
 }
 
 // ================================================================ random differential

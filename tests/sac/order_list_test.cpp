@@ -4,7 +4,10 @@
 // exactly the reference sequence (walking next() from base()), less() must agree with the
 // reference positions, and check_invariants() must pass. Inserts are spread at random, heavily
 // clustered at one spot (group splits, group relabels and top-level relabels) and appended in
-// long runs; erase and erase_between remove single stamps and whole intervals.
+// long runs; erase and erase_between remove single stamps and whole intervals. Corrupted
+// labels, links and groups (the groups through the test-only OrderListTestAccess) must fail
+// check_invariants().
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -19,6 +22,18 @@
 
 #include "sac/errors.hpp"
 #include "sac/order_list.hpp"
+
+namespace sac {
+
+/// The test-only hook declared in OrderList: the private groups, so that the checker tests
+/// below can corrupt one of them and see check_invariants() fail.
+struct OrderListTestAccess {
+  static std::uint32_t& count(OrderList& ol, std::uint32_t group) { return ol.groups_[group].count; }
+  static std::uint64_t& label(OrderList& ol, std::uint32_t group) { return ol.groups_[group].label; }
+  static std::size_t& group_count(OrderList& ol) { return ol.group_count_; }
+};
+
+}  // namespace sac
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SAC_OL_TEST_SANITIZED 1
@@ -501,6 +516,63 @@ TEST(OrderList, CheckInvariantsDetectsOtherCorruption) {
   a->set_next(b->next());
   EXPECT_THROW(m.ol.check_invariants(), sac::InvariantError);
   a->set_next(b);
+  EXPECT_NO_THROW(m.ol.check_invariants());
+}
+
+/// The message of the sac::InvariantError that ol.check_invariants() throws, or "" if none.
+std::string invariant_message(const OrderList& ol) {
+  try {
+    ol.check_invariants();
+  } catch (const sac::InvariantError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+using sac::OrderListTestAccess;
+using testing::HasSubstr;
+
+TEST(OrderList, CheckInvariantsDetectsAWrongGroupCount) {
+  Model m;
+  int last = -1;
+  for (int i = 0; i < 200; ++i) last = m.insert_new_after(last);  // several groups
+  ASSERT_GE(m.ol.group_count(), 3u);
+  ASSERT_NO_THROW(m.ol.check_invariants());
+  const std::uint32_t g = m.stamp(100)->group;
+  std::uint32_t& count = OrderListTestAccess::count(m.ol, g);
+  ++count;
+  EXPECT_THROW(m.ol.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(m.ol), HasSubstr("group count mismatch"));
+  --count;
+  EXPECT_NO_THROW(m.ol.check_invariants());
+}
+
+TEST(OrderList, CheckInvariantsDetectsAWrongNumberOfGroups) {
+  Model m;
+  int last = -1;
+  for (int i = 0; i < 200; ++i) last = m.insert_new_after(last);
+  ASSERT_NO_THROW(m.ol.check_invariants());
+  ++OrderListTestAccess::group_count(m.ol);
+  EXPECT_THROW(m.ol.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(m.ol), HasSubstr("group count total mismatch"));
+  --OrderListTestAccess::group_count(m.ol);
+  EXPECT_NO_THROW(m.ol.check_invariants());
+}
+
+TEST(OrderList, CheckInvariantsDetectsGroupLabelsOutOfOrder) {
+  Model m;
+  int last = -1;
+  for (int i = 0; i < 200; ++i) last = m.insert_new_after(last);
+  ASSERT_NO_THROW(m.ol.check_invariants());
+  // The group of the last stamp gets the base group's label (0): not after its predecessor.
+  const std::uint32_t g = m.stamp(199)->group;
+  ASSERT_NE(g, m.ol.base()->group);
+  std::uint64_t& label = OrderListTestAccess::label(m.ol, g);
+  const std::uint64_t saved = label;
+  label = OrderListTestAccess::label(m.ol, m.ol.base()->group);
+  EXPECT_THROW(m.ol.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(m.ol), HasSubstr("group labels not increasing"));
+  label = saved;
   EXPECT_NO_THROW(m.ol.check_invariants());
 }
 

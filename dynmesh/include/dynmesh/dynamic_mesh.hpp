@@ -9,7 +9,9 @@
 //
 // Invariants (check_invariants()): the engine's invariants; the quadtree program's
 // invariants (DynamicQuadtree); the refined tree T' satisfies its rules; the live triangles
-// tile the box, every present point is a vertex, and no angle is below the bound.
+// tile the box, every present point is a vertex, and no angle is below the bound. Built with
+// the CMake option SAC_DEBUG_CHECKS, every insert, erase and apply ends with
+// check_invariants().
 // Failure atomicity: every mutator call validates its whole input first; a call that throws
 // InputError leaves the mesh, the ids and the engine as they were.
 // Determinism: the mesh depends only on the point set and the box.

@@ -17,6 +17,8 @@
 //   * the cell directory is consistent: each slot is filed under its own cell, every
 //     child of a split cell has a slot whose point list was written, and each point's
 //     per-level list nodes hold that point.
+// Built with the CMake option SAC_DEBUG_CHECKS, every insert, erase and apply ends with
+// check_invariants().
 // Failure atomicity: every mutator call validates its whole input before changing anything,
 // so a call that throws InputError leaves the tree, the ids and the engine as they were.
 // Determinism: results depend only on the point set; ids never enter the computation, and
@@ -135,6 +137,10 @@ class DynamicQuadtree {
   void check_invariants() const;
 
  private:
+  // Test-only hook: tests/dynmesh/dynamic_quadtree_test.cpp defines it to corrupt the
+  // directory and the tree and see check_invariants() fail. Nothing else may define it.
+  friend struct DynamicQuadtreeTestAccess;
+
   std::unique_ptr<detail::DynamicState<d>> s_;
 };
 

@@ -27,6 +27,17 @@ namespace dynmesh {
 /// stated with the margin the checker uses.
 inline constexpr double kQuadtreeMinAngle = 18.4;
 
+/// Throws InputError(Resolution) unless the mesh's double arithmetic works in `box`:
+///   * its cells are resolved (mesh_resolution_level ≥ 2, detail/quadtree_mesh_rules.hpp).
+///     Each point's rule implies it, so it matters for the empty set: a box far smaller than
+///     its offset (o + L == o) would otherwise mesh as two degenerate triangles;
+///   * 2^−440 ≤ L < 2^441 (kMeshSideExponent): the rules choose each leaf's triangulation by
+///     angles computed from unscaled products of coordinate differences, which overflow to
+///     NaN or underflow to 0 beyond that, giving angles below the bound or no triangulation.
+/// Shared by both meshers.
+inline constexpr int kMeshSideExponent = 440;
+void validate_mesh_box(const Box<2>& box);
+
 /// The closure rule of T' (detail/quadtree_mesh_rules.hpp) on its sorted leaves: no leaf
 /// twice, exactly `npoints` leaves hold a point, and each of them has its 3x3 block of
 /// same-size leaves. Throws InvariantError. Shared by both meshers' check_invariants().

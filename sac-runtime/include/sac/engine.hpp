@@ -32,7 +32,8 @@
 // well nested (every read's interval contains exactly the events its body created); every
 // live read is attached to the version visible at its start time; versions of a modifiable
 // are ordered by time; every memo entry and keyed allocation is in its table; outside
-// propagate() the queue is empty.
+// propagate() the queue is empty. Built with the CMake option SAC_DEBUG_CHECKS, propagate()
+// runs the check at its end and throws InvariantError on a violation.
 // Complexity: read/write/alloc O(1) amortized plus the version walk of the touched
 // modifiable; propagate() O(trace distance x log(queue size)) for monotone programs.
 #pragma once
@@ -213,6 +214,10 @@ class Engine {
   void dump_dot(std::ostream& os) const;
 
  private:
+  // Test-only hook: tests/sac/engine_test.cpp defines it to corrupt one part of the trace
+  // and see check_invariants() fail. Nothing else may define it.
+  friend struct EngineTestAccess;
+
   using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits>;
 
   // Work of the trampoline. Exec* carry a node that is not linked yet.

@@ -143,6 +143,10 @@ class OrderList {
   void check_invariants() const;
 
  private:
+  // Test-only hook: tests/sac/order_list_test.cpp defines it to corrupt the groups and see
+  // check_invariants() fail. Nothing else may define it.
+  friend struct OrderListTestAccess;
+
   static constexpr std::uint64_t kBottomRange = std::uint64_t{1} << 32;
   static constexpr std::uint64_t kAppendStep = kBottomRange / kGroupCap;
   static constexpr std::uint64_t kTopAppendStep = std::uint64_t{1} << 24;

@@ -1,0 +1,100 @@
+// fuzz_dynamic_mesh — libFuzzer target: DynamicMesh (2D, Postprocess::Quadtree) against its
+// static twin QuadtreeMesh under fuzzed runs of insert, erase and batch operations, valid
+// and invalid (see differential.hpp for the driver and the contract it predicts).
+//
+// Properties, after the construction and every operation: the mesh (canonical, mesh()) and
+// the triangles equal the twin's, and so do the leaves of the refined tree T'; the mesh
+// passes check_mesh with the quadtree bound (kQuadtreeMinAngle) and every present point a
+// vertex; the twin and the structure pass check_invariants(); the change feed is empty
+// after construction and replays exactly (the triangles before an update, less its removed,
+// plus its added, are the triangles after it); a refused operation changes nothing (mesh,
+// T', points, ids, the feed, live trace events and bytes).
+// Complexity: per operation O((n + t) log t) (the static twin and the mesh checker).
+#include "differential.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "dynmesh/dynamic_mesh.hpp"
+#include "dynmesh/mesh.hpp"
+#include "dynmesh/mesh_check.hpp"
+#include "dynmesh/quadtree_mesh.hpp"
+
+namespace {
+
+using namespace dynmesh_fuzz;
+
+struct MeshTraits {
+  using Subject = DynamicMesh;
+  using Oracle = QuadtreeMesh;
+  static constexpr std::size_t kMaxWork = 20000;  // triangles compared
+  struct Snapshot {  // what compare() does not see
+    MeshChange change;
+    std::uint64_t live_events = 0;
+    std::size_t record_bytes = 0;
+  };
+
+  Subject make(const Box<2>& box, std::span<const Point<2>> points) const {
+    MeshOptions options;
+    options.postprocess = Postprocess::Quadtree;
+    return Subject(box, points, options);
+  }
+  Oracle oracle(const Box<2>& box, std::span<const Point<2>> points) const { return Oracle(box, points); }
+
+  std::size_t compare(const Subject& dyn, const Oracle& twin, std::span<const Point<2>> points, const Point<2>&,
+                      bool updated) {
+    const Mesh mesh = dyn.mesh();
+    check(mesh == twin.mesh(), "mesh() differs from the static twin's");
+    const std::vector<Triangle> triangles = triangles_of(mesh);
+    check(triangles == twin.triangles(), "the triangles differ from the static twin's");
+    if (!updated) check(dyn.triangles() == triangles && dyn.num_triangles() == triangles.size(),
+                        "triangles() or num_triangles() disagree with mesh()");
+    check(dyn.refined_leaves() == twin.refined_leaves(), "the refined tree T' differs from the static twin's");
+    try {
+      twin.check_invariants();
+    } catch (const std::exception& e) {
+      fail(std::string("the static twin's check_invariants: ") + e.what());
+    }
+    MeshCheckOptions options;
+    options.min_angle_deg = kQuadtreeMinAngle;
+    const MeshReport report = check_mesh(mesh, dyn.box(), points, options);
+    if (!report.ok()) fail("check_mesh: " + report.summary());
+    // The change feed.
+    const MeshChange& change = dyn.last_change();
+    if (first_) {
+      check(change.removed.empty() && change.added.empty(), "the feed is not empty after construction");
+    } else if (updated) {
+      std::vector<Triangle> replay = previous_;
+      check(apply_change(replay, change) && replay == triangles, "the change feed does not replay the update");
+    } else {
+      check(triangles == previous_, "the mesh changed without an update");
+    }
+    first_ = false;
+    previous_ = triangles;
+    return triangles.size();
+  }
+
+  std::string describe(const Subject& dyn) const {
+    return std::to_string(dyn.num_triangles()) + " triangles, " + std::to_string(dyn.refined_leaves().size()) +
+           " leaves of T'";
+  }
+  Snapshot snapshot(const Subject& dyn) const { return {dyn.last_change(), dyn.live_events(), dyn.record_bytes()}; }
+  bool same(const Snapshot& a, const Snapshot& b) const {
+    return a.change == b.change && a.live_events == b.live_events && a.record_bytes == b.record_bytes;
+  }
+
+ private:
+  bool first_ = true;
+  std::vector<Triangle> previous_;
+};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  FuzzedDataProvider in(data, size);
+  Differential<2, MeshTraits>(in).run();
+  return 0;
+}
