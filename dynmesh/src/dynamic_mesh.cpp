@@ -106,13 +106,31 @@ struct MeshState {
   }
 };
 
+/// T* as the quadtree's contract states it, and T''s closure rule.
+void check_trees_of(const DynamicMesh& mesh, const MeshState& s) {
+  std::vector<Position<2>> qs;
+  for (const auto* n = s.core.first; n; n = n->succ) qs.push_back(n->q);
+  std::vector<Leaf<2>> tree;
+  s.core.for_each_leaf_of([&](const CellId<2>& c) { return s.core.is_split(c); },
+                          [&](const CellId<2>& c) {
+                            std::uint32_t k = 0;
+                            for (const auto* p = s.core.points_in(c); p; p = p->next.get()) ++k;
+                            tree.push_back(Leaf<2>{c, k});
+                          });
+  std::sort(tree.begin(), tree.end());
+  require_valid_tree<2>(qs, tree);
+  // T': every point leaf has its block of same-size leaves.
+  require_refined_tree(mesh.refined_leaves(), mesh.size());
+}
+
 /// Applies validated edits with one propagation. Built with the CMake option
-/// SAC_DEBUG_CHECKS, every checker of the tree and the mesh then runs (the engine's ran at
-/// the end of propagate()).
+/// SAC_DEBUG_CHECKS, every checker then runs: check_invariants() but the engine's, which
+/// propagate() has just run.
 std::vector<PointId> checked_update(const DynamicMesh& mesh, MeshState& s, std::span<const Edit<2>> edits) {
   std::vector<PointId> ids = s.update(edits);
 #ifdef SAC_DEBUG_CHECKS
-  mesh.check_invariants();
+  s.core.check_own_invariants();
+  check_trees_of(mesh, s);
 #else
   (void)mesh;
 #endif
@@ -217,22 +235,8 @@ std::uint64_t DynamicMesh::live_events() const { return s_->core.rt.live_events(
 void DynamicMesh::compact() { s_->core.compact(); }
 
 void DynamicMesh::check_invariants() const {
-  const auto& s = *s_;
-  s.core.check_invariants();
-  // T* as the quadtree's contract states it.
-  std::vector<Position<2>> qs;
-  for (const auto* n = s.core.first; n; n = n->succ) qs.push_back(n->q);
-  std::vector<Leaf<2>> tree;
-  s.core.for_each_leaf_of([&](const CellId<2>& c) { return s.core.is_split(c); },
-                          [&](const CellId<2>& c) {
-                            std::uint32_t k = 0;
-                            for (const auto* p = s.core.points_in(c); p; p = p->next.get()) ++k;
-                            tree.push_back(Leaf<2>{c, k});
-                          });
-  std::sort(tree.begin(), tree.end());
-  require_valid_tree<2>(qs, tree);
-  // T': every point leaf has its block of same-size leaves.
-  require_refined_tree(refined_leaves(), size());
+  s_->core.check_invariants();
+  detail::check_trees_of(*this, *s_);
 }
 
 }  // namespace dynmesh

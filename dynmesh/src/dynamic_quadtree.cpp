@@ -21,15 +21,28 @@ std::vector<Edit<d>> inserts_of(std::span<const Point<d>> points) {
   return edits;
 }
 
+/// The tree's rules: every leaf's list holds exactly the points located in it, and the
+/// leaves are those of T* (check_tree).
+template <std::size_t d>
+void check_tree_of(const DynamicQuadtree<d>& tree, const DynamicState<d>& s) {
+  s.for_each_leaf([&](const CellId<d>& c, const PNode<d>* p) {
+    for (; p; p = p->next.get())
+      if (!dynmesh::contains(c, p->q) || !s.by_pos.contains(p->q))
+        throw InvariantError("dynmesh: leaf " + to_string(c) + " lists a point it does not hold");
+  });
+  require_valid_tree<d>(tree.positions(), tree.leaves());
+}
+
 /// Applies validated edits with one propagation. Built with the CMake option
-/// SAC_DEBUG_CHECKS, every checker of the tree then runs (the engine's ran at the end of
-/// propagate()).
+/// SAC_DEBUG_CHECKS, every checker then runs: check_invariants() but the engine's, which
+/// propagate() has just run.
 template <std::size_t d>
 std::vector<PointId> checked_update(const DynamicQuadtree<d>& tree, DynamicState<d>& s,
                                     std::span<const Edit<d>> edits) {
   std::vector<PointId> ids = s.update(edits);
 #ifdef SAC_DEBUG_CHECKS
-  tree.check_invariants();
+  s.check_own_invariants();
+  check_tree_of(tree, s);
 #else
   (void)tree;
 #endif
@@ -207,15 +220,8 @@ void DynamicQuadtree<d>::compact() { s_->compact(); }
 template <std::size_t d>
   requires SupportedDim<d>
 void DynamicQuadtree<d>::check_invariants() const {
-  const auto& s = *s_;
-  s.check_invariants();
-  // Every leaf's list holds exactly the points located in it.
-  s.for_each_leaf([&](const CellId<d>& c, const detail::PNode<d>* p) {
-    for (; p; p = p->next.get())
-      if (!dynmesh::contains(c, p->q) || !s.by_pos.contains(p->q))
-        throw InvariantError("dynmesh: leaf " + to_string(c) + " lists a point it does not hold");
-  });
-  require_valid_tree<d>(positions(), leaves());
+  s_->check_invariants();
+  detail::check_tree_of(*this, *s_);
 }
 
 template class DynamicQuadtree<2>;

@@ -375,6 +375,11 @@ class QuadtreeCore {
   /// shape: see DynamicQuadtree::check_invariants).
   void check_invariants() const {
     rt.check_invariants();
+    check_own_invariants();
+  }
+  /// check_invariants() but the engine's: for SAC_DEBUG_CHECKS after an update, whose
+  /// propagate() has just checked the engine.
+  void check_own_invariants() const {
     std::size_t k = 0;
     for (const Node* n = first; n; n = n->succ, ++k) {
       if (n->succ && n->succ->prev != n) throw InvariantError("dynmesh: input list links broken");

@@ -1,11 +1,14 @@
 // The engine's non-template machinery: change propagation, undo, memo matching, checks.
 #include "sac/engine.hpp"
 
+#include <cstdint>
 #include <cstdio>
 #include <ostream>
 #include <string>
 #include <unordered_map>
-#include <unordered_set>
+#include <vector>
+
+#include "sac/hash.hpp"
 
 namespace sac {
 
@@ -13,6 +16,57 @@ using detail::AllocNode;
 using detail::MemoNode;
 using detail::ReadNode;
 using detail::VersionBase;
+
+namespace {
+
+/// The checker's set of record addresses: open addressing in one array. A node-based hash
+/// set allocated per element, which dominated check_invariants() in the sanitizer build,
+/// where SAC_DEBUG_CHECKS runs it after every propagation.
+class AddressSet {
+ public:
+  explicit AddressSet(std::size_t expected) {
+    std::size_t n = 64;
+    while (n < 2 * expected) n *= 2;
+    slots_.assign(n, nullptr);
+  }
+  /// Adds p (not null); false if it was there already.
+  bool insert(const void* p) {
+    if (2 * (size_ + 1) > slots_.size()) grow();
+    const std::size_t i = slot_of(p);
+    if (slots_[i]) return false;
+    slots_[i] = p;
+    ++size_;
+    return true;
+  }
+  bool contains(const void* p) const { return slots_[slot_of(p)] != nullptr; }
+  std::size_t size() const { return size_; }
+  template <class F>
+  void for_each(F&& f) const {
+    for (const void* p : slots_)
+      if (p) f(p);
+  }
+
+ private:
+  /// p's slot, or the empty slot where it would go (linear probing).
+  std::size_t slot_of(const void* p) const {
+    const std::size_t mask = slots_.size() - 1;
+    std::size_t i = static_cast<std::size_t>(mix64(reinterpret_cast<std::uintptr_t>(p))) & mask;
+    while (slots_[i] && slots_[i] != p) i = (i + 1) & mask;
+    return i;
+  }
+  void grow() {
+    std::vector<const void*> old(slots_.size() * 2, nullptr);
+    old.swap(slots_);
+    size_ = 0;
+    for (const void* p : old)
+      if (p) insert(p);
+  }
+
+  std::vector<const void*> slots_;
+  std::size_t size_ = 0;
+};
+
+}  // namespace
 
 Engine::Engine() { tail_ = order_.base(); }
 
@@ -594,8 +648,8 @@ void Engine::check_invariants() const {
   std::vector<Open> stack;
   std::uint64_t events = 0;
   std::size_t nkeyed = 0, nmemo = 0;
-  std::unordered_set<const ModBase*> mods;
-  std::unordered_set<const ReadNode*> reads;
+  AddressSet mods(stats_.live_events / 2);  // the modifiables read or written
+  AddressSet reads(stats_.live_events / 2);
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     switch (s->kind()) {
       case StampKind::ReadStart: {
@@ -666,7 +720,8 @@ void Engine::check_invariants() const {
   // readers between this version and the next newer one (so each reader hangs on the version
   // visible at its time), and every reader a live read of the trace, each exactly once.
   std::size_t attached = 0;
-  for (const ModBase* m : mods) {
+  mods.for_each([&](const void* mod) {
+    const auto* m = static_cast<const ModBase*>(mod);
     const VersionBase* newer = nullptr;
     for (const VersionBase* v = m->newest_; v; v = v->older()) {
       if (v->mod() != m) fail("version chain does not end at its modifiable");
@@ -680,12 +735,12 @@ void Engine::check_invariants() const {
         if (r->mod != m) fail("reader of another modifiable");
         if (!v->is_base() && !order_.less(&v->stamp, &r->start)) fail("reader before its version");
         if (newer && !order_.less(&r->start, &newer->stamp)) fail("reader after the next version");
-        if (!reads.count(r)) fail("a version's reader is not a live read of the trace");
+        if (!reads.contains(r)) fail("a version's reader is not a live read of the trace");
         ++attached;
       }
       newer = v;
     }
-  }
+  });
   if (attached != reads.size()) fail("read not attached to the version visible at its time");
   allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops->hash(n); },
                            [&](const AllocNode* n) {

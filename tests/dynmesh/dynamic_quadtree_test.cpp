@@ -687,7 +687,8 @@ struct StabilityFigures {
 /// distance must stay below live/k. The tree is checked against the oracle at the end.
 StabilityFigures stability_run(std::size_t n, std::uint64_t seed, std::uint64_t max_fraction_divisor) {
   SCOPED_TRACE("uniform n=" + std::to_string(n) + " seed=" + std::to_string(seed));
-  constexpr int kUpdates = 50;
+  // Under SAC_DEBUG_CHECKS every update checks the whole tree (seconds at n = 4000 at -O0).
+  constexpr int kUpdates = kDebugChecks ? 10 : 50;
   const auto pool = generate<2>(Distribution::Uniform, n + kUpdates / 2, seed);
   Rng rng(seed + 1);
   // All but kUpdates/2 points (none an extreme) start in the tree.
@@ -743,7 +744,8 @@ TEST(DynamicQuadtreeStability, TraceDistanceDoesNotGrowWithN) {
   // O(lg L/s) per update: quadrupling n adds about one level to a uniform set's tree, so the
   // mean trace distance may grow a little but not in proportion to n. From n = 2000 on, every
   // single update must re-execute far less than the whole trace (trace distance < live/20).
-  // Not scaled down in slow builds: the figures are deterministic.
+  // Not scaled down in slow builds: the figures are deterministic (but stability_run makes
+  // fewer updates under SAC_DEBUG_CHECKS).
   const auto a = stability_run(1000, 1401, 0);
   const auto m = stability_run(2000, 1402, 20);
   const auto b = stability_run(4000, 1402, 20);
@@ -1157,7 +1159,7 @@ TYPED_TEST(DynamicQuadtreeApi, DirectoryStaysBoundedOverManyCycles) {
   // larger than a fresh tree's on the same points.
   constexpr std::size_t d = TypeParam::value;
   const std::size_t n = d == 2 ? 200 : 60;
-  const int cycles = scaled(2000, 4);
+  const int cycles = kDebugChecks ? 100 : scaled(2000, 4);  // each update checks the tree
   const auto pool = generate<d>(Distribution::Uniform, n, 2000);
   const Box<d> box = derive_box<d>(pool);
   DynamicQuadtree<d> tree(box, pool);
@@ -1435,7 +1437,7 @@ TYPED_TEST(DynamicQuadtreeCheckers, UpdatesRunTheCheckersUnderSacDebugChecks) {
   auto* node = it->second;
   s.by_id.erase(it);  // survives the update below, which does not touch point 0
   const Point<d> extra = checker_pool<d>().back();
-  if (test_support::kDebugChecks) {
+  if (kDebugChecks) {
     EXPECT_THROW(tree.insert(extra), InvariantError);
   } else {
     EXPECT_NO_THROW(tree.insert(extra));

@@ -28,6 +28,9 @@ namespace dynmesh_test {
 /// sizes down. (Optimization, not NDEBUG: the RelWithDebInfo build of the brief sets its
 /// flags to "-O2 -g", without -DNDEBUG.)
 using test_support::kSanitized;
+/// Built with SAC_DEBUG_CHECKS: every update checks the whole tree and trace, so loops of
+/// many updates scale down further.
+using test_support::kDebugChecks;
 #ifdef __OPTIMIZE__
 constexpr bool kSlowBuild = kSanitized;
 #else

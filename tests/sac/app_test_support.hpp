@@ -13,6 +13,9 @@ namespace app_test {
 
 /// Built with AddressSanitizer (CI runs it at -O0): tests scale their sizes down.
 using test_support::kSanitized;
+/// Built with SAC_DEBUG_CHECKS (every propagate() checks the whole trace): loops of many
+/// updates on a large trace scale down further.
+using test_support::kDebugChecks;
 
 /// After a propagate: the output is right, the engine is sound, and the live trace equals a
 /// from-scratch run's on the current input.

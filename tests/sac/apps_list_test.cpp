@@ -30,10 +30,15 @@ namespace {
 using app_test::expect_consistent;
 using app_test::pick;
 
+using app_test::kDebugChecks;
 using app_test::kSanitized;
 
 // Large sizes of the work tests (kept modest under the sanitizers, which run at -O0).
 constexpr std::size_t kLargeN = kSanitized ? 20000 : 100000;
+
+/// Updates per work measurement: 100, but 10 on the large input under SAC_DEBUG_CHECKS,
+/// where each propagation checks the whole trace.
+constexpr std::size_t work_updates(std::size_t n) { return kDebugChecks && n > 1000 ? 10 : 100; }
 
 const std::vector<std::string> kApps{"map", "filter", "reverse", "minimum", "sum", "exptrees"};
 
@@ -211,7 +216,7 @@ TEST(AppsWork, MapSingleChangeIsConstantWork) {
     auto app = make("map");
     app->generate(n, 21);
     app->run_self_adjusting();
-    const Work w = measure_updates(*app, 100);
+    const Work w = measure_updates(*app, work_updates(n));
     std::printf("[ map n=%zu ] mean trace distance %.2f, max %llu, max re-executed %llu\n", n,
                 w.mean_distance, static_cast<unsigned long long>(w.max_distance),
                 static_cast<unsigned long long>(w.max_reexecuted));
@@ -226,7 +231,7 @@ TEST(AppsWork, FilterSingleChangeIsConstantExpectedWork) {
     auto app = make("filter");
     app->generate(n, 22);
     app->run_self_adjusting();
-    const Work w = measure_updates(*app, 100);
+    const Work w = measure_updates(*app, work_updates(n));
     std::printf("[ filter n=%zu ] mean trace distance %.2f, max %llu, max re-executed %llu\n", n,
                 w.mean_distance, static_cast<unsigned long long>(w.max_distance),
                 static_cast<unsigned long long>(w.max_reexecuted));
@@ -277,7 +282,7 @@ TEST_P(AppsLogWorkTest, UpdatesAreSublinear) {
     app->generate(n, 31);
     app->run_self_adjusting();
     const std::size_t scratch_events = app->engine().live_events();
-    const Work w = measure_updates(*app, 100);
+    const Work w = measure_updates(*app, work_updates(n));
     std::printf("[ %s n=%zu ] mean trace distance %.2f, max %llu, max re-executed %llu\n",
                 GetParam().c_str(), n, w.mean_distance,
                 static_cast<unsigned long long>(w.max_distance),
@@ -306,7 +311,8 @@ TEST(AppsMemory, MapRemoveReinsertCyclesReturnToFromScratch) {
   app->run_self_adjusting();
   const std::size_t trace0 = app->engine().trace_bytes();
   std::mt19937_64 rng(42);
-  for (int cycle = 0; cycle < 10000; ++cycle) {
+  const int cycles = kDebugChecks ? 1000 : 10000;  // each propagation checks the trace
+  for (int cycle = 0; cycle < cycles; ++cycle) {
     const std::size_t i = rng() % n;
     app->remove(i);
     app->engine().propagate();

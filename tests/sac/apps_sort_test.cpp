@@ -42,6 +42,7 @@ using sacapps::quickhull::Distribution;
 using sacapps::quickhull::QuickhullApp;
 using sacapps::quicksort::QuicksortApp;
 
+using app_test::kDebugChecks;
 using app_test::kSanitized;
 
 // ------------------------------------------------------------------ the apps under test
@@ -382,7 +383,8 @@ TEST_P(SacAppWork, UpdatesCostLogarithmicTraceDistance) {
   // hulls at n = 20000 (more at n = 2000 for the hulls: changes of the hull itself weigh more).
   const std::size_t small = kSanitized ? 500 : 2000;
   const std::size_t large = kSanitized ? 4000 : 20000;
-  const std::size_t updates = kSanitized ? 20 : 50;
+  // Under SAC_DEBUG_CHECKS each propagation checks the whole trace.
+  const std::size_t updates = kDebugChecks ? 8 : kSanitized ? 20 : 50;
   double mean[2];
   for (int k = 0; k < 2; ++k) {
     const std::size_t n = k == 0 ? small : large;
