@@ -38,4 +38,9 @@ int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Poin
                                                               to_kernel(c), to_kernel(d)));
 }
 
+bool encroaches(const Point<2>& a, const Point<2>& b, const Point<2>& x) noexcept {
+  // The angle at x of a, x, b is obtuse exactly when x is strictly inside the diametral circle.
+  return Kernel::Angle_2()(to_kernel(a), to_kernel(x), to_kernel(b)) == CGAL::OBTUSE;
+}
+
 }  // namespace dynmesh

@@ -13,6 +13,7 @@
 #include "dynmesh/detail/cell_table.hpp"
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/errors.hpp"
+#include "locate_points.hpp"
 
 namespace dynmesh {
 namespace {
@@ -38,27 +39,10 @@ void check_resolution(const MeshGrid& grid, std::span<const Point<2>> points, st
   }
 }
 
-std::vector<Position<2>> locate_all(const Box<2>& box, std::span<const Point<2>> points) {
-  validate_box(box);
-  std::vector<Position<2>> qs(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    for (unsigned a = 0; a < 2; ++a)
-      if (!std::isfinite(points[i][a]))
-        throw InputError(InputError::Kind::NotFinite, "point " + std::to_string(i) + " has a NaN or infinite coordinate")
-            .with_points({i});
-    const auto q = try_locate(box, points[i]);
-    if (!q)
-      throw InputError(InputError::Kind::OutsideBox, "point " + std::to_string(i) + " is outside the domain box")
-          .with_points({i});
-    qs[i] = *q;
-  }
-  return qs;
-}
-
 }  // namespace
 
 QuadtreeMesh::QuadtreeMesh(const Box<2>& box, std::span<const Point<2>> points)
-    : box_(box), points_(points.begin(), points.end()), tree_(locate_all(box, points)) {
+    : box_(box), points_(points.begin(), points.end()), tree_(detail::locate_all(box, points)) {
   const MeshGrid grid(box);
   const auto qs = tree_.points();
   check_resolution(grid, points, qs);

@@ -1,7 +1,7 @@
 // dynmesh/predicates.hpp — exact 2D orientation and in-circle predicates.
 //
-// Purpose: the two geometric decisions the meshes make (is a triangle counter-clockwise, is
-// a point strictly inside a circumcircle) decided exactly on IEEE double inputs, so that the
+// Purpose: the geometric decisions the meshes make (is a triangle counter-clockwise, is a
+// point strictly inside a circumcircle, does a point encroach a segment) decided exactly on IEEE double inputs, so that the
 // static and the self-adjusting meshers, and the mesh checker, never disagree through
 // rounding. The work is done by CGAL's Exact_predicates_inexact_constructions_kernel
 // (LGPL, Debian's libcgal-dev): a floating-point filter with an exact fallback. CGAL's
@@ -27,5 +27,9 @@ int orient2d(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept;
 /// the orientation-style sign of the degenerate determinant, as the classic incircle test).
 /// Inputs must be finite.
 int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept;
+
+/// True when x lies strictly inside the circle with diameter ab, i.e. (a−x)·(b−x) < 0: x
+/// encroaches the segment ab (Ruppert; Triangle's test for subsegments). Inputs finite.
+bool encroaches(const Point<2>& a, const Point<2>& b, const Point<2>& x) noexcept;
 
 }  // namespace dynmesh

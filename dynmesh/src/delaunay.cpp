@@ -1,0 +1,249 @@
+// delaunay.cpp — Bowyer–Watson insertion with a perturbed in-circle test (see delaunay.hpp).
+#include "delaunay.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include "dynmesh/errors.hpp"
+#include "dynmesh/predicates.hpp"
+
+namespace dynmesh::detail {
+
+namespace {
+
+constexpr int next(int i) noexcept { return i == 2 ? 0 : i + 1; }
+constexpr int prev(int i) noexcept { return i == 0 ? 2 : i - 1; }
+
+}  // namespace
+
+bool perturbed_incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept {
+  if (const int s = incircle(a, b, c, d); s != 0) return s > 0;
+  // Decreasing rank: the point perturbed most decides first.
+  const Point<2>* order[4] = {&a, &b, &c, &d};
+  std::sort(order, order + 4, [](const Point<2>* u, const Point<2>* v) { return xy_less(*v, *u); });
+  for (const Point<2>* p : order) {
+    int coef;
+    if (p == &d) coef = -orient2d(a, b, c);
+    else if (p == &a) coef = orient2d(d, b, c);
+    else if (p == &b) coef = orient2d(a, d, c);
+    else coef = orient2d(a, b, d);
+    if (coef != 0) return coef > 0;
+  }
+  return false;  // unreachable for a real triangle a, b, c
+}
+
+Delaunay::Delaunay(const Box<2>& box) : box_(box) {
+  hi_[0] = box.origin[0] + box.side;
+  hi_[1] = box.origin[1] + box.side;
+  const double x0 = box.origin[0], y0 = box.origin[1];
+  pts_ = {Point<2>{x0, y0}, Point<2>{hi_[0], y0}, Point<2>{hi_[0], hi_[1]}, Point<2>{x0, hi_[1]}};
+  // The four corners are cocircular: the perturbation picks the diagonal.
+  if (!perturbed_incircle(pts_[0], pts_[1], pts_[2], pts_[3])) {
+    const Tid s = new_tri(0, 1, 2), t = new_tri(0, 2, 3);
+    tris_[s].n = {kNone, t, kNone};  // edge 2-0 (opposite 1) is shared
+    tris_[t].n = {kNone, kNone, s};  // edge 0-2 (opposite 3)
+  } else {
+    const Tid s = new_tri(0, 1, 3), t = new_tri(1, 2, 3);
+    tris_[s].n = {t, kNone, kNone};  // edge 1-3 (opposite 0)
+    tris_[t].n = {kNone, s, kNone};  // edge 3-1 (opposite 2)
+  }
+}
+
+Delaunay::Tid Delaunay::new_tri(Vid a, Vid b, Vid c) {
+  Tid t;
+  if (!free_.empty()) {
+    t = free_.back();
+    free_.pop_back();
+  } else {
+    t = static_cast<Tid>(tris_.size());
+    tris_.emplace_back();
+  }
+  Tri& T = tris_[t];
+  T.v = {a, b, c};
+  T.n = {kNone, kNone, kNone};
+  T.alive = true;
+  ++live_;
+  return t;
+}
+
+Delaunay::Tid Delaunay::any_live() const noexcept {
+  for (Tid t = 0; t < tris_.size(); ++t)
+    if (tris_[t].alive) return t;
+  return kNone;
+}
+
+Delaunay::Walk Delaunay::walk(Tid start, const Point<2>& x) const {
+  Tid t = start;
+  // A visibility walk ends in a Delaunay triangulation; the cap is a guard, not a bound.
+  for (std::size_t steps = 0; steps <= 4 * tris_.size() + 16; ++steps) {
+    const Tri& T = tris_[t];
+    int exit = -1;
+    for (int i = 0; i < 3; ++i) {
+      const Point<2>& a = pts_[T.v[next(i)]];
+      const Point<2>& b = pts_[T.v[prev(i)]];
+      if (orient2d(a, b, x) >= 0) continue;
+      if (exit < 0) {
+        exit = i;
+        continue;
+      }
+      // Two edges face x: leave through the one whose smaller end is smaller.
+      const auto key = [&](int e) {
+        const Point<2>& u = pts_[T.v[next(e)]];
+        const Point<2>& w = pts_[T.v[prev(e)]];
+        return xy_less(u, w) ? std::pair{u, w} : std::pair{w, u};
+      };
+      const auto ki = key(i), ke = key(exit);
+      if (xy_less(ki.first, ke.first) || (ki.first == ke.first && xy_less(ki.second, ke.second))) exit = i;
+    }
+    if (exit < 0) return Walk{t, -1};
+    if (T.n[exit] == kNone) return Walk{t, exit};
+    t = T.n[exit];
+  }
+  throw InvariantError("dynmesh: Delaunay walk did not end");
+}
+
+std::optional<Delaunay::Vid> Delaunay::vertex_at(Tid t, const Point<2>& x) const noexcept {
+  for (Vid v : tris_[t].v)
+    if (pts_[v] == x) return v;
+  return std::nullopt;
+}
+
+bool Delaunay::in_conflict(Tid t, const Point<2>& x) const noexcept {
+  const Tri& T = tris_[t];
+  return perturbed_incircle(pts_[T.v[0]], pts_[T.v[1]], pts_[T.v[2]], x);
+}
+
+void Delaunay::cavity(Tid t, const Point<2>& x, std::vector<Tid>& out) const {
+  out.clear();
+  out.push_back(t);
+  // Breadth first; the cavity is small, so membership is a linear scan.
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    for (Tid u : tris_[out[i]].n) {
+      if (u == kNone || std::find(out.begin(), out.end(), u) != out.end()) continue;
+      if (in_conflict(u, x)) out.push_back(u);
+    }
+  }
+}
+
+void Delaunay::cavity_box_edges(std::span<const Tid> cav, std::vector<std::array<Vid, 2>>& out) const {
+  out.clear();
+  for (Tid t : cav) {
+    const Tri& T = tris_[t];
+    for (int i = 0; i < 3; ++i)
+      if (T.n[i] == kNone) out.push_back({T.v[next(i)], T.v[prev(i)]});
+  }
+}
+
+Delaunay::Vid Delaunay::insert(const Point<2>& x, std::span<const Tid> cav, std::vector<Tid>& created) {
+  const Vid xv = static_cast<Vid>(pts_.size());
+  pts_.push_back(x);
+  const auto in_cavity = [&](Tid u) { return std::find(cav.begin(), cav.end(), u) != cav.end(); };
+  by_first_.clear();
+  by_second_.clear();
+  const std::size_t first_new = created.size();
+  // The boundary edges first, read before any slot is reused.
+  struct Edge {
+    Vid a, b;
+    Tid outside;
+  };
+  std::vector<Edge> edges;
+  for (Tid t : cav) {
+    const Tri& T = tris_[t];
+    for (int i = 0; i < 3; ++i)
+      if (T.n[i] == kNone || !in_cavity(T.n[i])) edges.push_back({T.v[next(i)], T.v[prev(i)], T.n[i]});
+  }
+  for (Tid t : cav) {
+    tris_[t].alive = false;
+    ++tris_[t].gen;
+    free_.push_back(t);
+    --live_;
+  }
+  for (const Edge& e : edges) {
+    // x on a box side: the side's edge through x is not fanned (it would be flat); its two
+    // halves become box edges of the neighbouring new triangles.
+    if (orient2d(pts_[e.a], pts_[e.b], x) <= 0) continue;
+    const Tid t = new_tri(e.a, e.b, xv);
+    tris_[t].n[2] = e.outside;
+    if (e.outside != kNone) {
+      Tri& O = tris_[e.outside];
+      for (int j = 0; j < 3; ++j)
+        if (O.v[next(j)] == e.b && O.v[prev(j)] == e.a) O.n[j] = t;
+    }
+    by_first_.emplace_back(e.a, t);
+    by_second_.emplace_back(e.b, t);
+    created.push_back(t);
+  }
+  const auto find = [](const std::vector<std::pair<Vid, Tid>>& m, Vid v) {
+    for (const auto& [k, t] : m)
+      if (k == v) return t;
+    return kNone;
+  };
+  for (std::size_t i = first_new; i < created.size(); ++i) {
+    Tri& T = tris_[created[i]];
+    T.n[0] = find(by_first_, T.v[1]);   // edge b→x: the new triangle starting at b
+    T.n[1] = find(by_second_, T.v[0]);  // edge x→a: the new triangle ending at a
+  }
+  return xv;
+}
+
+std::optional<Delaunay::Vid> Delaunay::insert(const Point<2>& x, Tid hint, std::vector<Tid>& created) {
+  const Walk w = walk(hint, x);
+  if (w.exit_edge >= 0) throw InvariantError("dynmesh: Delaunay insertion outside the box");
+  if (vertex_at(w.t, x)) return std::nullopt;
+  std::vector<Tid> cav;
+  cavity(w.t, x, cav);
+  return insert(x, cav, created);
+}
+
+std::optional<std::pair<Delaunay::Tid, int>> Delaunay::box_edge_of(Tid t, Vid a, Vid b) const noexcept {
+  const Tri& T = tris_[t];
+  for (int i = 0; i < 3; ++i)
+    if (T.n[i] == kNone && T.v[next(i)] == a && T.v[prev(i)] == b) return std::pair{t, i};
+  return std::nullopt;
+}
+
+std::vector<Triangle> Delaunay::triangles() const {
+  std::vector<Triangle> out;
+  out.reserve(live_);
+  for (const Tri& T : tris_)
+    if (T.alive) out.push_back(canonical_triangle(pts_[T.v[0]], pts_[T.v[1]], pts_[T.v[2]]));
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+void Delaunay::check_invariants() const {
+  const auto fail = [](const std::string& what) { throw InvariantError("dynmesh: Delaunay: " + what); };
+  const auto on_side = [&](const Point<2>& a, const Point<2>& b) {
+    return (a[0] == b[0] && (a[0] == box_.origin[0] || a[0] == hi_[0])) ||
+           (a[1] == b[1] && (a[1] == box_.origin[1] || a[1] == hi_[1]));
+  };
+  std::size_t live = 0;
+  for (Tid t = 0; t < tris_.size(); ++t) {
+    const Tri& T = tris_[t];
+    if (!T.alive) continue;
+    ++live;
+    if (orient2d(pts_[T.v[0]], pts_[T.v[1]], pts_[T.v[2]]) <= 0) fail("triangle " + std::to_string(t) + " is not ccw");
+    for (int i = 0; i < 3; ++i) {
+      const Vid a = T.v[next(i)], b = T.v[prev(i)];
+      if (T.n[i] == kNone) {
+        if (!on_side(pts_[a], pts_[b])) fail("an edge without a neighbour is not on a box side");
+        continue;
+      }
+      const Tri& U = tris_[T.n[i]];
+      if (!U.alive) fail("neighbour link to a dead triangle");
+      int j = -1;
+      for (int k = 0; k < 3; ++k)
+        if (U.v[next(k)] == b && U.v[prev(k)] == a) j = k;
+      if (j < 0 || U.n[j] != t) fail("neighbour links are not mutual");
+      if (perturbed_incircle(pts_[T.v[0]], pts_[T.v[1]], pts_[T.v[2]], pts_[U.v[j]]))
+        fail("not locally Delaunay across an edge");
+    }
+  }
+  if (live != live_) fail("live count is off");
+  std::size_t h = 0;
+  for (const Point<2>& p : pts_)
+    if (p[0] == box_.origin[0] || p[0] == hi_[0] || p[1] == box_.origin[1] || p[1] == hi_[1]) ++h;
+  if (live_ + h + 2 != 2 * pts_.size()) fail("Euler's formula fails: the triangles do not tile the box");
+}
+
+}  // namespace dynmesh::detail
