@@ -441,4 +441,74 @@ template double closest_pair_distance<3>(std::span<const Point<3>>);
 template double log2_spread<2>(const Box<2>&, std::span<const Point<2>>);
 template double log2_spread<3>(const Box<3>&, std::span<const Point<3>>);
 
+namespace {
+
+/// CPython's random.Random(seed).random(): MT19937 seeded by init_by_array({seed}), then
+/// (a >> 5, b >> 6) of two outputs as a 53-bit fraction.
+class PythonRandom {
+ public:
+  explicit PythonRandom(std::uint32_t seed) {
+    init_genrand(19650218u);
+    const std::uint32_t key[1] = {seed};
+    std::size_t i = 1, j = 0;
+    for (std::size_t k = 624; k > 0; --k) {
+      mt_[i] = (mt_[i] ^ ((mt_[i - 1] ^ (mt_[i - 1] >> 30)) * 1664525u)) + key[j] + static_cast<std::uint32_t>(j);
+      if (++i >= 624) {
+        mt_[0] = mt_[623];
+        i = 1;
+      }
+      if (++j >= 1) j = 0;
+    }
+    for (std::size_t k = 623; k > 0; --k) {
+      mt_[i] = (mt_[i] ^ ((mt_[i - 1] ^ (mt_[i - 1] >> 30)) * 1566083941u)) - static_cast<std::uint32_t>(i);
+      if (++i >= 624) {
+        mt_[0] = mt_[623];
+        i = 1;
+      }
+    }
+    mt_[0] = 0x8000'0000u;
+    index_ = 624;
+  }
+  double random() {
+    const std::uint32_t a = next() >> 5, b = next() >> 6;
+    return (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
+  }
+
+ private:
+  void init_genrand(std::uint32_t s) {
+    mt_[0] = s;
+    for (std::size_t i = 1; i < 624; ++i)
+      mt_[i] = 1812433253u * (mt_[i - 1] ^ (mt_[i - 1] >> 30)) + static_cast<std::uint32_t>(i);
+  }
+  std::uint32_t next() {
+    if (index_ >= 624) {
+      for (std::size_t k = 0; k < 624; ++k) {
+        const std::uint32_t y = (mt_[k] & 0x8000'0000u) | (mt_[(k + 1) % 624] & 0x7fff'ffffu);
+        mt_[k] = mt_[(k + 397) % 624] ^ (y >> 1) ^ ((y & 1u) ? 0x9908'b0dfu : 0u);
+      }
+      index_ = 0;
+    }
+    std::uint32_t y = mt_[index_++];
+    y ^= y >> 11;
+    y ^= (y << 7) & 0x9d2c'5680u;
+    y ^= (y << 15) & 0xefc6'0000u;
+    y ^= y >> 18;
+    return y;
+  }
+  std::uint32_t mt_[624];
+  std::size_t index_ = 0;
+};
+
+}  // namespace
+
+std::vector<Point<2>> python_uniform(std::size_t n, std::uint32_t seed) {
+  PythonRandom rng(seed);
+  std::vector<Point<2>> pts(n);
+  for (auto& p : pts) {
+    p[0] = rng.random();
+    p[1] = rng.random();
+  }
+  return pts;
+}
+
 }  // namespace dynmesh

@@ -17,7 +17,6 @@
 #include "dynmesh/mesh_check.hpp"
 #include "dynmesh/predicates.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
-#include "dynmesh/static_quadtree.hpp"
 #include "locate_points.hpp"
 
 namespace dynmesh {
@@ -72,6 +71,8 @@ class Refiner {
     // (at 30° the refinement then never ends). Like Triangle, place it a little lower
     // (kApexFactor), so that its triangle is strictly better than the bound.
     apex_height_ = kApexFactor * 0.5 / std::tan(min_angle_deg * (std::numbers::pi / 360.0));
+    const double s = std::sin(min_angle_deg * (std::numbers::pi / 180.0));
+    sin2_theta_ = s * s;
   }
 
   void insert_inputs(std::span<const Point<2>> points, std::span<const Position<2>> qs) {
@@ -153,9 +154,25 @@ class Refiner {
     Vid p, q, t;  // the triangle p, q, t is counter-clockwise; pq is its shortest edge
   };
 
+  /// corner_angle_deg, the checker's definition, decides; a filter on sin² of the smallest
+  /// angle (opposite the shortest edge: sin = 2·area / (product of the two longer edges))
+  /// settles all but the near-ties first, since three atan2 per new triangle cost more
+  /// than the rest of its making.
   bool bad(Tid t) const noexcept {
     const auto& v = dt_.tri(t).v;
     const Point<2>&a = dt_.point(v[0]), &b = dt_.point(v[1]), &c = dt_.point(v[2]);
+    const double ux = b[0] - a[0], uy = b[1] - a[1], wx = c[0] - a[0], wy = c[1] - a[1];
+    const double m = std::max({std::abs(ux), std::abs(uy), std::abs(wx), std::abs(wy)});
+    if (m > 0x1p-200 && m < 0x1p200) {  // no overflow or underflow in fourth powers
+      const double cross = ux * wy - uy * wx;
+      const double lab = ux * ux + uy * uy, lac = wx * wx + wy * wy;
+      const double lbc = (wx - ux) * (wx - ux) + (wy - uy) * (wy - uy);
+      const double lmin = std::min({lab, lac, lbc});
+      const double longer = lab == lmin ? lac * lbc : lac == lmin ? lab * lbc : lab * lac;
+      const double sin2 = cross * cross / longer;
+      if (sin2 > sin2_theta_ * (1 + 1e-9)) return false;
+      if (sin2 < sin2_theta_ * (1 - 1e-9)) return true;
+    }
     return corner_angle_deg(a, b, c) < theta_ || corner_angle_deg(b, c, a) < theta_ ||
            corner_angle_deg(c, a, b) < theta_;
   }
@@ -285,6 +302,7 @@ class Refiner {
   Delaunay dt_;
   double theta_;
   double apex_height_ = 0;
+  double sin2_theta_ = 0;
   std::size_t max_vertices_;
   HpuStats& stats_;
   std::map<int, std::vector<Entry>> buckets_;
@@ -305,7 +323,7 @@ HpuMesh::HpuMesh(const Box<2>& box, std::span<const Point<2>> points, double min
     : box_(box), min_angle_(min_angle_deg), points_(points.begin(), points.end()) {
   validate_min_angle(min_angle_deg);
   const auto qs = detail::locate_all(box, points);
-  { const StaticQuadtree<2> tree(qs); }  // duplicates and the spread's resolution, as T* reports them
+  detail::check_separated(qs);  // duplicates and the spread's resolution, as T* reports them
   validate_mesh_box(box);
   // A guard against a refinement that runs away, far above any size the tests have seen.
   const std::size_t max_vertices = 1000 * (points.size() + 4) + (std::size_t{1} << 20);

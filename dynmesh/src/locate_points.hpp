@@ -1,13 +1,16 @@
 // locate_points.hpp (private) — the static meshers' first validation of their input.
 //
 // Purpose: checks the box, then each point (finite, inside the box) and returns the points'
-// grid positions, with InputError naming the failing point's index as DynamicMesh does.
+// grid positions, with InputError naming the failing point's index as DynamicMesh does;
+// check_separated() then rejects what the quadtree rejects after that, without building it.
 // Invariants: on return, positions[i] is try_locate(box, points[i]) for every i.
-// Complexity: O(n).
+// Complexity: locate_all O(n); check_separated O(n log n).
 // Paper: none.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -33,6 +36,37 @@ inline std::vector<Position<2>> locate_all(const Box<2>& box, std::span<const Po
     qs[i] = *q;
   }
   return qs;
+}
+
+/// The quadtree's own rules on positions (static_quadtree.cpp), as errors naming the two
+/// points: two equal positions are duplicates (InputError::Duplicate); two positions within
+/// one grid unit per axis would need a cell below level 52 (InputError::Resolution).
+inline void check_separated(std::span<const Position<2>> qs) {
+  std::vector<std::uint32_t> order(qs.size());
+  for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return qs[a] < qs[b] || (qs[a] == qs[b] && a < b); });
+  const auto report = [&](std::uint32_t a, std::uint32_t b) {
+    const std::size_t i = std::min(a, b), j = std::max(a, b);
+    if (qs[a] == qs[b])
+      throw InputError(InputError::Kind::Duplicate,
+                       "points " + std::to_string(i) + " and " + std::to_string(j) + " have the same located position (duplicate point)")
+          .with_points({i, j});
+    throw InputError(InputError::Kind::Resolution,
+                     "points " + std::to_string(i) + " and " + std::to_string(j) +
+                         " are within one grid unit of each other: the spread L/s is beyond the resolution of 2^52")
+        .with_points({i, j});
+  };
+  // Sorted by (x, y): a close pair has x' in {x, x + 1}; search each run for y' within 1.
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const Position<2>& q = qs[order[k]];
+    if (k + 1 < order.size() && qs[order[k + 1]][0] == q[0] && qs[order[k + 1]][1] <= q[1] + 1)
+      report(order[k], order[k + 1]);
+    if (q[0] == UINT64_MAX) continue;
+    const Position<2> from{q[0] + 1, q[1] == 0 ? 0 : q[1] - 1};
+    const auto it = std::lower_bound(order.begin() + static_cast<std::ptrdiff_t>(k), order.end(), from,
+                                     [&](std::uint32_t a, const Position<2>& p) { return qs[a] < p; });
+    if (it != order.end() && qs[*it][0] == from[0] && qs[*it][1] <= q[1] + 1) report(order[k], *it);
+  }
 }
 
 }  // namespace dynmesh::detail

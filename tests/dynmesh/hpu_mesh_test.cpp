@@ -26,73 +26,6 @@ using namespace dynmesh;
 using detail::Delaunay;
 using dynmesh_test::kSanitized;
 
-/// CPython's random.Random(seed).random() for a small non-negative int seed: MT19937 seeded
-/// by init_by_array({seed}), then (a >> 5, b >> 6) of two outputs as a 53-bit fraction. It
-/// makes the unif1e4 / unif1e5 inputs without Python.
-class PythonRandom {
- public:
-  explicit PythonRandom(std::uint32_t seed) {
-    init_genrand(19650218u);
-    const std::uint32_t key[1] = {seed};
-    std::size_t i = 1, j = 0;
-    for (std::size_t k = 624; k > 0; --k) {
-      mt_[i] = (mt_[i] ^ ((mt_[i - 1] ^ (mt_[i - 1] >> 30)) * 1664525u)) + key[j] + static_cast<std::uint32_t>(j);
-      if (++i >= 624) {
-        mt_[0] = mt_[623];
-        i = 1;
-      }
-      if (++j >= 1) j = 0;
-    }
-    for (std::size_t k = 623; k > 0; --k) {
-      mt_[i] = (mt_[i] ^ ((mt_[i - 1] ^ (mt_[i - 1] >> 30)) * 1566083941u)) - static_cast<std::uint32_t>(i);
-      if (++i >= 624) {
-        mt_[0] = mt_[623];
-        i = 1;
-      }
-    }
-    mt_[0] = 0x8000'0000u;
-    index_ = 624;
-  }
-  double random() {
-    const std::uint32_t a = next() >> 5, b = next() >> 6;
-    return (a * 67108864.0 + b) * (1.0 / 9007199254740992.0);
-  }
-
- private:
-  void init_genrand(std::uint32_t s) {
-    mt_[0] = s;
-    for (std::size_t i = 1; i < 624; ++i)
-      mt_[i] = 1812433253u * (mt_[i - 1] ^ (mt_[i - 1] >> 30)) + static_cast<std::uint32_t>(i);
-  }
-  std::uint32_t next() {
-    if (index_ >= 624) {
-      for (std::size_t k = 0; k < 624; ++k) {
-        const std::uint32_t y = (mt_[k] & 0x8000'0000u) | (mt_[(k + 1) % 624] & 0x7fff'ffffu);
-        mt_[k] = mt_[(k + 397) % 624] ^ (y >> 1) ^ ((y & 1u) ? 0x9908'b0dfu : 0u);
-      }
-      index_ = 0;
-    }
-    std::uint32_t y = mt_[index_++];
-    y ^= y >> 11;
-    y ^= (y << 7) & 0x9d2c'5680u;
-    y ^= (y << 15) & 0xefc6'0000u;
-    y ^= y >> 18;
-    return y;
-  }
-  std::uint32_t mt_[624];
-  std::size_t index_ = 0;
-};
-
-std::vector<Point<2>> python_uniform(std::size_t n) {
-  PythonRandom rng(1);
-  std::vector<Point<2>> pts(n);
-  for (auto& p : pts) {
-    p[0] = rng.random();
-    p[1] = rng.random();
-  }
-  return pts;
-}
-
 void expect_contract(const HpuMesh& m, std::span<const Point<2>> points, double angle, const std::string& what) {
   const MeshReport r = check_mesh(m.mesh(), m.box(), points, MeshCheckOptions{.min_angle_deg = angle, .delaunay = true});
   EXPECT_TRUE(r.ok()) << what << ": " << r.summary();
@@ -103,10 +36,11 @@ void expect_contract(const HpuMesh& m, std::span<const Point<2>> points, double 
 
 TEST(HpuDelaunay, PythonRandomMatchesCPython) {
   // random.Random(1): 0.13436424411240122, 0.8474337369372327, 0.763774618976614
-  PythonRandom rng(1);
-  EXPECT_EQ(rng.random(), 0.13436424411240122);
-  EXPECT_EQ(rng.random(), 0.8474337369372327);
-  EXPECT_EQ(rng.random(), 0.763774618976614);
+  const auto pts = python_uniform(2);
+  EXPECT_EQ(pts[0][0], 0.13436424411240122);
+  EXPECT_EQ(pts[0][1], 0.8474337369372327);
+  EXPECT_EQ(pts[1][0], 0.763774618976614);
+  EXPECT_EQ(pts[1][1], 0.2550690257394217);
 }
 
 TEST(HpuDelaunay, PerturbedInCircleDecidesCocircularPointsConsistently) {
@@ -271,15 +205,33 @@ TEST(HpuMesh, RejectsBadInput) {
   EXPECT_THROW(HpuMesh(box, nan), InputError);
   const std::vector<Point<2>> outside = {{0.3, 1.5}};
   EXPECT_THROW(HpuMesh(box, outside), InputError);
-  const std::vector<Point<2>> dup = {{0.3, 0.3}, {0.3, 0.3}};
-  EXPECT_THROW(HpuMesh(box, dup), InputError);
+  const std::vector<Point<2>> dup = {{0.7, 0.1}, {0.3, 0.3}, {0.3, 0.3}};
+  try {
+    HpuMesh(box, dup);
+    ADD_FAILURE() << "a duplicate was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.kind(), InputError::Kind::Duplicate);
+    EXPECT_EQ(e.point_indices(), (std::vector<std::size_t>{1, 2}));
+  }
+  // One grid unit (L / 2^52) apart, diagonally: the quadtree could not separate them.
+  const std::vector<Point<2>> close = {{0.5, 0.5}, {0.2, 0.9}, {0.5 + 0x1p-52, 0.5 - 0x1p-52}};
+  try {
+    HpuMesh(box, close);
+    ADD_FAILURE() << "points one grid unit apart were accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.kind(), InputError::Kind::Resolution);
+    EXPECT_EQ(e.point_indices(), (std::vector<std::size_t>{0, 2}));
+  }
+  // Two grid units apart is fine.
+  const std::vector<Point<2>> apart = {{0.5, 0.5}, {0.5 + 0x1p-51, 0.5}};
+  EXPECT_NO_THROW(HpuMesh(box, apart, 30));
 }
 
 TEST(HpuMesh, SizeAgainstTriangleOnUnif1e4) {
   // The unif1e4 (Python's random.Random(1)), FORMATS.md's default box. Triangle 1.6
   // (-pq) makes 16,462 vertices at 20.7° and 28,427 at 30°; the target is at most 1.10x.
   if (kSanitized) GTEST_SKIP() << "10^4 points at -O0 under the sanitizers";
-  const auto pts = python_uniform(10000);
+  const auto pts = python_uniform(10000);  // unif1e4
   const Box<2> box = derive_box<2>(pts);
   for (const auto& [angle, triangle] : {std::pair{20.7, 16462.0}, std::pair{30.0, 28427.0}}) {
     const HpuMesh m(box, pts, angle);

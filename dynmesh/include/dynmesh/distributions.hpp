@@ -100,6 +100,12 @@ std::optional<Distribution> parse_distribution(std::string_view name) noexcept;
 template <std::size_t d>
 std::vector<Point<d>> generate(Distribution dist, std::size_t n, std::uint64_t seed, double spread = 0x1p20);
 
+/// The peers' benchmark inputs: n points (x, y) from CPython's random.Random(seed), drawn as
+/// `x = rng.random(); y = rng.random()` n times (seed 1 makes the unif1e4 / unif1e5 inputs
+/// against which Triangle's and CGAL's mesh sizes are quoted). Bit-identical to CPython's
+/// doubles: MT19937 seeded by init_by_array({seed}), 53-bit fractions.
+std::vector<Point<2>> python_uniform(std::size_t n, std::uint32_t seed = 1);
+
 /// The smallest distance between two of the points (+infinity for fewer than two points,
 /// 0 if two are equal). Precondition: the ratio of the points' extent to that distance is
 /// below 2^60 (true for any set with distinct located positions); otherwise

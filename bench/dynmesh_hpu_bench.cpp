@@ -1,0 +1,103 @@
+// dynmesh_hpu_bench — the hpu mesh (HpuMesh, DynHPU's static twin) against its peers on the
+// issue's inputs, for bench/RESULTS.md and docs/EXPERIMENTS.md.
+//
+// Method: unif1e4 and unif1e5 are python_uniform(n, 1) (CPython's random.Random(1)), in
+// FORMATS.md's default box, the inputs on which Triangle 1.6 (-pq) and CGAL 5.5 Mesh_2 were
+// measured (their figures below are the issue's, measured on this kind of machine). Each
+// mesh is built `--reps` times (median time), checked against the contract (Delaunay, every
+// angle >= the bound, tiling, inputs present: checked = 1), and reported with its size, its
+// ratio to the peers' sizes, and its angle histogram (10-degree bins, every angle of every
+// triangle). Output: a table, or CSV with --csv:
+//   input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,checked
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "bench_stats.hpp"
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/hpu_mesh.hpp"
+#include "dynmesh/mesh_check.hpp"
+#include "dynmesh/mesh_io.hpp"
+
+namespace {
+
+using namespace dynmesh;
+
+struct Peer {
+  std::size_t n;
+  double angle;
+  double triangle_vertices, cgal_vertices;
+};
+
+// The table (vertices): Triangle 1.6 -pq and CGAL 5.5 Mesh_2 at 20.7 and 30 degrees.
+constexpr Peer kPeers[] = {
+    {10000, 20.7, 16462, 19773},
+    {10000, 30.0, 28427, 46426},
+    {100000, 20.7, 160302, 189985},
+    {100000, 30.0, 276933, 436638},
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"dynmesh_hpu_bench: the hpu mesh against Triangle's and CGAL's sizes"};
+  std::vector<std::size_t> ns{10000, 100000};
+  int reps = 3;
+  bool csv = false, histogram = false;
+  app.add_option("--n", ns, "input sizes (python_uniform(n, 1))")->delimiter(',');
+  app.add_option("--reps", reps, "builds per mesh (median time)")->check(CLI::Range(1, 100));
+  app.add_flag("--csv", csv, "CSV instead of a table");
+  app.add_flag("--histogram", histogram, "print each mesh's angle histogram");
+  CLI11_PARSE(app, argc, argv);
+
+  if (csv) std::printf("input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,checked\n");
+  else
+    std::printf("%-9s %6s %9s %9s %9s %8s %8s %9s %6s %7s\n", "input", "angle", "seconds", "vertices", "triangles",
+                "vs_Tri", "vs_CGAL", "min_angle", "rounds", "checked");
+  bool all_ok = true;
+  for (const std::size_t n : ns) {
+    const auto pts = python_uniform(n, 1);
+    const Box<2> box = derive_box<2>(pts);
+    for (const Peer& peer : kPeers) {
+      if (peer.n != n) continue;
+      std::vector<double> times;
+      std::vector<Triangle> tris;
+      HpuStats stats;
+      for (int r = 0; r < reps; ++r)
+        times.push_back(bench::seconds([&] {
+          const HpuMesh m(box, pts, peer.angle);
+          tris = m.triangles();
+          stats = m.stats();
+        }));
+      const Mesh mesh = make_mesh(tris);
+      const MeshReport report =
+          check_mesh(mesh, box, pts, MeshCheckOptions{.min_angle_deg = peer.angle, .delaunay = true});
+      all_ok = all_ok && report.ok();
+      const std::string input = "unif1e" + std::to_string(n == 10000 ? 4 : n == 100000 ? 5 : 0);
+      const double vt = double(mesh.num_vertices()) / peer.triangle_vertices;
+      const double vc = double(mesh.num_vertices()) / peer.cgal_vertices;
+      if (csv)
+        std::printf("%s,%.1f,%.4f,%zu,%zu,%.4f,%.4f,%.3f,%zu,%d\n", input.c_str(), peer.angle, bench::median(times),
+                    mesh.num_vertices(), mesh.num_triangles(), vt, vc, report.min_angle_deg, stats.rounds,
+                    report.ok() ? 1 : 0);
+      else
+        std::printf("%-9s %6.1f %9.4f %9zu %9zu %8.3f %8.3f %9.3f %6zu %7d\n", input.c_str(), peer.angle,
+                    bench::median(times), mesh.num_vertices(), mesh.num_triangles(), vt, vc, report.min_angle_deg,
+                    stats.rounds, report.ok() ? 1 : 0);
+      if (histogram) {
+        const MeshStats ms = mesh_stats(mesh);
+        std::printf("  angle histogram (%s, %.1f deg):", input.c_str(), peer.angle);
+        for (std::size_t k = 0; k < ms.angle_histogram.size(); ++k)
+          if (ms.angle_histogram[k]) std::printf(" [%zu,%zu):%zu", 10 * k, 10 * k + 10, ms.angle_histogram[k]);
+        std::printf("\n");
+      }
+    }
+  }
+  return all_ok ? 0 : 1;
+}
