@@ -109,11 +109,6 @@ QuadtreeMesh::QuadtreeMesh(const Box<2>& box, std::span<const Point<2>> points)
 }
 
 void validate_mesh_box(const Box<2>& box) {
-  if (std::abs(std::ilogb(box.side)) > kMeshSideExponent)
-    throw InputError(InputError::Kind::Resolution,
-                     "the domain box's side L = " + format_brief(box.side) + " is beyond what the mesh computes in double "
-                     "precision (2^-" + std::to_string(kMeshSideExponent) + " <= L < 2^" +
-                         std::to_string(kMeshSideExponent + 1) + ")");
   if (MeshGrid(box).level_limit < 2)
     throw InputError(InputError::Kind::Resolution,
                      "the domain box is too small for its offset: double coordinates cannot resolve its cells");

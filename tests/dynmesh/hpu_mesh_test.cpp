@@ -183,6 +183,19 @@ TEST(HpuMesh, EmptyAndTinyInputs) {
   }
 }
 
+TEST(HpuMesh, ExtremeBoxSides) {
+  // Constructions run in frames scaled by powers of two and the predicates are exact, so
+  // every side validate_box() accepts is meshed within the bound.
+  const std::vector<Box<2>> boxes = {{{0.0, 0.0}, 0x1p1000}, {{0.0, 0.0}, 0x1p-960}, {{1e-280, -2e-280}, 0x1p-900},
+                                     {{-3.3700738560978761e+305, -4.4934318081305018e+305}, 6.7401477121957522e+305}};
+  for (const Box<2>& box : boxes) {
+    const double o0 = box.origin[0], o1 = box.origin[1], side = box.side;
+    const std::vector<Point<2>> pts = {
+        {o0 + side * 0.3, o1 + side * 0.45}, {o0 + side * 0.7, o1 + side * 0.6}, {o0 + side * 0.5, o1 + side * 0.5000001}};
+    for (const double angle : {20.7, 30.0}) expect_contract(HpuMesh(box, pts, angle), pts, angle, "side " + format_exact(side));
+  }
+}
+
 TEST(HpuMesh, IsAFunctionOfThePointSet) {
   // Any order of the same points gives the same triangles, bit for bit.
   for (const auto dist : {Distribution::Uniform, Distribution::Grid, Distribution::Clusters}) {

@@ -27,15 +27,12 @@ namespace dynmesh {
 /// stated with the margin the checker uses.
 inline constexpr double kQuadtreeMinAngle = 18.4;
 
-/// Throws InputError(Resolution) unless the mesh's double arithmetic works in `box`:
-///   * its cells are resolved (mesh_resolution_level ≥ 2, detail/quadtree_mesh_rules.hpp).
-///     Each point's rule implies it, so it matters for the empty set: a box far smaller than
-///     its offset (o + L == o) would otherwise mesh as two degenerate triangles;
-///   * 2^−440 ≤ L < 2^441 (kMeshSideExponent): the rules choose each leaf's triangulation by
-///     angles computed from unscaled products of coordinate differences, which overflow to
-///     NaN or underflow to 0 beyond that, giving angles below the bound or no triangulation.
-/// Shared by both meshers.
-inline constexpr int kMeshSideExponent = 440;
+/// Throws InputError(Resolution) unless the mesh's cells are resolved in `box`
+/// (mesh_resolution_level ≥ 2, detail/quadtree_mesh_rules.hpp). Each point's rule implies it,
+/// so it matters for the empty set: a box far smaller than its offset (o + L == o) would
+/// otherwise mesh as two degenerate triangles. Any side validate_box() accepts is meshed
+/// otherwise: the rules scale their angle computations by powers of two. Shared by the
+/// meshers.
 void validate_mesh_box(const Box<2>& box);
 
 /// The closure rule of T' (detail/quadtree_mesh_rules.hpp) on its sorted leaves: no leaf

@@ -133,9 +133,13 @@ inline WarpTarget warp_target(const MeshGrid& grid, const Position<2>& q, const 
     const CellId<2> c = cell_of(q, t);
     unsigned best = 0;
     double best_d = 0;
+    // Distances in a frame scaled by a power of two where the squares could overflow or
+    // underflow: the same comparisons (scaling is exact) in every box.
+    const double side = grid.unit * std::ldexp(1.0, kMaxLevel - t);
+    const int shift = side > 0x1p400 || side < 0x1p-400 ? -std::ilogb(side) : 0;
     for (unsigned k = 0; k < 4; ++k) {
       const Point<2> v = grid.corner(c, k);
-      const double dx = v[0] - p[0], dy = v[1] - p[1];
+      const double dx = std::ldexp(v[0] - p[0], shift), dy = std::ldexp(v[1] - p[1], shift);
       const double dist = dx * dx + dy * dy;
       if (k == 0 || dist < best_d) best = k, best_d = dist;
     }
@@ -213,10 +217,17 @@ struct LeafShape {
   Point<2> warp_to{};          // where it moves (the point)
 };
 
-/// Smallest angle of triangle abc in radians (atan2 of |cross| and dot at each corner).
+/// Smallest angle of triangle abc in radians (atan2 of |cross| and dot at each corner). The
+/// differences are scaled by a power of two first (exact; the angle does not change), so the
+/// products neither overflow nor underflow in a box of any side double precision allows.
 inline double min_angle(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept {
   auto angle = [](const Point<2>& o, const Point<2>& u, const Point<2>& v) {
-    const double ux = u[0] - o[0], uy = u[1] - o[1], vx = v[0] - o[0], vy = v[1] - o[1];
+    double ux = u[0] - o[0], uy = u[1] - o[1], vx = v[0] - o[0], vy = v[1] - o[1];
+    const double m = std::fmax(std::fmax(std::fabs(ux), std::fabs(uy)), std::fmax(std::fabs(vx), std::fabs(vy)));
+    if (m > 0 && std::isfinite(m) && (m < 0x1p-400 || m > 0x1p400)) {
+      const int e = std::ilogb(m);
+      ux = std::ldexp(ux, -e), uy = std::ldexp(uy, -e), vx = std::ldexp(vx, -e), vy = std::ldexp(vy, -e);
+    }
     return std::atan2(std::fabs(ux * vy - uy * vx), ux * vx + uy * vy);
   };
   return std::fmin(angle(a, b, c), std::fmin(angle(b, c, a), angle(c, a, b)));
@@ -254,8 +265,13 @@ inline void triangulate_leaf(const MeshGrid& grid, const LeafShape& s, std::vect
     for (unsigned i = 0; i < np; ++i) emit(centre, poly[i], poly[(i + 1) % np]);
     return;
   }
-  const Point<2> centroid = {((corner[0][0] + corner[1][0]) + (corner[2][0] + corner[3][0])) / 4,
-                             ((corner[0][1] + corner[1][1]) + (corner[2][1] + corner[3][1])) / 4};
+  // Each corner quartered first: the same bits as quartering the sum (a power of two
+  // commutes with rounding) in every box whose coordinates stay clear of the subnormals, and
+  // no overflow near the largest doubles.
+  const auto quarter_sum = [&](unsigned a) {
+    return (corner[0][a] * 0.25 + corner[1][a] * 0.25) + (corner[2][a] * 0.25 + corner[3][a] * 0.25);
+  };
+  const Point<2> centroid = {quarter_sum(0), quarter_sum(1)};
   // Candidates: 0 diagonal 0-2, 1 diagonal 1-3, 2 fan from the centre, 3 fan from the centroid.
   auto evaluate = [&](int which, bool commit) {
     double worst = 10.0;
