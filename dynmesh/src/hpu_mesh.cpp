@@ -324,6 +324,9 @@ HpuMesh::HpuMesh(const Box<2>& box, std::span<const Point<2>> points, double min
   validate_min_angle(min_angle_deg);
   const auto qs = detail::locate_all(box, points);
   detail::check_separated(qs);  // duplicates and the spread's resolution, as T* reports them
+  // What double coordinates cannot refine around (the quadtree mesh's rule: near points and
+  // points near a side have 4096 ulps of room at the finest level, L/2^R).
+  detail::check_resolution(detail::MeshGrid(box), points, qs);
   validate_mesh_box(box);
   // A guard against a refinement that runs away, far above any size the tests have seen.
   const std::size_t max_vertices = 1000 * (points.size() + 4) + (std::size_t{1} << 20);

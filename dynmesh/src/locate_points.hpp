@@ -2,9 +2,12 @@
 //
 // Purpose: checks the box, then each point (finite, inside the box) and returns the points'
 // grid positions, with InputError naming the failing point's index as DynamicMesh does;
-// check_separated() then rejects what the quadtree rejects after that, without building it.
+// check_separated() then rejects what the quadtree rejects after that, without building it;
+// check_resolution() what the meshes' double arithmetic cannot resolve (detail/
+// quadtree_mesh_rules.hpp: points in neighbouring cells of level R, or within L/2^R of a box
+// side they are not on).
 // Invariants: on return, positions[i] is try_locate(box, points[i]) for every i.
-// Complexity: locate_all O(n); check_separated O(n log n).
+// Complexity: locate_all O(n); check_separated O(n log n); check_resolution O(n) expected.
 // Paper: none.
 #pragma once
 
@@ -16,6 +19,8 @@
 #include <vector>
 
 #include "dynmesh/box.hpp"
+#include "dynmesh/detail/cell_table.hpp"
+#include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
 
@@ -66,6 +71,24 @@ inline void check_separated(std::span<const Position<2>> qs) {
     const auto it = std::lower_bound(order.begin() + static_cast<std::ptrdiff_t>(k), order.end(), from,
                                      [&](std::uint32_t a, const Position<2>& p) { return qs[a] < p; });
     if (it != order.end() && qs[*it][0] == from[0] && qs[*it][1] <= q[1] + 1) report(order[k], *it);
+  }
+}
+
+/// The mesh's resolution rules (detail/quadtree_mesh_rules.hpp) over a whole point set.
+inline void check_resolution(const MeshGrid& grid, std::span<const Point<2>> points, std::span<const Position<2>> qs) {
+  detail::CellTable<2, std::uint32_t> count;
+  for (const auto& q : qs) ++*count.try_emplace(cell_of(q, std::max(grid.level_limit, 0)), 0u).first;
+  for (std::size_t i = 0; i < qs.size(); ++i) {
+    const CellId<2> own = cell_of(qs[i], std::max(grid.level_limit, 0));
+    detail::check_mesh_resolution(
+        grid, qs[i], points[i],
+        [&](const CellId<2>& c) {
+          const std::uint32_t* k = count.find(c);
+          return k && *k > (c == own ? 1u : 0u);
+        },
+        [&](const std::string& text) {
+          throw InputError(InputError::Kind::Resolution, "point " + std::to_string(i) + ": " + text).with_points({i});
+        });
   }
 }
 

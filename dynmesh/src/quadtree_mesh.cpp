@@ -21,31 +21,13 @@ namespace {
 using detail::CellTable;
 using detail::MeshGrid;
 
-/// The mesh's resolution rules (detail/quadtree_mesh_rules.hpp) over a whole point set.
-void check_resolution(const MeshGrid& grid, std::span<const Point<2>> points, std::span<const Position<2>> qs) {
-  CellTable<2, std::uint32_t> count;
-  for (const auto& q : qs) ++*count.try_emplace(cell_of(q, std::max(grid.level_limit, 0)), 0u).first;
-  for (std::size_t i = 0; i < qs.size(); ++i) {
-    const CellId<2> own = cell_of(qs[i], std::max(grid.level_limit, 0));
-    detail::check_mesh_resolution(
-        grid, qs[i], points[i],
-        [&](const CellId<2>& c) {
-          const std::uint32_t* k = count.find(c);
-          return k && *k > (c == own ? 1u : 0u);
-        },
-        [&](const std::string& text) {
-          throw InputError(InputError::Kind::Resolution, "point " + std::to_string(i) + ": " + text).with_points({i});
-        });
-  }
-}
-
 }  // namespace
 
 QuadtreeMesh::QuadtreeMesh(const Box<2>& box, std::span<const Point<2>> points)
     : box_(box), points_(points.begin(), points.end()), tree_(detail::locate_all(box, points)) {
   const MeshGrid grid(box);
   const auto qs = tree_.points();
-  check_resolution(grid, points, qs);
+  detail::check_resolution(grid, points, qs);
   validate_mesh_box(box);
 
   // T': T*'s split cells, then every point's seeds and what grading forces.

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <fstream>
 #include <ostream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -43,11 +44,18 @@ constexpr std::size_t kSegmentsPerPath = 8192;
 
 }  // namespace
 
+double default_point_radius_px(std::size_t points, double size_px, double largest_px) {
+  const double floor_px = std::min(0.25, largest_px);
+  if (points == 0) return largest_px;
+  return std::clamp(0.1 * size_px / std::sqrt(static_cast<double>(points)), floor_px, largest_px);
+}
+
 void write_svg(std::ostream& out, const Box<2>& box, std::span<const Leaf<2>> leaves,
                std::span<const Point<2>> points, const SvgOptions& opt) {
   const double size = opt.size_px, margin = opt.margin_px;
   const double total = size + 2 * margin;
   const int visible = finest_visible_level(size, opt.min_cell_px);
+  const bool draw_points = points.size() <= opt.max_points;
 
   // Tiles: leaves at visible levels, and the level-`visible` ancestors of finer leaves
   // (blocks). Together they still tile the box. Sorted so the output ignores input order.
@@ -76,7 +84,8 @@ void write_svg(std::ostream& out, const Box<2>& box, std::span<const Leaf<2>> le
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
       << "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"" << px(total) << "\" height=\""
       << px(total) << "\" viewBox=\"0 0 " << px(total) << ' ' << px(total) << "\">\n"
-      << "<title>dynmesh quadtree: " << leaves.size() << " leaves, " << points.size() << " points</title>\n"
+      << "<title>dynmesh quadtree: " << leaves.size() << " leaves, " << points.size() << " points"
+      << (draw_points ? "" : " (not drawn: more than " + std::to_string(opt.max_points) + ")") << "</title>\n"
       << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
 
   if (!blocks.empty()) {
@@ -108,11 +117,11 @@ void write_svg(std::ostream& out, const Box<2>& box, std::span<const Leaf<2>> le
   out << "<rect x=\"" << px(margin) << "\" y=\"" << px(margin) << "\" width=\"" << px(size) << "\" height=\""
       << px(size) << "\" fill=\"none\" stroke=\"#404040\" stroke-width=\"" << px(2 * opt.stroke_px) << "\"/>\n";
 
-  // Points on a quarter-pixel grid, each distinct dot once.
+  // Points on a quarter-pixel grid, each distinct dot once; none above max_points.
   std::vector<std::pair<std::int64_t, std::int64_t>> dots;
-  dots.reserve(points.size());
+  if (draw_points) dots.reserve(points.size());
   const double per_unit = size / box.side;
-  for (const Point<2>& p : points) {
+  for (const Point<2>& p : draw_points ? points : std::span<const Point<2>>{}) {
     const double x = margin + (p[0] - box.origin[0]) * per_unit;
     const double y = margin + size - (p[1] - box.origin[1]) * per_unit;
     if (!std::isfinite(x) || !std::isfinite(y) || std::abs(x) > 1e9 || std::abs(y) > 1e9) continue;
@@ -122,7 +131,9 @@ void write_svg(std::ostream& out, const Box<2>& box, std::span<const Leaf<2>> le
   dots.erase(std::unique(dots.begin(), dots.end()), dots.end());
   if (!dots.empty()) {
     out << "<g fill=\"#c0392b\">\n";
-    const std::string r = px(opt.point_radius_px);
+    const double radius =
+        opt.point_radius_px > 0 ? opt.point_radius_px : default_point_radius_px(points.size(), size, 1.0);
+    const std::string r = px(radius);
     for (const auto& [x4, y4] : dots)
       out << "<circle cx=\"" << px(static_cast<double>(x4) / 4) << "\" cy=\"" << px(static_cast<double>(y4) / 4)
           << "\" r=\"" << r << "\"/>\n";

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "dynmesh/svg.hpp"
+
 namespace dynmesh::tool {
 
 struct QuadtreeOptions {
@@ -30,6 +32,9 @@ struct QuadtreeOptions {
   std::string cells;        // --cells OUT
   bool check = false;       // --check
   std::string svg;          // --svg OUT.svg (2D)
+  double svg_point_radius = 0;                // --svg-point-radius PX (0: from the point count)
+  std::size_t svg_max_points = kSvgMaxPoints;  // --svg-max-points N
+  bool force = false;       // --force: skip the memory guard (memory_guard.hpp)
 };
 
 // `dynmesh mesh` (2D); named apart from dynmesh::MeshOptions, the library's.
@@ -47,8 +52,11 @@ struct MeshCommandOptions {
   std::string vtk;               // --vtk F
   std::string msh;               // --msh F
   std::string svg;               // --svg F
+  double svg_point_radius = 0;   // --svg-point-radius PX (0: from the point count)
+  std::size_t svg_max_points = kSvgMaxPoints;  // --svg-max-points N
   bool check = false;            // --check
   bool stats = false;            // --stats
+  bool force = false;            // --force: skip the memory guard (memory_guard.hpp)
 };
 
 struct StabilityOptions {
@@ -63,6 +71,7 @@ struct StabilityOptions {
   std::uint64_t seed = 1;
   std::string csv;
   std::string plot;  // --plot OUT.svg (empty: no plot)
+  bool force = false;  // --force: skip the memory guard (memory_guard.hpp)
 };
 
 struct DemoOptions {

@@ -1,14 +1,19 @@
 // dynmesh — the command-line tool of the dynmesh library (shared/FORMATS.md):
 //   dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--duplicates error|skip]
 //                   [--edits FILE] [--batch K] --cells OUT [--check] [--svg OUT.svg]
+//                   [--svg-point-radius PX] [--svg-max-points N] [--force]
 //   dynmesh mesh POINTS [--box o1 o2 L] [--duplicates error|skip] [--postprocess hpu|quadtree]
 //                [--min-angle DEG] [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F]
-//                [--msh F] [--svg F] [--check] [--stats]
+//                [--msh F] [--svg F] [--svg-point-radius PX] [--svg-max-points N] [--check]
+//                [--stats] [--force]
 //   dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]
 //                     [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv [--plot OUT.svg]
+//                     [--force]
 //   dynmesh demo [--n N] [--updates U] [--seed X] [--svg OUT.svg]
 // Exit status: 0 on success; 1 with exactly one line `dynmesh: <message>` on stderr on any
-// error; 2 for a command line CLI11 rejects (also one line).
+// error (a build refused by the memory guard included); 2 for a command line CLI11 rejects
+// (also one line). Progress lines (progress.hpp) go to stderr too, only on runs longer than a
+// second (DYNMESH_PROGRESS_DELAY_MS overrides the second, for tests).
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -19,6 +24,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "memory_guard.hpp"
 #include "number_options.hpp"
 #include "verify.hpp"
 
@@ -33,6 +39,26 @@ int main(int argc, char** argv) {
   constexpr std::uint64_t kMaxCount = 1'000'000'000;  // points or updates: beyond memory anyway
   const char* const duplicates_help =
       "error (the default): a repeated point is an error; skip: drop later copies of a point and say how many";
+  const char* const force_help = "build even when the estimated memory exceeds the memory available (see below)";
+  const std::string svg_max_help = "--svg draws no input points when there are more than N (default " +
+                                   std::to_string(dynmesh::kSvgMaxPoints) + ")";
+  const char* const svg_radius_help =
+      "--svg dot radius in pixels of the 1000-pixel drawing (default: from the number of points, a tenth of "
+      "their even spacing, from 1 px (quadtree) or 1.5 px (mesh) down to 0.25 px)";
+  // The memory guard's rule under each command's synopsis, with the costs per point it uses.
+  auto memory_note = [](const std::string& costs) {
+    return "Memory: a build whose estimated peak exceeds the memory available (the least of MemAvailable and "
+           "what ulimit -v and ulimit -d leave) stops at once with exit status 1; --force builds anyway. "
+           "Estimated peak per point held: " +
+           costs + ".";
+  };
+  auto cost_text = [](const char* structure, const MemoryCost& cost, const char* check) {
+    return std::string(structure) + " about " + human_bytes(cost.bytes_per_point) + ", " +
+           human_bytes(cost.check_bytes_per_point) + " more " + check;
+  };
+  // A radius in pixels: positive, and no larger than the drawing.
+  const CLI::Validator radius_px = CLI::Range(0.01, 1000.0);
+  const CLI::Validator any_count = whole_number(0, std::numeric_limits<std::size_t>::max());
 
   QuadtreeOptions q;
   CLI::App* quadtree = app.add_subcommand(
@@ -54,7 +80,23 @@ int main(int argc, char** argv) {
       ->check(at_least_one);
   quadtree->add_option("--cells", q.cells, "output: the final leaves as .cells")->required();
   quadtree->add_flag("--check", q.check, "also rebuild from scratch on the final points and fail if the trees differ");
-  quadtree->add_option("--svg", q.svg, "also draw the final tree and points (2D only)");
+  CLI::Option* quadtree_svg = quadtree->add_option("--svg", q.svg, "also draw the final tree and points (2D only)");
+  quadtree->add_option("--svg-point-radius", q.svg_point_radius, svg_radius_help)
+      ->check(radius_px)
+      ->needs(quadtree_svg)
+      ->type_name("PX");
+  quadtree->add_option("--svg-max-points", q.svg_max_points, svg_max_help)
+      ->check(any_count)
+      ->needs(quadtree_svg)
+      ->type_name("N");
+  quadtree->add_flag("--force", q.force, force_help);
+  quadtree->footer(
+      "\nSynopsis (shared/FORMATS.md):\n"
+      "  dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--duplicates error|skip]\n"
+      "                   [--edits FILE] [--batch K] --cells OUT [--check]\n"
+      "                   [--svg OUT.svg [--svg-point-radius PX] [--svg-max-points N]] [--force]\n\n" +
+      memory_note(cost_text("quadtree (2D)", kQuadtree2dCost, "with --check") + "; " +
+                  cost_text("octree (3D)", kOctree3dCost, "with --check")));
 
   MeshCommandOptions me;
   CLI::App* mesh = app.add_subcommand(
@@ -80,9 +122,25 @@ int main(int argc, char** argv) {
   mesh->add_option("--feed", me.feed, "also write the change feed of every propagation");
   mesh->add_option("--vtk", me.vtk, "also write the mesh as legacy VTK");
   mesh->add_option("--msh", me.msh, "also write the mesh as Gmsh 2.2 ASCII");
-  mesh->add_option("--svg", me.svg, "also draw the mesh and its input points");
+  CLI::Option* mesh_svg = mesh->add_option("--svg", me.svg, "also draw the mesh and its input points");
+  mesh->add_option("--svg-point-radius", me.svg_point_radius, svg_radius_help)
+      ->check(radius_px)
+      ->needs(mesh_svg)
+      ->type_name("PX");
+  mesh->add_option("--svg-max-points", me.svg_max_points, svg_max_help)
+      ->check(any_count)
+      ->needs(mesh_svg)
+      ->type_name("N");
   mesh->add_flag("--check", me.check, "also mesh the final points from scratch and fail unless the meshes agree");
   mesh->add_flag("--stats", me.stats, "print a quality report on stderr");
+  mesh->add_flag("--force", me.force, force_help);
+  mesh->footer(
+      "\nSynopsis (shared/FORMATS.md):\n"
+      "  dynmesh mesh POINTS [--box o1 o2 L] [--duplicates error|skip] [--postprocess hpu|quadtree]\n"
+      "               [--min-angle DEG] [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F]\n"
+      "               [--msh F] [--svg F [--svg-point-radius PX] [--svg-max-points N]] [--check]\n"
+      "               [--stats] [--force]\n\n" +
+      memory_note(cost_text("quadtree mesh", kQuadtreeMeshCost, "with --check")));
 
   StabilityOptions s;
   CLI::App* stability = app.add_subcommand(
@@ -110,6 +168,16 @@ int main(int argc, char** argv) {
       "--min-angle", s.min_angle, "with a mesh: the smallest angle checked on the final mesh (quadtree: <= 18.4)");
   stability->add_option("--csv", s.csv, "output CSV (appended to; header written when new or empty)")->required();
   stability->add_option("--plot", s.plot, "also plot every row of the CSV with gnuplot (SVG)");
+  stability->add_flag("--force", s.force, force_help);
+  stability->footer(
+      "\nSynopsis (shared/FORMATS.md):\n"
+      "  dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]\n"
+      "                    [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv\n"
+      "                    [--plot OUT.svg] [--force]\n\n" +
+      memory_note(cost_text("quadtree (2D)", kQuadtree2dCost, "for the final check") + "; " +
+                  cost_text("octree (3D)", kOctree3dCost, "for the final check") + "; " +
+                  cost_text("quadtree mesh", kQuadtreeMeshCost, "for the final check") +
+                  "; the structure holds at most N + U/2 points"));
 
   DemoOptions m;
   CLI::App* demo = app.add_subcommand(

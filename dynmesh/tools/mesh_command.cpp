@@ -4,7 +4,9 @@
 // documented default) is refused with a clear message. Every error names the file and line it
 // comes from, as `dynmesh quadtree` does; every output is written aside and renamed into place
 // only after all of them were written (atomic_file.hpp), so a failed run leaves old files
-// untouched.
+// untouched. Before anything is read, the memory guard (memory_guard.hpp) refuses a mesh that
+// cannot fit in memory, unless --force; the long phases (reading, building, --check) show
+// their elapsed time on stderr (progress.hpp).
 // Complexity: construction O(n lg n + |T'|) expected, then O(lg L/s) expected trace distance
 // per edit (DynamicMesh); the outputs are linear in the mesh (the SVG O(t log t)); --check
 // adds a from-scratch QuadtreeMesh and check_mesh, O((t + n) log t).
@@ -33,6 +35,8 @@
 #include "dynmesh/mesh_check.hpp"
 #include "dynmesh/mesh_io.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
+#include "dynmesh/svg.hpp"
+#include "memory_guard.hpp"
 #include "progress.hpp"
 #include "verify.hpp"
 
@@ -59,23 +63,34 @@ std::vector<Point<2>> current_points(const DynamicMesh& mesh) {
 int run_mesh(const MeshCommandOptions& o) {
   check_mesh_options(o);
   const double bound = o.min_angle_given ? o.min_angle : kQuadtreeMinAngle;
+  if (!o.force) {
+    const std::uint64_t points = points_held(o.points, o.edits);
+    guard_memory("building the quadtree mesh of " + std::to_string(points) + " points" +
+                     (o.check ? " with --check" : ""),
+                 estimated_bytes(kQuadtreeMeshCost, points, o.check));
+  }
 
+  std::optional<Phase> reading(std::in_place, "reading " + o.points);
   const InitialPoints<2> initial = read_initial_points<2>(o.points, o.box, o.skip_duplicates);
   const PointFile<2>& file = initial.file;
   const Box<2>& box = initial.box;
   // Read the whole script before meshing, so a malformed script fails fast.
   const EditScript<2> script = o.edits.empty() ? EditScript<2>{} : read_edits_file<2>(o.edits);
   const std::vector<Edit<2>>& edits = script.edits;
+  reading.reset();
 
   MeshOptions mesh_options;
   mesh_options.postprocess = Postprocess::Quadtree;
   std::optional<DynamicMesh> built;
-  try {
-    built.emplace(box, std::span<const Point<2>>(file.points), mesh_options);
-  } catch (const InputError& e) {
-    // The mesh resolves points only down to its level R (none below 2: the box is unusable).
-    const int level = dynmesh::detail::MeshGrid::resolution_level(box);
-    rethrow_construction_error<2>(e, initial, level >= 2 ? level : -1);
+  {
+    const Phase building("building the quadtree mesh of " + std::to_string(file.points.size()) + " points");
+    try {
+      built.emplace(box, std::span<const Point<2>>(file.points), mesh_options);
+    } catch (const InputError& e) {
+      // The mesh resolves points only down to its level R (none below 2: the box is unusable).
+      const int level = dynmesh::detail::MeshGrid::resolution_level(box);
+      rethrow_construction_error<2>(e, initial, level >= 2 ? level : -1);
+    }
   }
   DynamicMesh& dm = *built;
 
@@ -128,7 +143,12 @@ int run_mesh(const MeshCommandOptions& o) {
 
   if (o.check) {
     // Everything is checked before any output is written: a failed check leaves old files.
-    const Verification v = verify(dm, bound);
+    Verification v;
+    {
+      const Phase checking("checking against a from-scratch mesh of the " + std::to_string(inputs.size()) +
+                           " final points");
+      v = verify(dm, bound);
+    }
     if (!v.ok) throw InvariantError("--check failed: " + v.problem);
   }
 
@@ -138,7 +158,17 @@ int run_mesh(const MeshCommandOptions& o) {
   if (want_feed) out.add(o.feed, feed);
   if (!o.vtk.empty()) out.add(o.vtk, format_vtk(mesh));
   if (!o.msh.empty()) out.add(o.msh, format_msh(mesh));
-  if (!o.svg.empty()) out.add(o.svg, format_svg(mesh, box, inputs));
+  if (!o.svg.empty()) {
+    // Dots shrink with density as in the quadtree's picture (svg.hpp), from the mesh's own
+    // default radius down.
+    SvgMeshOptions svg_options;
+    const double largest_px = svg_options.point_radius_px;
+    svg_options.point_radius_px = o.svg_point_radius > 0
+                                      ? o.svg_point_radius
+                                      : default_point_radius_px(inputs.size(), svg_options.width_px, largest_px);
+    svg_options.max_marked_inputs = o.svg_max_points;
+    out.add(o.svg, format_svg(mesh, box, inputs, svg_options));
+  }
   out.commit();
 
   // After the outputs are in place, so that a failed run prints only its error line.

@@ -1,22 +1,54 @@
-// dynmesh/tools/progress.hpp — a progress line on stderr for long runs.
+// dynmesh/tools/progress.hpp — progress lines on stderr for long runs.
 //
-// Purpose: `[dynmesh] 1234/10000 updates`, rewritten in place with '\r'. Silent for the
-// first second (short runs print nothing), then refreshed at most five times a second;
-// finish() (or the destructor) ends the line with a newline if anything was printed. It goes to stderr whether
-// or not stderr is a terminal (a log file gets the '\r'-separated updates).
-// Invariants: nothing is printed before one second has elapsed since construction.
-// Complexity: tick() is one clock read and a comparison, O(1).
+// Purpose: two kinds of line, both rewritten in place with '\r' and both silent for the first
+// second (progress_delay()), so that short runs print nothing:
+//   * Progress: `[dynmesh] 1234/10000 updates`, for loops that can count their steps (edits,
+//     updates). tick() refreshes it at most five times a second; finish() (or the destructor)
+//     ends the line with a newline if anything was printed.
+//   * Phase: `[dynmesh] building the quadtree of 2000000 points: 12 s`, for one long library
+//     call that cannot report its own progress (a from-scratch build, the --check rebuild).
+//     A background thread refreshes the elapsed time once a second; the destructor stops and
+//     joins it, then ends the line: `...: done in 12.4 s` (or `...: stopped after 12.4 s` when
+//     unwinding from an error).
+// Both go to stderr whether or not it is a terminal (a log file gets the '\r'-separated
+// updates); stdout is never touched.
+// DYNMESH_PROGRESS_DELAY_MS (milliseconds, default 1000) overrides the one-second delay; the
+// command-line tests set it to 0 to see the lines on small inputs.
+// Invariants: nothing is printed before the delay has elapsed since construction. A Phase
+// that lasts at least the delay always ends with its final line (printed by the destructor
+// even if the thread never got to run), and its thread has ended when the destructor returns.
+// Complexity: Progress::tick() is one clock read and a comparison, O(1); a Phase costs one
+// thread that sleeps on a condition variable and wakes once a second.
 // Paper: none.
 #pragma once
 
 #include <chrono>
+#include <condition_variable>
 #include <cstddef>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <mutex>
 #include <string>
+#include <system_error>
+#include <thread>
 #include <utility>
 
 namespace dynmesh::tool {
+
+/// How long a run stays silent before its progress line appears: one second, or
+/// DYNMESH_PROGRESS_DELAY_MS milliseconds when that is set to a whole number (tests).
+inline std::chrono::milliseconds progress_delay() {
+  static const std::chrono::milliseconds delay = [] {
+    const char* text = std::getenv("DYNMESH_PROGRESS_DELAY_MS");
+    if (text == nullptr || *text == '\0') return std::chrono::milliseconds(1000);
+    char* end = nullptr;
+    const long long ms = std::strtoll(text, &end, 10);
+    if (*end != '\0' || ms < 0) return std::chrono::milliseconds(1000);
+    return std::chrono::milliseconds(ms);
+  }();
+  return delay;
+}
 
 class Progress {
  public:
@@ -32,7 +64,7 @@ class Progress {
 
   void tick(std::size_t done) {
     const auto now = Clock::now();
-    if (now - start_ < std::chrono::seconds(1)) return;
+    if (now - start_ < delay_) return;
     if (printed_ && now - last_ < std::chrono::milliseconds(200)) return;
     last_ = now;
     printed_ = true;
@@ -60,8 +92,66 @@ class Progress {
   std::string what_;
   std::size_t total_;
   Clock::time_point start_, last_;
+  std::chrono::milliseconds delay_ = progress_delay();
   bool printed_ = false;
   int exceptions_ = std::uncaught_exceptions();
+};
+
+/// The elapsed time of one long call, shown while it runs: construct before the call, let it
+/// go out of scope after. `what` names the phase ("building the quadtree of 2000000 points").
+class Phase {
+ public:
+  explicit Phase(std::string what) : what_(std::move(what)), start_(Clock::now()) {
+    try {
+      thread_ = std::thread([this] { run(); });
+    } catch (const std::system_error&) {
+      // No thread (a tight ulimit -v, say): the phase runs without a live line; the
+      // destructor still prints the final one.
+    }
+  }
+  Phase(const Phase&) = delete;
+  Phase& operator=(const Phase&) = delete;
+
+  ~Phase() {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+    }
+    wake_.notify_one();
+    if (thread_.joinable()) thread_.join();
+    // After the join only this thread prints: the final line, if the phase lasted the delay.
+    const Clock::duration elapsed = Clock::now() - start_;
+    if (elapsed < delay_) return;
+    const bool failed = std::uncaught_exceptions() > exceptions_;
+    std::fprintf(stderr, "\r[dynmesh] %s: %s %.1f s\n", what_.c_str(), failed ? "stopped after" : "done in",
+                 std::chrono::duration<double>(elapsed).count());
+    std::fflush(stderr);
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+
+  // The thread: wait out the delay, then print the whole seconds elapsed once a second, until
+  // the destructor says stop. It allocates nothing (fprintf to unbuffered stderr).
+  void run() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    Clock::time_point next = start_ + delay_;
+    while (!wake_.wait_until(lock, next, [this] { return stopping_; })) {
+      const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(Clock::now() - start_).count();
+      std::fprintf(stderr, "\r[dynmesh] %s: %lld s", what_.c_str(), static_cast<long long>(seconds));
+      std::fflush(stderr);
+      next += std::chrono::seconds(1);
+    }
+  }
+
+  std::string what_;
+  Clock::time_point start_;
+  std::chrono::milliseconds delay_ = progress_delay();
+  int exceptions_ = std::uncaught_exceptions();
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;  // guarded by mutex_
+  std::thread thread_;     // last: started once every other member is ready
 };
 
 }  // namespace dynmesh::tool

@@ -6,6 +6,9 @@
 // shared with `dynmesh mesh`. As there, --check runs before anything is written, and the
 // outputs (.cells, --svg) are written aside and renamed into place together
 // (atomic_file.hpp), so a failed run leaves the files of an earlier run as they were.
+// Before anything is read, the memory guard (memory_guard.hpp) compares the build's estimated
+// peak with the memory available and refuses a build that cannot fit, unless --force; the
+// long phases (reading, building, --check) show their elapsed time on stderr (progress.hpp).
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -26,6 +29,7 @@
 #include "dynmesh/errors.hpp"
 #include "dynmesh/io.hpp"
 #include "dynmesh/svg.hpp"
+#include "memory_guard.hpp"
 #include "progress.hpp"
 #include "verify.hpp"
 
@@ -34,24 +38,33 @@ namespace {
 
 using Kind = InputError::Kind;
 
+// What the tree is called in messages: T* is a quadtree in 2D and an octree in 3D.
+const char* tree_name(int dim) { return dim == 3 ? "octree" : "quadtree"; }
+
 template <std::size_t d>
 int run(const QuadtreeOptions& o) {
   if (d != 2 && !o.svg.empty())
     throw InputError(Kind::Malformed, "--svg draws 2D trees only; " + o.points + " holds " + std::to_string(d) +
                                           "D points");
 
+  std::optional<Phase> reading(std::in_place, "reading " + o.points);
   const InitialPoints<d> initial = read_initial_points<d>(o.points, o.box, o.skip_duplicates);
   const PointFile<d>& file = initial.file;
   const Box<d>& box = initial.box;
   // Read the whole script before building, so a malformed script fails fast.
   const EditScript<d> script = o.edits.empty() ? EditScript<d>{} : read_edits_file<d>(o.edits);
   const std::vector<Edit<d>>& edits = script.edits;
+  reading.reset();
 
   std::optional<DynamicQuadtree<d>> built;
-  try {
-    built.emplace(box, std::span<const Point<d>>(file.points));
-  } catch (const InputError& e) {
-    rethrow_construction_error<d>(e, initial);
+  {
+    const Phase building(std::string("building the ") + tree_name(d) + " of " + std::to_string(file.points.size()) +
+                         " points");
+    try {
+      built.emplace(box, std::span<const Point<d>>(file.points));
+    } catch (const InputError& e) {
+      rethrow_construction_error<d>(e, initial);
+    }
   }
   DynamicQuadtree<d>& tree = *built;
 
@@ -87,7 +100,12 @@ int run(const QuadtreeOptions& o) {
   }
 
   if (o.check) {
-    const Verification v = verify<d>(tree);
+    Verification v;
+    {
+      const Phase checking("checking against a from-scratch build of the " + std::to_string(tree.size()) +
+                           " final points");
+      v = verify<d>(tree);
+    }
     if (!v.ok) throw InvariantError("--check failed: " + v.problem);
   }
   const std::vector<Leaf<d>> leaves = tree.leaves();
@@ -97,8 +115,11 @@ int run(const QuadtreeOptions& o) {
     if (!o.svg.empty()) {
       std::vector<Point<2>> pts;
       for (const auto& entry : tree.points()) pts.push_back(entry.second);
+      SvgOptions svg_options;
+      svg_options.point_radius_px = o.svg_point_radius;
+      svg_options.max_points = o.svg_max_points;
       std::ostringstream svg;
-      write_svg(svg, box, leaves, pts);
+      write_svg(svg, box, leaves, pts, svg_options);
       out.add(o.svg, svg.str());
     }
   }
@@ -113,7 +134,14 @@ int run_quadtree(const QuadtreeOptions& o) {
   int dim = o.dim;
   // A `.node` header announces its dimension; without --dim it decides, with --dim the two
   // must agree (read_node reports a mismatch, naming the header line).
-  if (!o.dim_given && format_for_path(o.points) == PointFormat::Node) dim = node_file_dimension(o.points) == 3 ? 3 : 2;
+  const bool node = format_for_path(o.points) == PointFormat::Node;
+  if (!o.dim_given && node) dim = node_file_dimension(o.points) == 3 ? 3 : 2;
+  if (!o.force) {
+    const std::uint64_t points = points_held(o.points, o.edits);
+    guard_memory(std::string("building the ") + tree_name(dim) + " of " + std::to_string(points) + " points" +
+                     (o.check ? " with --check" : ""),
+                 estimated_bytes(dim == 3 ? kOctree3dCost : kQuadtree2dCost, points, o.check));
+  }
   return dim == 3 ? run<3>(o) : run<2>(o);
 }
 

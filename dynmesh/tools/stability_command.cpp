@@ -10,6 +10,11 @@
 // a sample of the distribution and the rest are fresh points of the same distribution,
 // distinct from them. log2_spread is exact for every row (UpdateDriver keeps the closest-pair
 // distance up to date; see update_driver.hpp).
+//
+// Before generating anything, the memory guard (memory_guard.hpp) refuses a run whose
+// structure (N points and the U/2 insertions, plus the final from-scratch check) cannot fit in
+// memory, unless --force; the build and the final check show their elapsed time on stderr
+// (progress.hpp).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -28,6 +33,7 @@
 #include "dynmesh/dynamic_mesh.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/errors.hpp"
+#include "memory_guard.hpp"
 #include "postprocess_option.hpp"
 #include "progress.hpp"
 #include "update_driver.hpp"
@@ -89,14 +95,26 @@ Verification verify_final(const DynamicQuadtree<d>& tree, double) {
 }
 inline Verification verify_final(const DynamicMesh& mesh, double min_angle) { return verify(mesh, min_angle); }
 
+// `what` names the structure on stdout ("quadtree", "quadtree mesh"); `cost` is its memory.
 template <std::size_t d, class Structure>
-int run(const StabilityOptions& o, Distribution dist, const char* what) {
+int run(const StabilityOptions& o, Distribution dist, const char* what, const MemoryCost& cost) {
+  // On stderr, a 3D tree is called what it is.
+  const char* structure_name = d == 3 ? "octree" : what;
+  if (!o.force) {
+    // Deletions and insertions alternate, so the structure never holds more than N + ⌈U/2⌉.
+    const std::uint64_t points = std::uint64_t{o.n} + (std::uint64_t{o.updates} + 1) / 2;
+    guard_memory(std::string("building the ") + structure_name + " of " + std::to_string(points) + " points",
+                 estimated_bytes(cost, points, /*check=*/true));
+  }
+  std::optional<Phase> building(std::in_place, std::string("building the ") + structure_name + " of " +
+                                                   std::to_string(o.n) + " points");
   std::vector<Point<d>> all = generate<d>(dist, o.n + o.updates, o.seed, o.spread);
   std::vector<Point<d>> pool(all.begin() + static_cast<std::ptrdiff_t>(o.n), all.end());
   all.resize(o.n);
   const Box<d> box = derive_box<d>(all);
   Structure structure = build(box, std::span<const Point<d>>(all), static_cast<const Structure*>(nullptr));
   UpdateDriver<d, Structure> driver(structure, std::move(pool), o.seed);
+  building.reset();
   const double initial_spread = driver.log2_spread();
   const std::string prefix =
       std::string(distribution_name(dist)) + ',' + std::to_string(d) + ',' + std::to_string(o.n) + ',';
@@ -120,7 +138,12 @@ int run(const StabilityOptions& o, Distribution dist, const char* what) {
 
   // History independence on every run: the updated structure must equal a from-scratch build
   // on the final points (the rows are written first, so a failure keeps them for inspection).
-  const Verification v = verify_final(structure, o.min_angle_given ? o.min_angle : kQuadtreeMinAngle);
+  Verification v;
+  {
+    const Phase checking("checking against a from-scratch build of the " + std::to_string(structure.size()) +
+                         " final points");
+    v = verify_final(structure, o.min_angle_given ? o.min_angle : kQuadtreeMinAngle);
+  }
   if (!v.ok) throw InvariantError("verification failed after the updates: " + v.problem);
 
   std::printf("stability: %s, %s %zuD, n = %zu, log2(L/s) = %.2f, %zu updates, mean trace distance %.1f, "
@@ -147,9 +170,10 @@ int run_stability(const StabilityOptions& o) {
   const PostprocessChoice choice = check_postprocess(
       o.postprocess, /*allow_none=*/true, o.min_angle_given ? std::optional<double>(o.min_angle) : std::nullopt);
   if (choice == PostprocessChoice::None)
-    return o.dim == 3 ? run<3, DynamicQuadtree<3>>(o, *dist, "quadtree") : run<2, DynamicQuadtree<2>>(o, *dist, "quadtree");
+    return o.dim == 3 ? run<3, DynamicQuadtree<3>>(o, *dist, "quadtree", kOctree3dCost)
+                      : run<2, DynamicQuadtree<2>>(o, *dist, "quadtree", kQuadtree2dCost);
   if (o.dim != 2) throw InputError(Kind::Malformed, "--postprocess " + o.postprocess + " meshes in 2D only (--dim 2)");
-  return run<2, DynamicMesh>(o, *dist, "quadtree mesh");
+  return run<2, DynamicMesh>(o, *dist, "quadtree mesh", kQuadtreeMeshCost);
 }
 
 }  // namespace dynmesh::tool

@@ -461,10 +461,129 @@ GNUPLOT
     dev fuzz 7
     grep -q '^cmake -S .* -B build/fuzz .*-DCMAKE_CXX_COMPILER=clang++ .*-DDYNMESH_FUZZ=ON -DDYNMESH_FUZZ_SECONDS=7 ' \
       calls.log || fail "fuzz: configure: $(cat calls.log)"
-    grep -qx 'cmake --build build/fuzz -j 1 --target fuzz_point_readers fuzz_edit_reader fuzz_dynamic_quadtree fuzz_dynamic_mesh' \
+    grep -qx 'cmake --build build/fuzz -j 1 --target fuzz_point_readers fuzz_edit_reader fuzz_dynamic_quadtree fuzz_dynamic_mesh fuzz_hpu_mesh' \
       calls.log || fail "fuzz builds more or less than the fuzz targets: $(cat calls.log)"
     grep -q "^ctest --test-dir build/fuzz -L ^fuzz\$ " calls.log || fail "fuzz runs no ctest: $(cat calls.log)"
     PATH="$PWD/fake:$PATH" bash stub/dev.sh fuzz 1.5 >out.txt 2>err.txt && fail "fuzz accepted 1.5 seconds"
+    ;;
+
+  progress) # phases of over the delay (1 s; DYNMESH_PROGRESS_DELAY_MS here) show on stderr alone
+    # Delay 0: every phase ends with its line, deterministically; stdout is as without it.
+    export DYNMESH_PROGRESS_DELAY_MS=0
+    run "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits2d.txt" --cells p.cells --check
+    cp out.txt progress_out.txt
+    for line in "reading $data/points2d.node: done in " 'building the quadtree of 50 points: done in ' \
+      'checking against a from-scratch build of the 43 final points: done in '; do
+      grep -qF "[dynmesh] $line" err.txt || fail "quadtree: no '$line' on stderr: $(tr '\r' '|' <err.txt)"
+    done
+    run "$dynmesh" quadtree "$data/points3d.node" --cells p3.cells
+    grep -qF '[dynmesh] building the octree of ' err.txt || fail "3D: no octree line: $(tr '\r' '|' <err.txt)"
+    run "$dynmesh" mesh "$data/points2d.node" --postprocess quadtree -o p --check
+    for line in 'building the quadtree mesh of 50 points: done in ' \
+      'checking against a from-scratch mesh of the 50 final points: done in '; do
+      grep -qF "[dynmesh] $line" err.txt || fail "mesh: no '$line' on stderr: $(tr '\r' '|' <err.txt)"
+    done
+    run "$dynmesh" stability --dim 2 --dist uniform --n 300 --updates 10 --csv p.csv
+    grep -qF '[dynmesh] building the quadtree of 300 points: done in ' err.txt || fail "stability: no build line"
+    grep -qF '[dynmesh] checking against a from-scratch build of the 300 final points: done in ' err.txt ||
+      fail "stability: no check line: $(tr '\r' '|' <err.txt)"
+    # A failed phase says so, and the error stays the last line.
+    "$dynmesh" quadtree "$data/bad_number.txt" --cells e.cells >out.txt 2>err.txt && fail "bad_number.txt accepted"
+    grep -qF "[dynmesh] reading $data/bad_number.txt: stopped after " err.txt || fail "no stopped line"
+    tail -1 err.txt | grep -q '^dynmesh: .*bad_number.txt:3: ' || fail "the error is not last: $(cat err.txt)"
+    # The default delay: these runs take well under a second, so stderr stays empty.
+    unset DYNMESH_PROGRESS_DELAY_MS
+    run "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits2d.txt" --cells q.cells --check
+    [[ ! -s err.txt ]] || fail "a short run printed progress: $(tr '\r' '|' <err.txt)"
+    cmp out.txt progress_out.txt || fail "the progress lines changed stdout"
+    cmp p.cells q.cells || fail "the progress lines changed the output"
+    # The live line, printed by the background thread while a build runs longer than the delay
+    # (10000 points: 0.5-1 s here, far more than 100 ms), then the final line.
+    DYNMESH_PROGRESS_DELAY_MS=100 run "$dynmesh" stability --dim 2 --dist uniform --n 10000 --updates 2 --csv live.csv
+    grep -qF $'\r[dynmesh] building the quadtree of 10000 points: 0 s' err.txt ||
+      fail "no live line during the build: $(tr '\r' '|' <err.txt)"
+    grep -qF $'\r[dynmesh] building the quadtree of 10000 points: done in ' err.txt || fail "no final line"
+    ;;
+
+  memory_guard) # a build that cannot fit in memory stops at once, before reading; --force goes on
+    awk 'BEGIN { for (i = 1; i <= 1000; i++) printf "%d %d\n", i, (i * 7919) % 1009 }' >p.txt
+    awk 'BEGIN { for (i = 1; i <= 10; i++) printf "+ %d.5 3.5\n", i }' >e.txt
+    { cat p.txt; echo 'x 1'; } >bad.txt # malformed on line 1001: reading it is an error
+    # Unlimited (this machine has the 51 MiB it needs), --force is accepted and changes nothing.
+    run "$dynmesh" quadtree p.txt --edits e.txt --cells plain.cells
+    run "$dynmesh" quadtree p.txt --edits e.txt --cells forced.cells --force
+    cmp plain.cells forced.cells || fail "--force changed the tree"
+    # Under ulimit -v: 1010 points (1000 and 10 inserted) need about 32 MiB + 1010 * 20000 bytes.
+    # A sanitizer build reserves terabytes of address space and cannot run under any such limit.
+    limit_kib=48000
+    if (ulimit -v $limit_kib && "$dynmesh" --help) >/dev/null 2>&1; then
+      limited() (ulimit -v $limit_kib && "$@")
+      expect_error 1 'building the quadtree of 1010 points needs about 51.3 MiB, but only ' \
+        limited "$dynmesh" quadtree p.txt --edits e.txt --cells e.cells
+      grep -qF 'MiB are available (under the address-space limit, ulimit -v); pass --force to try anyway' err.txt ||
+        fail "unclear message: $(cat err.txt)"
+      expect_error 1 'building the quadtree mesh of 1000 points with --check needs about 133 MiB' \
+        limited "$dynmesh" mesh p.txt --postprocess quadtree -o e --check
+      # Before reading: the malformed line is not reached.
+      expect_error 1 'building the quadtree of 1001 points needs about' limited "$dynmesh" quadtree bad.txt \
+        --cells e.cells
+      # --force skips the guard: reading reports the malformed line, a good file reaches the build.
+      expect_error 1 'bad.txt:1001: ' limited "$dynmesh" quadtree bad.txt --cells e.cells --force
+      DYNMESH_PROGRESS_DELAY_MS=0 limited "$dynmesh" quadtree p.txt --edits e.txt --cells forced.cells --force \
+        >out.txt 2>err.txt
+      grep -qF '[dynmesh] building the quadtree of 1000 points: ' err.txt ||
+        fail "--force did not reach the build: $(tr '\r' '|' <err.txt)"
+      ! grep -q 'pass --force' err.txt || fail "--force did not skip the guard: $(cat err.txt)"
+      [[ ! -e e.cells && ! -e e.node ]] || fail "a refused run wrote its output file"
+    else
+      echo "the program cannot run under ulimit -v $limit_kib (a sanitizer build?): the limit is not tested"
+    fi
+    # MemAvailable: no machine has the 22 TiB of 10^9 points; refused before generating any.
+    expect_error 1 'building the quadtree of 1000000000 points needs about 22.3 TiB, but only ' \
+      "$dynmesh" stability --dim 2 --dist uniform --n 1000000000 --updates 0 --csv e.csv
+    expect_error 1 'building the octree of 1000000001 points needs about ' \
+      "$dynmesh" stability --dim 3 --dist uniform --n 1000000000 --updates 2 --csv e.csv
+    [[ ! -e e.csv ]] || fail "a refused stability run wrote its CSV"
+    ;;
+
+  svg_options) # --svg-point-radius and --svg-max-points; dots shrink with density by default
+    # radius_of SVG: the distinct r="..." values of the dots.
+    radius_of() { grep -o '<circle [^>]* r="[^"]*"' "$1" | sed 's/.* r="//; s/"$//' | sort -u | tr '\n' ' '; }
+    final=$(grep -vc '^#' "$data/final2d.txt") # 43 points after the edits
+    qt() { run "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits2d.txt" --cells s.cells "$@"; }
+    qt --svg default.svg
+    [[ $(radius_of default.svg) == '1 ' ]] || fail "few points: radius $(radius_of default.svg), expected 1"
+    qt --svg big.svg --svg-point-radius 2.5
+    [[ $(radius_of big.svg) == '2.5 ' ]] || fail "--svg-point-radius 2.5: radius $(radius_of big.svg)"
+    [[ $(grep -c '<circle' big.svg) -eq $final ]] || fail "--svg-point-radius changed the dots"
+    qt --svg at.svg --svg-max-points "$final"
+    [[ $(grep -c '<circle' at.svg) -eq $final ]] || fail "--svg-max-points $final: not every point drawn"
+    qt --svg over.svg --svg-max-points $((final - 1))
+    [[ $(grep -c '<circle' over.svg) -eq 0 ]] || fail "--svg-max-points $((final - 1)): points drawn"
+    grep -qF "$final points (not drawn: more than $((final - 1)))" over.svg || fail "the title does not say so"
+    cmp <(sed '/<title>/d; /<g fill="#c0392b">/,/<\/g>/d' default.svg) <(grep -v '<title>' over.svg) ||
+      fail "leaving the points out changed the rest of the picture"
+    # Density: 128^2 = 16384 points (under the default 20000) get 0.1 * 1000 / 128 = 0.78 px
+    # dots; one point fewer allowed than given, none.
+    awk 'BEGIN { for (i = 0; i < 128; i++) for (j = 0; j < 128; j++) printf "%d %d\n", i, j }' >grid.txt
+    run "$dynmesh" quadtree grid.txt --cells grid.cells --svg grid.svg
+    [[ $(grep -c '<circle' grid.svg) -eq 16384 && $(radius_of grid.svg) == '0.78 ' ]] ||
+      fail "16384 points: $(grep -c '<circle' grid.svg) dots of radius $(radius_of grid.svg)"
+    # The mesh: the same options (its own default radius, 1.5 px, on few points).
+    mesh() { run "$dynmesh" mesh "$data/points2d.node" --postprocess quadtree -o m "$@"; }
+    mesh --svg m.svg
+    [[ $(radius_of m.svg) == '1.5 ' ]] || fail "mesh: radius $(radius_of m.svg), expected 1.5"
+    mesh --svg m2.svg --svg-point-radius 0.6
+    [[ $(radius_of m2.svg) == '0.6 ' ]] || fail "mesh --svg-point-radius 0.6: radius $(radius_of m2.svg)"
+    mesh --svg m0.svg --svg-max-points 0
+    [[ $(grep -c '<circle' m0.svg) -eq 0 && $(grep -c '<circle' m.svg) -gt 0 ]] || fail "mesh --svg-max-points 0"
+    # The options need --svg and a sensible value.
+    expect_error 2 '--svg' "$dynmesh" quadtree "$data/points2d.node" --cells e.cells --svg-point-radius 2
+    expect_error 2 '--svg-point-radius' "$dynmesh" quadtree "$data/points2d.node" --cells e.cells --svg e.svg \
+      --svg-point-radius 0
+    expect_error 2 '--svg-max-points' "$dynmesh" mesh "$data/points2d.node" --postprocess quadtree -o e \
+      --svg e.svg --svg-max-points -1
+    [[ ! -e e.cells && ! -e e.svg ]] || fail "a refused run wrote its output file"
     ;;
 
   *)

@@ -235,8 +235,20 @@ TEST(HpuMesh, RejectsBadInput) {
     EXPECT_EQ(e.kind(), InputError::Kind::Resolution);
     EXPECT_EQ(e.point_indices(), (std::vector<std::size_t>{0, 2}));
   }
-  // Two grid units apart is fine.
-  const std::vector<Point<2>> apart = {{0.5, 0.5}, {0.5 + 0x1p-51, 0.5}};
+  // Found by fuzzing: a point a subnormal away from a side made the refinement grade over
+  // a thousand octaves towards the corner. As for the quadtree mesh, a point within L/2^R of
+  // a side it is not on is beyond the mesh's resolution (detail/quadtree_mesh_rules.hpp).
+  for (const Point<2>& p : {Point<2>{9.0908078834789364e-322, 0}, Point<2>{0.5, 1e-17}, Point<2>{1 - 0x1p-50, 0.5}}) {
+    const std::vector<Point<2>> near_side = {{0.25, 0.5}, p};
+    try {
+      HpuMesh(box, near_side);
+      ADD_FAILURE() << "a point near a side was accepted";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.kind(), InputError::Kind::Resolution) << e.what();
+    }
+  }
+  // Far enough apart is fine.
+  const std::vector<Point<2>> apart = {{0.5, 0.5}, {0.5 + 0x1p-44, 0.5}};
   EXPECT_NO_THROW(HpuMesh(box, apart, 30));
 }
 

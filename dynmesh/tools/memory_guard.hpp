@@ -1,0 +1,211 @@
+// dynmesh/tools/memory_guard.hpp — refuse a build that cannot fit in memory, before it starts.
+//
+// Purpose: a dynamic quadtree keeps its whole trace, some 15 KB per point in 2D, so a
+// few million points can exceed the machine; without a guard the run is killed by the OOM
+// killer (or fails with bad_alloc) minutes into the build. The commands estimate the peak
+// from the number of points the structure will hold (initial points plus those the edits
+// insert) and a measured cost per point, compare it with the memory available, and stop at
+// once with one line when it does not fit; `--force` skips the guard.
+//   * The point counts come from counting lines (points_held), a
+//     cheap scan that precedes the expensive parse; it may overcount (a malformed line is
+//     counted, the parser reports it later), never undercount a valid regular file (a pipe
+//     is not read ahead: it counts as empty).
+//   * Available memory is the least of MemAvailable (/proc/meminfo) and what remains under
+//     the finite soft limits RLIMIT_AS (`ulimit -v`, less the current VmSize) and RLIMIT_DATA
+//     (`ulimit -d`, less the current VmData). Control-group limits are not read.
+// Invariants: the guard throws only when the estimate exceeds a known available amount; when
+// nothing can be read (no /proc) it lets the run go on.
+// Complexity: O(bytes of the point and edit files) for the line counts; O(1) otherwise.
+// Paper: none.
+#pragma once
+
+#include <cinttypes>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <sys/resource.h>
+#include <sys/stat.h>
+
+#include "dynmesh/errors.hpp"
+#include "dynmesh/io.hpp"
+
+namespace dynmesh::tool {
+
+/// The peak resident memory of a build per point it holds, and what --check adds on top.
+struct MemoryCost {
+  std::uint64_t bytes_per_point;
+  std::uint64_t check_bytes_per_point;  // the from-scratch rebuild of --check (and stability)
+};
+
+// Measured on x86-64 (RelWithDebInfo -O2, glibc malloc) with uniform points written by
+// python3 (random.random(), %.17g): peak RSS ("Maximum resident set size" of /usr/bin/time -v)
+// at n = 10^5, less that of a 10-point run (7 MB, the program itself), over n; then about 30%
+// added, because the cost per point grows slowly with n (2D, 10^6 points: 15,248,256 KiB,
+// 15,607 B/point) and clustered points cost about 5% more than uniform ones (`stability
+// --dim 2 --n 100000 --updates 100`: 1,899,680 KiB for clusters, 1,803,396 KiB for uniform).
+// Under `ulimit -v` set to the estimate, the 10^5-point runs below complete.
+//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells          1,467,272 KiB: 14,954 B/point
+//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells --check  1,798,376 KiB: +3,390 B/point
+inline constexpr MemoryCost kQuadtree2dCost{20'000, 4'500};
+//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells          3,353,968 KiB: 34,271 B/point
+//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells --check  4,024,876 KiB: +6,869 B/point
+inline constexpr MemoryCost kOctree3dCost{44'000, 9'000};
+//   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o          7,050,276 KiB: 72,112 B/point
+//   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o --check  8,130,208 KiB: +11,057 B/point
+inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};
+// The program before any point: 7-8 MB resident, more address space (libraries, a thread stack).
+inline constexpr std::uint64_t kFixedBytes = std::uint64_t{32} << 20;
+
+/// The estimated peak of a build holding `points` points (saturating, never wraps).
+inline std::uint64_t estimated_bytes(const MemoryCost& cost, std::uint64_t points, bool check) {
+  const std::uint64_t per_point = cost.bytes_per_point + (check ? cost.check_bytes_per_point : 0);
+  const std::uint64_t max = std::numeric_limits<std::uint64_t>::max();
+  if (points > (max - kFixedBytes) / per_point) return max;
+  return kFixedBytes + points * per_point;
+}
+
+/// "27.1 GiB", "512 MiB", "3.0 KiB": three significant figures at most, binary units.
+inline std::string human_bytes(std::uint64_t bytes) {
+  static const char* const units[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+  double v = static_cast<double>(bytes);
+  std::size_t u = 0;
+  while (v >= 1024 && u + 1 < std::size(units)) {
+    v /= 1024;
+    ++u;
+  }
+  char buf[32];
+  if (u == 0)
+    std::snprintf(buf, sizeof buf, "%" PRIu64 " bytes", bytes);
+  else if (v < 100)
+    std::snprintf(buf, sizeof buf, "%.1f %s", v, units[u]);
+  else
+    std::snprintf(buf, sizeof buf, "%.0f %s", v, units[u]);
+  return buf;
+}
+
+struct AvailableMemory {
+  std::uint64_t bytes = 0;
+  std::string source;  // what limits it, for the message
+};
+
+namespace detail {
+
+// The value in kB of "<key>:" in a /proc file (/proc/meminfo, /proc/self/status), in bytes.
+inline std::optional<std::uint64_t> proc_kb(const char* path, const std::string& key) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.compare(0, key.size(), key) != 0 || line.size() <= key.size() || line[key.size()] != ':') continue;
+    unsigned long long kb = 0;
+    if (std::sscanf(line.c_str() + key.size() + 1, "%llu", &kb) != 1) return std::nullopt;
+    return static_cast<std::uint64_t>(kb) * 1024;
+  }
+  return std::nullopt;
+}
+
+// What remains under the soft limit `resource`, given `used` bytes already counted against
+// it; nullopt when the limit is infinite.
+inline std::optional<std::uint64_t> under_limit(int resource, std::optional<std::uint64_t> used) {
+  struct ::rlimit limit;
+  if (::getrlimit(resource, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY) return std::nullopt;
+  const auto cap = static_cast<std::uint64_t>(limit.rlim_cur);
+  const std::uint64_t in_use = used.value_or(0);
+  return cap > in_use ? cap - in_use : 0;
+}
+
+}  // namespace detail
+
+/// The memory a build may use now; nullopt when nothing is known (no /proc, no limits).
+inline std::optional<AvailableMemory> available_memory() {
+  std::optional<AvailableMemory> best;
+  auto consider = [&best](std::optional<std::uint64_t> bytes, const char* source) {
+    if (bytes && (!best || *bytes < best->bytes)) best = AvailableMemory{*bytes, source};
+  };
+  consider(detail::proc_kb("/proc/meminfo", "MemAvailable"), "MemAvailable in /proc/meminfo");
+  consider(detail::under_limit(RLIMIT_AS, detail::proc_kb("/proc/self/status", "VmSize")),
+           "under the address-space limit, ulimit -v");
+  consider(detail::under_limit(RLIMIT_DATA, detail::proc_kb("/proc/self/status", "VmData")),
+           "under the data-size limit, ulimit -d");
+  return best;
+}
+
+/// Throws Error "<what> needs about X, but only Y are available (...); pass --force to try
+/// anyway" when `estimate` exceeds the available memory. `what` names the build, e.g.
+/// "building the quadtree of 2000000 points".
+inline void guard_memory(const std::string& what, std::uint64_t estimate) {
+  const std::optional<AvailableMemory> available = available_memory();
+  if (!available || estimate <= available->bytes) return;
+  throw Error(what + " needs about " + human_bytes(estimate) + ", but only " + human_bytes(available->bytes) +
+              " are available (" + available->source + "); pass --force to try anyway");
+}
+
+namespace detail {
+
+// Calls on_line(first) for every line that is neither blank nor a '#' comment, with `first`
+// its first character after leading blanks (a UTF-8 byte order mark at the start is skipped).
+// A file that cannot be read counts nothing: its reader reports the error later. Nor does
+// anything but a regular file: a pipe (/dev/stdin, <(...)) read here would be empty for the
+// reader.
+template <class OnLine>
+void scan_data_lines(const std::string& path, OnLine on_line) {
+  struct ::stat st;
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return;
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) return;
+  std::vector<char> buf(std::size_t{1} << 20);
+  bool at_start = true;        // still in the leading blanks of a line
+  std::size_t bom_left = 3;    // bytes of a possible byte order mark still to match
+  static constexpr unsigned char kBom[3] = {0xef, 0xbb, 0xbf};
+  std::size_t got = 0;
+  while ((got = std::fread(buf.data(), 1, buf.size(), file)) > 0) {
+    for (std::size_t i = 0; i < got; ++i) {
+      const char c = buf[i];
+      if (bom_left > 0) {
+        if (static_cast<unsigned char>(c) == kBom[3 - bom_left]) {
+          --bom_left;
+          continue;
+        }
+        bom_left = 0;
+      }
+      if (c == '\n') {
+        at_start = true;
+      } else if (at_start && c != ' ' && c != '\t' && c != '\r') {
+        at_start = false;
+        if (c != '#') on_line(c);
+      }
+    }
+  }
+  std::fclose(file);
+}
+
+}  // namespace detail
+
+/// The number of points a point file holds, counted from its lines (a .node header excluded).
+inline std::uint64_t count_point_lines(const std::string& path, bool node_format) {
+  std::uint64_t lines = 0;
+  detail::scan_data_lines(path, [&lines](char) { ++lines; });
+  return node_format && lines > 0 ? lines - 1 : lines;
+}
+
+/// The number of insertions ('+' lines) of an edit script.
+inline std::uint64_t count_insert_lines(const std::string& path) {
+  std::uint64_t inserts = 0;
+  detail::scan_data_lines(path, [&inserts](char first) { inserts += first == '+'; });
+  return inserts;
+}
+
+/// The most points a structure built on `points_path` and edited by `edits_path` (empty: no
+/// edits) holds at once: the initial points and every point the edits insert.
+inline std::uint64_t points_held(const std::string& points_path, const std::string& edits_path) {
+  return count_point_lines(points_path, format_for_path(points_path) == PointFormat::Node) +
+         (edits_path.empty() ? 0 : count_insert_lines(edits_path));
+}
+
+}  // namespace dynmesh::tool
