@@ -109,9 +109,10 @@ int main(int argc, char** argv) {
           "--duplicates", [&me](const std::string& v) { me.skip_duplicates = v == "skip"; }, duplicates_help)
       ->check(CLI::IsMember({"error", "skip"}));
   mesh->add_option("--postprocess", me.postprocess,
-                   "hpu (the default; not available yet) or quadtree (the quadtree mesh, angles >= 18.4)");
+                   "hpu (the default: the off-center Delaunay mesh, from scratch; no --edits yet) or quadtree (the "
+                   "self-adjusting quadtree mesh, angles >= 18.4)");
   CLI::Option* min_angle_opt =
-      mesh->add_option("--min-angle", me.min_angle, "smallest angle in degrees (quadtree: at most 18.4)")
+      mesh->add_option("--min-angle", me.min_angle, "smallest angle in degrees (hpu: 1 to 30, default 20.7; quadtree: at most 18.4)")
           ->check(CLI::Range(0.0, 60.0));  // no triangle has a smallest angle above 60
   mesh->add_option("--edits", me.edits, "edit script: '+ x y' inserts, '- x y' deletes, one per line");
   mesh->add_option("--batch", me.batch, "propagate K consecutive edits together (default: each edit alone)")
@@ -162,7 +163,8 @@ int main(int argc, char** argv) {
       ->check(whole_number(0, kMaxCount));
   stability->add_option("--seed", s.seed, "random seed")->capture_default_str()->check(any_seed);
   stability->add_option("--postprocess", s.postprocess,
-                        "none (the default: the quadtree alone), quadtree (2D: the quadtree mesh too) or hpu; "
+                        "none (the default: the quadtree alone), quadtree (2D: the quadtree mesh too) or hpu (not "
+                        "available yet); "
                         "with a mesh, trace_distance and seconds count the whole update, tree and mesh");
   CLI::Option* stability_angle_opt = stability->add_option(
       "--min-angle", s.min_angle, "with a mesh: the smallest angle checked on the final mesh (quadtree: <= 18.4)");

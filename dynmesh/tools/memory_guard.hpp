@@ -60,6 +60,11 @@ inline constexpr MemoryCost kOctree3dCost{44'000, 9'000};
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o          7,050,276 KiB: 72,112 B/point
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o --check  8,130,208 KiB: +11,057 B/point
 inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};
+// The hpu mesh (HpuMesh, no trace) on unif1e5 (python3 random.Random(1)), at its largest,
+// 30 degrees (20.7 degrees: 62,984 KiB, 589 B/point; --check +252 B/point):
+//   /usr/bin/time -v dynmesh mesh unif1e5.txt -o o --min-angle 30          101,860 KiB: 987 B/point
+//   /usr/bin/time -v dynmesh mesh unif1e5.txt -o o --min-angle 30 --check  147,524 KiB: +468 B/point
+inline constexpr MemoryCost kHpuMeshCost{1'300, 650};
 // The program before any point: 7-8 MB resident, more address space (libraries, a thread stack).
 inline constexpr std::uint64_t kFixedBytes = std::uint64_t{32} << 20;
 

@@ -1,15 +1,18 @@
 // `dynmesh mesh` (2D): mesh a point file in its box, apply an edit script dynamically, write
 // the final mesh as .node/.ele (and optionally the change feed, VTK, MSH, SVG), shared/
-// FORMATS.md "dynmesh mesh (2D)". Only `--postprocess quadtree` exists so far; `hpu` (the
-// documented default) is refused with a clear message. Every error names the file and line it
+// FORMATS.md "dynmesh mesh (2D)". `--postprocess hpu` (the default) meshes the points from
+// scratch with HpuMesh, DynHPU's static twin; until the self-adjusting hpu mesh exists, it
+// refuses --edits with a clear message. `--postprocess quadtree` is the self-adjusting
+// quadtree mesh (DynamicMesh). Every error names the file and line it
 // comes from, as `dynmesh quadtree` does; every output is written aside and renamed into place
 // only after all of them were written (atomic_file.hpp), so a failed run leaves old files
 // untouched. Before anything is read, the memory guard (memory_guard.hpp) refuses a mesh that
 // cannot fit in memory, unless --force; the long phases (reading, building, --check) show
 // their elapsed time on stderr (progress.hpp).
 // Complexity: construction O(n lg n + |T'|) expected, then O(lg L/s) expected trace distance
-// per edit (DynamicMesh); the outputs are linear in the mesh (the SVG O(t log t)); --check
-// adds a from-scratch QuadtreeMesh and check_mesh, O((t + n) log t).
+// per edit (DynamicMesh); hpu O(n lg n + m) expected for m vertices; the outputs are linear
+// in the mesh (the SVG O(t log t)); --check adds a from-scratch mesh and check_mesh,
+// O((t + n) log t).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -30,6 +33,7 @@
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/dynamic_mesh.hpp"
 #include "dynmesh/errors.hpp"
+#include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/io.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/mesh_check.hpp"
@@ -46,10 +50,92 @@ namespace {
 using Kind = InputError::Kind;
 
 // The postprocess and angle options, checked before any file is read.
-void check_mesh_options(const MeshCommandOptions& o) {
-  check_postprocess(o.postprocess, /*allow_none=*/false,
-                    o.min_angle_given ? std::optional<double>(o.min_angle) : std::nullopt);
+PostprocessChoice check_mesh_options(const MeshCommandOptions& o) {
+  const PostprocessChoice choice =
+      check_postprocess(o.postprocess, /*allow_none=*/false,
+                        o.min_angle_given ? std::optional<double>(o.min_angle) : std::nullopt, /*static_hpu=*/true);
   if (o.outbase.empty()) throw InputError(Kind::Malformed, "-o needs a non-empty OUTBASE");
+  if (choice == PostprocessChoice::Hpu && !o.edits.empty())
+    throw InputError(Kind::Malformed,
+                     "--edits needs the self-adjusting mesh, which hpu does not have yet: pass --postprocess quadtree "
+                     "to apply edits (hpu meshes the points of POINTS from scratch)");
+  return choice;
+}
+
+/// Writes the outputs aside and renames them into place together (atomic_file.hpp); then
+/// the duplicate count and --stats. `feed` is empty unless --feed was given.
+void write_outputs(const MeshCommandOptions& o, const Mesh& mesh, const Box<2>& box, std::span<const Point<2>> inputs,
+                   const std::string& feed, std::size_t duplicates_skipped) {
+  AtomicOutputs out;
+  out.add(o.outbase + ".node", format_node(mesh, box));
+  out.add(o.outbase + ".ele", format_ele(mesh));
+  if (!o.feed.empty()) out.add(o.feed, feed);
+  if (!o.vtk.empty()) out.add(o.vtk, format_vtk(mesh));
+  if (!o.msh.empty()) out.add(o.msh, format_msh(mesh));
+  if (!o.svg.empty()) {
+    // Dots shrink with density as in the quadtree's picture (svg.hpp), from the mesh's own
+    // default radius down.
+    SvgMeshOptions svg_options;
+    const double largest_px = svg_options.point_radius_px;
+    svg_options.point_radius_px = o.svg_point_radius > 0
+                                      ? o.svg_point_radius
+                                      : default_point_radius_px(inputs.size(), svg_options.width_px, largest_px);
+    svg_options.max_marked_inputs = o.svg_max_points;
+    out.add(o.svg, format_svg(mesh, box, inputs, svg_options));
+  }
+  out.commit();
+
+  // After the outputs are in place, so that a failed run prints only its error line.
+  if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", duplicates_skipped);
+  if (o.stats) {
+    const std::string report = format_stats(mesh_stats(mesh));
+    std::fflush(stdout);
+    std::fputs(report.c_str(), stderr);
+    std::fflush(stderr);
+  }
+}
+
+/// --postprocess hpu: HpuMesh of the points, from scratch. --check meshes the points again in
+/// reverse order (the mesh is a function of the point set) and checks the contract: Delaunay,
+/// every angle at least the bound, tiling, every point a vertex.
+int run_hpu_mesh(const MeshCommandOptions& o) {
+  const double bound = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle;
+  if (!o.force) {
+    const std::uint64_t points = points_held(o.points, o.edits);
+    guard_memory("building the hpu mesh of " + std::to_string(points) + " points" + (o.check ? " with --check" : ""),
+                 estimated_bytes(kHpuMeshCost, points, o.check));
+  }
+  std::optional<Phase> reading(std::in_place, "reading " + o.points);
+  const InitialPoints<2> initial = read_initial_points<2>(o.points, o.box, o.skip_duplicates);
+  const std::vector<Point<2>>& points = initial.file.points;
+  const Box<2>& box = initial.box;
+  reading.reset();
+
+  std::optional<HpuMesh> built;
+  {
+    const Phase building("building the hpu mesh of " + std::to_string(points.size()) + " points");
+    try {
+      built.emplace(box, std::span<const Point<2>>(points), bound);
+    } catch (const InputError& e) {
+      const int level = dynmesh::detail::MeshGrid::resolution_level(box);
+      rethrow_construction_error<2>(e, initial, level >= 2 ? level : -1);
+    }
+  }
+  const Mesh mesh = built->mesh();
+  if (o.check) {
+    const Phase checking("checking against a from-scratch mesh of the " + std::to_string(points.size()) +
+                         " points in reverse order");
+    const std::vector<Point<2>> reversed(points.rbegin(), points.rend());
+    if (HpuMesh(box, reversed, bound).mesh() != mesh)
+      throw InvariantError("--check failed: meshing the points in reverse order gives another mesh");
+    MeshCheckOptions options;
+    options.min_angle_deg = bound;
+    options.delaunay = true;
+    const MeshReport report = check_mesh(mesh, box, points, options);
+    if (!report.ok()) throw InvariantError("--check failed: " + report.summary());
+  }
+  write_outputs(o, mesh, box, points, o.feed.empty() ? std::string() : feed_header(), initial.duplicates_skipped);
+  return 0;
 }
 
 std::vector<Point<2>> current_points(const DynamicMesh& mesh) {
@@ -61,7 +147,7 @@ std::vector<Point<2>> current_points(const DynamicMesh& mesh) {
 }  // namespace
 
 int run_mesh(const MeshCommandOptions& o) {
-  check_mesh_options(o);
+  if (check_mesh_options(o) == PostprocessChoice::Hpu) return run_hpu_mesh(o);
   const double bound = o.min_angle_given ? o.min_angle : kQuadtreeMinAngle;
   if (!o.force) {
     const std::uint64_t points = points_held(o.points, o.edits);
@@ -137,8 +223,6 @@ int run_mesh(const MeshCommandOptions& o) {
   }
 
   const Mesh mesh = dm.mesh();
-  const std::string node_text = format_node(mesh, box);
-  const std::string ele_text = format_ele(mesh);
   const std::vector<Point<2>> inputs = current_points(dm);
 
   if (o.check) {
@@ -152,33 +236,7 @@ int run_mesh(const MeshCommandOptions& o) {
     if (!v.ok) throw InvariantError("--check failed: " + v.problem);
   }
 
-  AtomicOutputs out;
-  out.add(o.outbase + ".node", node_text);
-  out.add(o.outbase + ".ele", ele_text);
-  if (want_feed) out.add(o.feed, feed);
-  if (!o.vtk.empty()) out.add(o.vtk, format_vtk(mesh));
-  if (!o.msh.empty()) out.add(o.msh, format_msh(mesh));
-  if (!o.svg.empty()) {
-    // Dots shrink with density as in the quadtree's picture (svg.hpp), from the mesh's own
-    // default radius down.
-    SvgMeshOptions svg_options;
-    const double largest_px = svg_options.point_radius_px;
-    svg_options.point_radius_px = o.svg_point_radius > 0
-                                      ? o.svg_point_radius
-                                      : default_point_radius_px(inputs.size(), svg_options.width_px, largest_px);
-    svg_options.max_marked_inputs = o.svg_max_points;
-    out.add(o.svg, format_svg(mesh, box, inputs, svg_options));
-  }
-  out.commit();
-
-  // After the outputs are in place, so that a failed run prints only its error line.
-  if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", initial.duplicates_skipped);
-  if (o.stats) {
-    const std::string report = format_stats(mesh_stats(mesh));
-    std::fflush(stdout);
-    std::fputs(report.c_str(), stderr);
-    std::fflush(stderr);
-  }
+  write_outputs(o, mesh, box, inputs, feed, initial.duplicates_skipped);
   return 0;
 }
 

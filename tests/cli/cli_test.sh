@@ -131,8 +131,8 @@ case $case_name in
     [[ $(wc -l <mesh.csv) -eq 41 ]] || fail "mesh CSV: expected header + 40 rows"
     paste -d, <(tail -n +2 tree.csv) <(tail -n +2 mesh.csv) | awk -F, '$4 != $11 || $5 != $12 || $13 <= $6 { bad = 1; print }
       END { exit bad }' || fail "mesh rows do not follow the tree rows (same ops and spreads, larger distances)"
-    expect_error 1 'hpu postprocess is not available yet' "$dynmesh" stability --dim 2 --dist uniform --n 50 \
-      --postprocess hpu --csv e.csv
+    expect_error 1 'self-adjusting hpu mesh is not available yet' "$dynmesh" stability --dim 2 --dist uniform \
+      --n 50 --postprocess hpu --csv e.csv
     expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess quadtree \
       --csv e.csv
     expect_error 1 '--min-angle needs a mesh' "$dynmesh" stability --dim 2 --dist uniform --n 50 --min-angle 10 \
@@ -164,6 +164,26 @@ case $case_name in
     sed -n 2p out.txt | grep -q '^  speedup  *[0-9]*x: an update vs a static rebuild' ||
       fail "demo does not lead with the speedup over a static rebuild: $(sed -n 2p out.txt)"
     head -c 5 demo.svg | grep -q '^<?xml\|^<svg' || fail "demo.svg is not SVG"
+    ;;
+
+  mesh_hpu) # the default postprocess: a quality Delaunay mesh, a function of the point set
+    run "$dynmesh" mesh "$data/final2d.txt" -o hpu --check --stats --vtk hpu.vtk --svg hpu.svg
+    [[ $(head -1 hpu.node | awk '{print $2, $3, $4}') == "2 0 1" ]] || fail "hpu.node header: $(head -1 hpu.node)"
+    smallest=$(grep -o 'Smallest angle: *[0-9.]*' err.txt | awk '{print $3}')
+    awk -v a="$smallest" 'BEGIN { exit !(a >= 20.7) }' || fail "smallest angle $smallest below 20.7"
+    # The points reversed (and with --duplicates skip on a copy) give the same files.
+    { grep '^#' "$data/final2d.txt"; grep -v '^#' "$data/final2d.txt" | tac; } >reversed.txt
+    run "$dynmesh" mesh reversed.txt --postprocess hpu -o rev
+    cmp hpu.node rev.node || fail "hpu: another point order gives another .node"
+    cmp hpu.ele rev.ele || fail "hpu: another point order gives another .ele"
+    for angle in 25 30; do
+      run "$dynmesh" mesh "$data/final2d.txt" --min-angle "$angle" -o "a$angle" --check --stats
+      smallest=$(grep -o 'Smallest angle: *[0-9.]*' err.txt | awk '{print $3}')
+      awk -v a="$smallest" -v b="$angle" 'BEGIN { exit !(a >= b) }' || fail "smallest angle $smallest below $angle"
+    done
+    # More Steiner points at a higher bound.
+    (($(head -1 a30.node | awk '{print $1}') > $(head -1 hpu.node | awk '{print $1}'))) ||
+      fail "30 degrees did not add vertices over 20.7"
     ;;
 
   mesh) # the quadtree mesh after edits equals a from-scratch mesh of the final points
@@ -215,9 +235,15 @@ case $case_name in
     expect_error 1 'bad_number.txt:3: ' "$dynmesh" mesh "$data/bad_number.txt" "${qt[@]}" -o old
     expect_error 1 'duplicate.txt:5: ' "$dynmesh" mesh "$data/duplicate.txt" "${qt[@]}" -o old
     expect_error 1 'above the quadtree' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --min-angle 25 -o old
-    expect_error 1 'hpu postprocess is not available yet' "$dynmesh" mesh "$data/points2d.node" \
-      --postprocess hpu -o old
-    expect_error 1 'hpu postprocess is not available yet' "$dynmesh" mesh "$data/points2d.node" -o old
+    expect_error 1 'pass --postprocess quadtree to apply edits' "$dynmesh" mesh "$data/points2d.node" \
+      --postprocess hpu --edits "$data/edits2d.txt" -o old
+    expect_error 1 'pass --postprocess quadtree to apply edits' "$dynmesh" mesh "$data/points2d.node" \
+      --edits "$data/edits2d.txt" -o old
+    for angle in 0.5 30.5; do
+      expect_error 1 "--min-angle for hpu must be between 1 and 30 degrees, got $angle" "$dynmesh" mesh \
+        "$data/points2d.node" --min-angle "$angle" -o old
+    done
+    expect_error 1 'duplicate.txt:5: ' "$dynmesh" mesh "$data/duplicate.txt" -o old
     expect_error 1 'points3d.node:1: ' "$dynmesh" mesh "$data/points3d.node" "${qt[@]}" -o old
     # An output that cannot be written: nothing else of the run is renamed into place.
     expect_error 1 'no-such-dir/x.svg' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" \
