@@ -1,4 +1,5 @@
-// predicates.cpp — orient2d and incircle on CGAL's filtered kernel (see predicates.hpp).
+// predicates.cpp — the exact stage of orient2d and incircle, and encroaches, on CGAL's
+// filtered kernel (see predicates.hpp).
 //
 // Purpose: the only translation unit that sees CGAL. Both predicates forward to
 // Exact_predicates_inexact_constructions_kernel, whose predicates are filtered: a static
@@ -26,12 +27,12 @@ KPoint to_kernel(const Point<2>& p) noexcept { return KPoint(p[0], p[1]); }
 
 }  // namespace
 
-int orient2d(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept {
+int detail::orient2d_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept {
   // CGAL::LEFT_TURN == POSITIVE == +1: c left of the directed line ab, i.e. a, b, c ccw.
   return static_cast<int>(Kernel::Orientation_2()(to_kernel(a), to_kernel(b), to_kernel(c)));
 }
 
-int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept {
+int detail::incircle_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept {
   // ON_POSITIVE_SIDE == +1 of the circle oriented by a, b, c: the inside when a, b, c are ccw.
   // CGAL evaluates the full lifted determinant, so collinear a, b, c get its sign, as promised.
   return static_cast<int>(Kernel::Side_of_oriented_circle_2()(to_kernel(a), to_kernel(b),

@@ -3,30 +3,93 @@
 // Purpose: the geometric decisions the meshes make (is a triangle counter-clockwise, is a
 // point strictly inside a circumcircle, does a point encroach a segment) decided exactly on IEEE double inputs, so that the
 // static and the self-adjusting meshers, and the mesh checker, never disagree through
-// rounding. The work is done by CGAL's Exact_predicates_inexact_constructions_kernel
-// (LGPL, Debian's libcgal-dev): a floating-point filter with an exact fallback. CGAL's
-// headers are confined to src/predicates.cpp.
+// rounding. Each test first evaluates its determinant in double, inline, and returns the
+// sign when it exceeds Shewchuk's a-priori error bound for that evaluation (his
+// ccwerrboundA and iccerrboundA); otherwise, and whenever a coordinate difference leaves the
+// range in which that bound holds (no product may underflow or overflow), it asks
+// CGAL's Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
+// interval filter with an exact fallback. CGAL's headers are confined to src/predicates.cpp.
+// The inline stage decides nearly all calls on meshing input and saves the call and CGAL's
+// own filter setup (the predicates were a third of the hpu mesh's build time).
 //
 // Invariants: the result is the sign of the exact real determinant of the double inputs,
 // for every finite input (including exactly degenerate and nearly degenerate ones).
-// Complexity: O(1); a few ns when the filter succeeds, more on (near-)degenerate input.
+// Complexity: O(1); a few ns when the inline filter succeeds, more on (near-)degenerate input.
 // Paper: Shewchuk, "Adaptive precision floating-point arithmetic and fast robust geometric
 // predicates" (1997) for the determinants; CGAL's filtered kernel for the implementation.
 #pragma once
+
+#include <cmath>
 
 #include "dynmesh/point.hpp"
 
 namespace dynmesh {
 
+namespace detail {
+/// The exact signs (CGAL), for the cases the inline filters below cannot settle.
+int orient2d_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept;
+int incircle_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept;
+/// Shewchuk's bounds, ε = 2^−53: the error of the double evaluations below is at most
+/// bound × permanent when no intermediate value overflows or underflows.
+inline constexpr double kEpsilon = 0x1p-53;
+inline constexpr double kOrientBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
+inline constexpr double kIncircleBound = (10.0 + 96.0 * kEpsilon) * kEpsilon;
+/// The bounds assume that no product underflows or overflows. Differences of the
+/// coordinates that are 0 or within [2^−lo, 2^hi] guarantee it: for orient2d (degree 2)
+/// products of at least 2^−1000; for incircle (degree 4) lifts and products of at least
+/// 2^−480, whose differences are multiples of 2^−532, so every term is at least 2^−1012.
+/// Anything else (a mix of magnitudes, huge or tiny boxes) goes to the exact stage.
+constexpr bool in_range(double x, double lo, double hi) noexcept {
+  const double a = x < 0 ? -x : x;
+  return a == 0 || (a >= lo && a <= hi);
+}
+}  // namespace detail
+
 /// Sign of det[[bx−ax, by−ay], [cx−ax, cy−ay]]: +1 when a, b, c turn counter-clockwise,
 /// −1 clockwise, 0 collinear. Inputs must be finite.
-int orient2d(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept;
+inline int orient2d(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept {
+  const double acx = a[0] - c[0], bcy = b[1] - c[1], acy = a[1] - c[1], bcx = b[0] - c[0];
+  const double left = acx * bcy;
+  const double right = acy * bcx;
+  const double det = left - right;
+  const double permanent = std::fabs(left) + std::fabs(right);
+  constexpr double lo = 0x1p-500, hi = 0x1p500;
+  if (detail::in_range(acx, lo, hi) && detail::in_range(bcy, lo, hi) && detail::in_range(acy, lo, hi) &&
+      detail::in_range(bcx, lo, hi)) {
+    const double bound = detail::kOrientBound * permanent;
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+  }
+  return detail::orient2d_exact(a, b, c);
+}
 
 /// For a, b, c counter-clockwise: +1 when d lies strictly inside their circumcircle, −1
 /// strictly outside, 0 on it (the sign flips for clockwise a, b, c; a, b, c collinear gives
 /// the orientation-style sign of the degenerate determinant, as the classic incircle test).
 /// Inputs must be finite.
-int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept;
+inline int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept {
+  const double adx = a[0] - d[0], ady = a[1] - d[1];
+  const double bdx = b[0] - d[0], bdy = b[1] - d[1];
+  const double cdx = c[0] - d[0], cdy = c[1] - d[1];
+  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
+  const double cdxady = cdx * ady, adxcdy = adx * cdy;
+  const double adxbdy = adx * bdy, bdxady = bdx * ady;
+  const double alift = adx * adx + ady * ady;
+  const double blift = bdx * bdx + bdy * bdy;
+  const double clift = cdx * cdx + cdy * cdy;
+  const double det = alift * (bdxcdy - cdxbdy) + blift * (cdxady - adxcdy) + clift * (adxbdy - bdxady);
+  const double permanent = (std::fabs(bdxcdy) + std::fabs(cdxbdy)) * alift +
+                           (std::fabs(cdxady) + std::fabs(adxcdy)) * blift +
+                           (std::fabs(adxbdy) + std::fabs(bdxady)) * clift;
+  constexpr double lo = 0x1p-240, hi = 0x1p240;
+  if (detail::in_range(adx, lo, hi) && detail::in_range(ady, lo, hi) && detail::in_range(bdx, lo, hi) &&
+      detail::in_range(bdy, lo, hi) && detail::in_range(cdx, lo, hi) && detail::in_range(cdy, lo, hi)) {
+    const double bound = detail::kIncircleBound * permanent;
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+  }
+  return detail::incircle_exact(a, b, c, d);
+}
 
 /// True when x lies strictly inside the circle with diameter ab, i.e. (a−x)·(b−x) < 0: x
 /// encroaches the segment ab (Ruppert; Triangle's test for subsegments). Inputs finite.
