@@ -15,6 +15,10 @@
 //   max_update_us,speedup,mean_distance,trace_bytes,bytes_per_point,verified
 // speedup = scratch_s / mean update time (the runtime's own from-scratch run, as the issue
 // asks); overhead = scratch_s / static_s.
+// --breakdown: after each build, where trace_bytes() goes (DynamicQuadtree::
+// memory_breakdown()): count, bytes, bytes per point and share of the total for each record
+// kind, side structure and directory part, then what trace_bytes() leaves out. Lines start
+// with '#', so CSV readers can skip them; the block follows its size's row.
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -48,10 +52,61 @@ struct Row {
          median_update_us = 0, max_update_us = 0, mean_distance = 0;
   std::size_t trace_bytes = 0;
   bool verified = false;
+  std::string breakdown;  // --breakdown: the block printed after the row
 };
 
+/// The breakdown block of --breakdown (see the header comment).
+std::string breakdown_text(const QuadtreeMemory& m, std::size_t trace_bytes, std::size_t n, int dim) {
+  std::string out;
+  char line[1024];
+  const double total = static_cast<double>(m.total());
+  auto row = [&](const char* name, std::uint64_t count, std::size_t bytes) {
+    std::snprintf(line, sizeof line, "# %-26s %12llu %14zu %10.1f %7.2f%%\n", name,
+                  static_cast<unsigned long long>(count), bytes,
+                  static_cast<double>(bytes) / static_cast<double>(n), 100.0 * static_cast<double>(bytes) / total);
+    out += line;
+  };
+  std::snprintf(line, sizeof line, "# breakdown dim=%d n=%zu\n# %-26s %12s %14s %10s %8s\n", dim, n, "part",
+                "count", "bytes", "B/point", "share");
+  out += line;
+  m.engine.for_each_part(row);
+  row("base version records", m.engine.inputs.count, m.engine.inputs.header);
+  row("base version values", m.engine.inputs.count, m.engine.inputs.payload);
+  row("directory slots", m.slots, m.slot_bytes);
+  row("directory table", m.slots, m.table_bytes);
+  row("per-level list nodes", m.level_nodes, m.level_node_bytes);
+  row("input list nodes", m.input_nodes, m.input_node_bytes);
+  std::snprintf(line, sizeof line,
+                "# total %zu B = trace_bytes() %zu B: %s (unaccounted records %lld B)\n"
+                "# base versions: %llu (2 per directory slot + 1 per input node + the list head = %zu)\n"
+                "# outside trace_bytes(): engine vectors %zu B, pool reserved %zu B (unused %zu B, %.1f B/point),"
+                " large blocks %zu B, size-class rounding %zu B\n",
+                m.total(), trace_bytes, m.total() == trace_bytes ? "equal" : "DIFFERENT",
+                static_cast<long long>(m.engine.unaccounted), static_cast<unsigned long long>(m.engine.inputs.count),
+                2 * m.slots + m.input_nodes + 1, m.engine.engine_vectors, m.engine.pool_reserved, m.engine.pool_unused(),
+                static_cast<double>(m.engine.pool_unused()) / static_cast<double>(n), m.engine.pool_large,
+                m.engine.size_class_rounding);
+  out += line;
+  out += "# the reads (records and closures) by record size, i.e. by closure type:\n";
+  for (const auto& [bytes, count] : m.engine.read_sizes) {
+    char name[64];
+    std::snprintf(name, sizeof name, "reads of %zu B", bytes);
+    row(name, count, bytes * count);
+  }
+  // trace_bytes() counts the directory's table at two slots per entry; after a build (no
+  // erase yet) its capacity is the least power of two, from 16, of at least that.
+  std::size_t capacity = 16;
+  while (capacity < 2 * m.slots) capacity *= 2;
+  const std::size_t table = capacity * (8 * static_cast<std::size_t>(dim) + sizeof(void*));
+  std::snprintf(line, sizeof line, "# directory table at its capacity: %zu B (%.1f B/point, %zu B more than counted)\n",
+                table, static_cast<double>(table) / static_cast<double>(n), table - m.table_bytes);
+  out += line;
+  return out;
+}
+
 template <std::size_t d>
-Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std::uint64_t seed) {
+Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std::uint64_t seed,
+            bool breakdown) {
   Row row;
   row.dim = static_cast<int>(d);
   row.dist = std::string(distribution_name(dist));
@@ -74,6 +129,7 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
   }
   row.scratch_s = median(sc);
   row.trace_bytes = tree->trace_bytes();
+  if (breakdown) row.breakdown = breakdown_text(tree->memory_breakdown(), row.trace_bytes, n, row.dim);
 
   Rng rng(seed ^ 0x5eed);
   std::vector<PointId> ids;
@@ -130,6 +186,7 @@ int main(int argc, char** argv) {
   int reps = 3;
   std::uint64_t seed = 1;
   bool csv = false;
+  bool breakdown = false;
   app.add_option("--dim", dim, "2 or 3")->check(CLI::IsMember({2, 3}));
   app.add_option("--dist", dist_name, "point distribution");
   app.add_option("--n", sizes, "sizes (several allowed)")->delimiter(',');
@@ -137,6 +194,7 @@ int main(int argc, char** argv) {
   app.add_option("--reps", reps, "timed from-scratch builds (median)")->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "seed");
   app.add_flag("--csv", csv, "CSV output");
+  app.add_flag("--breakdown", breakdown, "after each build, print trace_bytes() by part ('#' lines)");
   CLI11_PARSE(app, argc, argv);
   const auto dist = parse_distribution(dist_name);
   if (!dist) {
@@ -151,8 +209,8 @@ int main(int argc, char** argv) {
                 "n", "static_s", "scratch_s", "overhead", "insert_us", "delete_us", "update_us",
                 "median_us", "max_us", "speedup", "distance", "bytes/point", "verified");
   for (std::size_t n : sizes) {
-    const Row r = dim == 2 ? measure<2>(*dist, n, updates, reps, seed)
-                           : measure<3>(*dist, n, updates, reps, seed);
+    const Row r = dim == 2 ? measure<2>(*dist, n, updates, reps, seed, breakdown)
+                           : measure<3>(*dist, n, updates, reps, seed, breakdown);
     const double overhead = r.scratch_s / r.static_s;
     const double speedup = r.scratch_s / (r.update_us * 1e-6);
     const double bpp = static_cast<double>(r.trace_bytes) / static_cast<double>(r.n);
@@ -166,6 +224,7 @@ int main(int argc, char** argv) {
                   r.dim, r.dist.c_str(), r.n, r.static_s, r.scratch_s, overhead, r.insert_us,
                   r.delete_us, r.update_us, r.median_update_us, r.max_update_us, speedup,
                   r.mean_distance, bpp, r.verified ? 1 : 0);
+    std::fputs(r.breakdown.c_str(), stdout);
     std::fflush(stdout);
     if (!r.verified) return 1;
   }

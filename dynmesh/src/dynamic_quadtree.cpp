@@ -207,6 +207,22 @@ std::size_t DynamicQuadtree<d>::record_bytes() const { return s_->rt.record_byte
 
 template <std::size_t d>
   requires SupportedDim<d>
+QuadtreeMemory DynamicQuadtree<d>::memory_breakdown() const {
+  const auto& s = *s_;
+  QuadtreeMemory m;
+  m.engine = s.rt.memory_breakdown();
+  m.slots = s.dir.slot_pool().live();
+  m.slot_bytes = s.dir.slot_pool().bytes();
+  m.level_nodes = s.dir.node_pool().live();
+  m.level_node_bytes = s.dir.node_pool().bytes();
+  m.table_bytes = s.dir.table_bytes();
+  m.input_nodes = s.inputs.live();
+  m.input_node_bytes = s.inputs.bytes();
+  return m;
+}
+
+template <std::size_t d>
+  requires SupportedDim<d>
 std::uint64_t DynamicQuadtree<d>::live_events() const { return s_->rt.live_events(); }
 
 template <std::size_t d>

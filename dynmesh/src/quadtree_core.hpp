@@ -76,6 +76,8 @@ class StablePool {
   std::size_t bytes() const noexcept {
     return store_.size() * sizeof(T) + free_.capacity() * sizeof(T*);
   }
+  /// Objects created and not destroyed.
+  std::size_t live() const noexcept { return store_.size() - free_.size(); }
 
  private:
   std::deque<T> store_;
@@ -102,9 +104,14 @@ class Directory {
     return v ? *v : nullptr;
   }
   std::size_t size() const noexcept { return table_.size(); }
-  std::size_t bytes() const noexcept {
-    return pool_.bytes() + copies_.bytes() + table_.size() * 2 * (8 * d + sizeof(void*));
-  }
+  std::size_t bytes() const noexcept { return pool_.bytes() + copies_.bytes() + table_bytes(); }
+  /// The hash table counted at its least capacity, two slots (8·d bytes of key and a
+  /// pointer) per entry; the true capacity is the power of two reached at the directory's
+  /// largest size, up to twice that.
+  std::size_t table_bytes() const noexcept { return table_.size() * 2 * (8 * d + sizeof(void*)); }
+  const StablePool<Slot<d>>& slot_pool() const noexcept { return pool_; }
+  /// The points' list nodes below level 0 (see below()).
+  const StablePool<PNode<d>>& node_pool() const noexcept { return copies_; }
 
   /// The node of p's point one level below p's, created on first use.
   PNode<d>* below(PNode<d>* p) {

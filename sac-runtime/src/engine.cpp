@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <ostream>
 #include <string>
 #include <unordered_map>
@@ -630,6 +631,74 @@ std::size_t Engine::trace_bytes() const {
   return record_bytes() + order_.memory_bytes() + queue_.memory_bytes() +
          allocs_.memory_bytes() + memos_.memory_bytes() +
          deferred_.capacity() * sizeof(AllocNode*);
+}
+
+MemoryBreakdown Engine::memory_breakdown() const {
+  if (in_computation_) throw UsageError("sac::Engine::memory_breakdown: not inside the computation");
+  MemoryBreakdown b;
+  // A record of `size` bytes (its ops->size, i.e. sizeof) is a pool block of the size rounded
+  // to the grain; the fixed `header` and the `key` come first, the rest is the payload.
+  auto block_of = [](std::size_t size) {
+    constexpr std::size_t g = detail::Pool::kGrain;
+    return size < g ? g : (size + g - 1) & ~(g - 1);
+  };
+  auto add = [&](RecordBytes& kind, std::size_t size, std::size_t header, std::size_t key) {
+    const std::size_t block = block_of(size);
+    if (block > detail::Pool::kMaxSmall) b.pool_large += block;
+    b.size_class_rounding += block - size;
+    ++kind.count;
+    kind.header += header;
+    kind.key += key;
+    kind.payload += block - header - key;
+  };
+  std::map<std::size_t, std::uint64_t> read_sizes;  // a few closure types: a few sizes
+  // Each record once, at its first stamp (a read's or memo entry's end stamp is in the
+  // same record).
+  for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
+    switch (s->kind()) {
+      case StampKind::ReadStart: {
+        const ReadNode* r = reinterpret_cast<const ReadNode*>(s);
+        add(b.reads, r->ops->size, sizeof(ReadNode), 0);
+        ++read_sizes[block_of(r->ops->size)];
+        break;
+      }
+      case StampKind::Write: {
+        const VersionBase* v = reinterpret_cast<const VersionBase*>(s);
+        add(b.versions, v->ops->size, sizeof(VersionBase), 0);
+        break;
+      }
+      case StampKind::Alloc: {
+        const AllocNode* n = reinterpret_cast<const AllocNode*>(s);
+        if (n->ops->key_equal)
+          add(b.keyed_allocs, n->ops->size, sizeof(AllocNode),
+              reinterpret_cast<const detail::KeyedAllocOps*>(n->ops)->key_bytes);
+        else
+          add(b.plain_allocs, n->ops->size, sizeof(AllocNode), 0);
+        break;
+      }
+      case StampKind::MemoStart: {
+        const MemoNode* n = reinterpret_cast<const MemoNode*>(s);
+        add(b.memos, n->ops->size, sizeof(MemoNode), 0);
+        break;
+      }
+      default:
+        break;
+    }
+  }
+  for (const VersionBase* v : bases_) add(b.inputs, v->ops->size, sizeof(VersionBase), 0);
+  b.read_sizes.assign(read_sizes.begin(), read_sizes.end());
+  b.unaccounted = static_cast<std::int64_t>(record_bytes()) - static_cast<std::int64_t>(b.records());
+  b.order_groups = order_.group_count();
+  b.order_bytes = order_.memory_bytes();
+  b.queue_bytes = queue_.memory_bytes();
+  b.alloc_table_bytes = allocs_.memory_bytes();
+  b.memo_table_bytes = memos_.memory_bytes();
+  b.deferred_bytes = deferred_.capacity() * sizeof(AllocNode*);
+  b.engine_vectors = bases_.capacity() * sizeof(VersionBase*) + tasks_.capacity() * sizeof(Task) +
+                     reruns_.capacity() * sizeof(RerunContext) + issued_.capacity() * sizeof(Task) +
+                     pending_segments_.capacity() * sizeof(PendingAlloc*);
+  b.pool_reserved = pool_.reserved_bytes();
+  return b;
 }
 
 void Engine::check_invariants() const {

@@ -37,6 +37,7 @@
 #include <span>
 #include <vector>
 
+#include <sac/memory_breakdown.hpp>
 #include <sac/stats.hpp>
 
 #include "dynmesh/box.hpp"
@@ -63,6 +64,26 @@ struct UpdateStats {
   std::uint64_t trace_distance = 0;  // trace events created + undone by its propagation
   std::uint64_t reexecuted = 0;      // reads re-executed
   double seconds = 0.0;              // wall time of propagate()
+};
+
+/// Where DynamicQuadtree::trace_bytes() goes: the engine's trace by record kind and the
+/// base versions (the directory slots' two defaults each, the input list's links), then
+/// what lives outside the engine: the cell directory and the input list's nodes.
+struct QuadtreeMemory {
+  sac::MemoryBreakdown engine;
+  std::size_t slots = 0;             // directory slots (cells the computation has named)
+  std::size_t slot_bytes = 0;        // their pool, freed slots included
+  std::size_t level_nodes = 0;       // the points' list nodes below level 0
+  std::size_t level_node_bytes = 0;  // their pool, freed nodes included
+  std::size_t table_bytes = 0;       // the directory's hash table, as trace_bytes() counts it
+  std::size_t input_nodes = 0;       // the input list's nodes, one per point
+  std::size_t input_node_bytes = 0;  // their pool, freed nodes included
+
+  /// == trace_bytes() (when engine.unaccounted == 0).
+  std::size_t total() const {
+    return engine.trace() + engine.inputs.bytes() + slot_bytes + level_node_bytes + table_bytes +
+           input_node_bytes;
+  }
 };
 
 namespace detail {
@@ -124,6 +145,8 @@ class DynamicQuadtree {
   std::size_t trace_bytes() const;
   /// Live trace records only (equal for equal traces).
   std::size_t record_bytes() const;
+  /// trace_bytes() by part (for bench/RESULTS.md). O(live events + directory).
+  QuadtreeMemory memory_breakdown() const;
   std::uint64_t live_events() const;
   /// Directory slots held (cells the computation has named).
   std::size_t directory_size() const noexcept;

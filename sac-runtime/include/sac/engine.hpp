@@ -52,6 +52,7 @@
 #include "sac/errors.hpp"
 #include "sac/fn.hpp"
 #include "sac/hash.hpp"
+#include "sac/memory_breakdown.hpp"
 #include "sac/mod.hpp"
 #include "sac/order_list.hpp"
 #include "sac/stamp_queue.hpp"
@@ -108,6 +109,15 @@ struct ReadOpsFor {
                                sizeof(ReadNodeT<F>)};
 };
 
+/// A keyed allocation's ops table with the bytes of its key (and the padding before the
+/// object), for Engine::memory_breakdown(): ops is the first member of this standard-layout
+/// struct, so a record's ops pointer leads back here. Every ops table with key_equal set
+/// lives in one (AllocOpsFor).
+struct KeyedAllocOps {
+  AllocOps ops;
+  std::uint32_t key_bytes;
+};
+
 template <class T, class K>
 struct AllocOpsFor {
   using N = AllocNodeT<T, K>;
@@ -116,7 +126,12 @@ struct AllocOpsFor {
     return static_cast<const N*>(n)->key == *static_cast<const K*>(k);
   }
   static std::size_t hash(const AllocNode* n) { return Hash<K>{}(static_cast<const N*>(n)->key); }
-  static constexpr AllocOps ops{&destroy, &key_equal, &hash, sizeof(N)};
+  // The key follows the 32-byte AllocNode; the object follows the key at its alignment.
+  static constexpr std::size_t kObjectOffset =
+      (sizeof(AllocNode) + sizeof(K) + alignof(T) - 1) / alignof(T) * alignof(T);
+  static constexpr KeyedAllocOps keyed{{&destroy, &key_equal, &hash, sizeof(N)},
+                                       static_cast<std::uint32_t>(kObjectOffset - sizeof(AllocNode))};
+  static constexpr const AllocOps& ops = keyed.ops;
 };
 
 template <class T>
@@ -202,6 +217,10 @@ class Engine {
   /// Bytes of live trace records only (exactly equal for equal traces; no table slack).
   std::size_t record_bytes() const { return pool_.live_bytes() - input_bytes_; }
   std::uint64_t live_events() const { return stats_.live_events; }
+  /// trace_bytes() by record kind and side structure, and what it leaves out (base
+  /// versions, pool slack); see sac/memory_breakdown.hpp. Outside the computation only.
+  /// O(live events + base versions).
+  MemoryBreakdown memory_breakdown() const;
   bool in_computation() const { return in_computation_; }
   bool poisoned() const { return poisoned_; }
   const OrderList& order() const { return order_; }
