@@ -85,7 +85,7 @@ cmd_asan() {
   deps
   local cxx=g++
   command -v clang++ >/dev/null && cxx=clang++
-  build build/asan -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug -DSAC_SANITIZE=ON
+  build build/asan -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug -DSAC_SANITIZE=ON -DSAC_DEBUG_CHECKS=ON
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     ctest --test-dir build/asan --output-on-failure --no-tests=error -j "$JOBS" -LE '^bench$'
 }
