@@ -63,6 +63,7 @@ Delaunay::Tid Delaunay::new_tri(Vid a, Vid b, Vid c) {
   T.n = {kNone, kNone, kNone};
   T.alive = true;
   ++live_;
+  ++made_;
   return t;
 }
 
@@ -114,13 +115,22 @@ bool Delaunay::in_conflict(Tid t, const Point<2>& x) const noexcept {
 }
 
 void Delaunay::cavity(Tid t, const Point<2>& x, std::vector<Tid>& out) const {
+  if (++epoch_ == 0) {  // wrapped: no stale mark may equal the new epoch
+    for (const Tri& T : tris_) T.mark = 0;
+    epoch_ = 1;
+  }
   out.clear();
   out.push_back(t);
-  // Breadth first; the cavity is small, so membership is a linear scan.
+  tris_[t].mark = epoch_;
+  // Breadth first; members are marked with the epoch, so each test is O(1) (cavities of
+  // nearly collinear points can hold thousands of slivers).
   for (std::size_t i = 0; i < out.size(); ++i) {
     for (Tid u : tris_[out[i]].n) {
-      if (u == kNone || std::find(out.begin(), out.end(), u) != out.end()) continue;
-      if (in_conflict(u, x)) out.push_back(u);
+      if (u == kNone || tris_[u].mark == epoch_) continue;
+      if (in_conflict(u, x)) {
+        tris_[u].mark = epoch_;
+        out.push_back(u);
+      }
     }
   }
 }
@@ -137,9 +147,12 @@ void Delaunay::cavity_box_edges(std::span<const Tid> cav, std::vector<std::array
 Delaunay::Vid Delaunay::insert(const Point<2>& x, std::span<const Tid> cav, std::vector<Tid>& created) {
   const Vid xv = static_cast<Vid>(pts_.size());
   pts_.push_back(x);
-  const auto in_cavity = [&](Tid u) { return std::find(cav.begin(), cav.end(), u) != cav.end(); };
-  by_first_.clear();
-  by_second_.clear();
+  max_cavity_ = std::max(max_cavity_, cav.size());
+  const auto in_cavity = [&](Tid u) { return tris_[u].mark == epoch_; };
+  if (first_of_.size() < pts_.size()) {
+    first_of_.resize(pts_.size() + pts_.size() / 2, kNone);
+    second_of_.resize(first_of_.size(), kNone);
+  }
   const std::size_t first_new = created.size();
   // The boundary edges first, read before any slot is reused.
   struct Edge {
@@ -169,19 +182,18 @@ Delaunay::Vid Delaunay::insert(const Point<2>& x, std::span<const Tid> cav, std:
       for (int j = 0; j < 3; ++j)
         if (O.v[next(j)] == e.b && O.v[prev(j)] == e.a) O.n[j] = t;
     }
-    by_first_.emplace_back(e.a, t);
-    by_second_.emplace_back(e.b, t);
+    first_of_[e.a] = t;
+    second_of_[e.b] = t;
     created.push_back(t);
   }
-  const auto find = [](const std::vector<std::pair<Vid, Tid>>& m, Vid v) {
-    for (const auto& [k, t] : m)
-      if (k == v) return t;
-    return kNone;
-  };
   for (std::size_t i = first_new; i < created.size(); ++i) {
     Tri& T = tris_[created[i]];
-    T.n[0] = find(by_first_, T.v[1]);   // edge b→x: the new triangle starting at b
-    T.n[1] = find(by_second_, T.v[0]);  // edge x→a: the new triangle ending at a
+    T.n[0] = first_of_[T.v[1]];   // edge b→x: the new triangle starting at b (kNone: a box side)
+    T.n[1] = second_of_[T.v[0]];  // edge x→a: the new triangle ending at a
+  }
+  for (std::size_t i = first_new; i < created.size(); ++i) {  // leave the scratch all kNone
+    first_of_[tris_[created[i]].v[0]] = kNone;
+    second_of_[tris_[created[i]].v[1]] = kNone;
   }
   return xv;
 }

@@ -50,6 +50,7 @@ class Delaunay {
     std::array<Tid, 3> n;  // n[i]: the triangle across the edge opposite v[i] (kNone: a box side)
     std::uint32_t gen = 0; // bumped when the slot dies, so stale references can be told apart
     bool alive = false;
+    mutable std::uint32_t mark = 0;  // == the epoch of the cavity that holds it
   };
 
   /// Where a walk towards x ended.
@@ -66,6 +67,10 @@ class Delaunay {
   const Tri& tri(Tid t) const noexcept { return tris_[t]; }
   std::size_t num_slots() const noexcept { return tris_.size(); }
   std::size_t num_live() const noexcept { return live_; }
+  /// Triangles made since construction (the work of all insertions).
+  std::size_t num_made() const noexcept { return made_; }
+  /// The largest cavity an insertion has replaced (the quadratic risk of degenerate input).
+  std::size_t max_cavity() const noexcept { return max_cavity_; }
   /// Any live triangle (a walk's default start).
   Tid any_live() const noexcept;
 
@@ -85,8 +90,9 @@ class Delaunay {
   /// The cavity's boundary edges that lie on a box side, as (a, b) vertex pairs.
   void cavity_box_edges(std::span<const Tid> cavity, std::vector<std::array<Vid, 2>>& out) const;
 
-  /// Inserts x (in the closed box, not a vertex) whose cavity is `cavity`; appends the new
-  /// triangles to `created` and returns x's vertex.
+  /// Inserts x (in the closed box, not a vertex) whose cavity is `cavity`, the result of the
+  /// last cavity() call (its members are marked); appends the new triangles to `created` and
+  /// returns x's vertex.
   Vid insert(const Point<2>& x, std::span<const Tid> cavity, std::vector<Tid>& created);
 
   /// Locates and inserts x; nullopt (nothing changes) when x is already a vertex.
@@ -113,8 +119,12 @@ class Delaunay {
   std::vector<Tri> tris_;
   std::vector<Tid> free_;
   std::size_t live_ = 0;
-  // Scratch of insert(): the new triangles by their first and second vertex.
-  std::vector<std::pair<Vid, Tid>> by_first_, by_second_;
+  std::size_t made_ = 0;
+  std::size_t max_cavity_ = 0;
+  mutable std::uint32_t epoch_ = 0;  // the last cavity()'s mark
+  // Scratch of insert(), indexed by vertex: the new triangle starting or ending there (all
+  // kNone between calls).
+  std::vector<Tid> first_of_, second_of_;
 };
 
 /// The perturbed in-circle decision for counter-clockwise a, b, c: is d inside? (See the

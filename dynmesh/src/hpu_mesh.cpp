@@ -62,6 +62,66 @@ std::uint64_t morton(const Position<2>& q) noexcept {
 /// Of the leaf's apex height; Triangle uses 0.95 of the off-center distance too.
 constexpr double kApexFactor = 0.95;
 
+/// The midpoint of a box edge, from its (x, y)-smaller end: one formula whoever asks (the
+/// precomputation below and a split during refinement), so the same edge always gives the
+/// same bits. Throws InputError(Resolution) when double precision cannot split the edge.
+Point<2> side_midpoint(const Point<2>& p, const Point<2>& q) {
+  const Point<2>& a = xy_less(q, p) ? q : p;
+  const Point<2>& b = xy_less(q, p) ? p : q;
+  const Point<2> mid{a[0] + (b[0] - a[0]) * 0.5, a[1] + (b[1] - a[1]) * 0.5};
+  if (mid == a || mid == b)
+    throw InputError(InputError::Kind::Resolution,
+                     "the mesh must split a box edge of length " + format_exact(std::sqrt(squared_length(a, b))) +
+                         " that double precision cannot split: the spread is beyond the mesh's resolution");
+  return mid;
+}
+
+/// Step 2 without a triangulation: the midpoints that splitting encroached box edges adds.
+/// An edge's diametral disc holds its halves' discs, and a point strictly inside one projects
+/// strictly inside the edge; midpoints and corners never encroach. So the edges split are
+/// exactly those some input encroaches, and for each input they form one path down the
+/// halving of the side edge its projection falls in. Inserting these before the inputs keeps
+/// their cavities small (splitting after the inputs made every split's cavity the fan of a
+/// line of points: quadratic on collinear input).
+std::vector<Point<2>> side_midpoints(const Box<2>& box, std::span<const Point<2>> points) {
+  const double lo[2] = {box.origin[0], box.origin[1]};
+  const double hi[2] = {box.origin[0] + box.side, box.origin[1] + box.side};
+  std::vector<Point<2>> out, side;
+  for (unsigned u = 0; u < 2; ++u) {  // the axis along the side
+    const unsigned w = 1 - u;         // the axis across it
+    for (const double c : {lo[w], hi[w]}) {
+      const auto at = [&](double t) {
+        Point<2> p;
+        p[u] = t;
+        p[w] = c;
+        return p;
+      };
+      side = {at(lo[u]), at(hi[u])};
+      for (const Point<2>& p : points)
+        if (p[w] == c) side.push_back(p);
+      std::sort(side.begin(), side.end(), [&](const Point<2>& a, const Point<2>& b) { return a[u] < b[u]; });
+      side.erase(std::unique(side.begin(), side.end()), side.end());
+      for (const Point<2>& p : points) {
+        if (p[w] == c) continue;
+        const auto it = std::upper_bound(side.begin(), side.end(), p[u],
+                                         [&](double t, const Point<2>& v) { return t < v[u]; });
+        if (it == side.begin() || it == side.end() || !((it - 1)->at(u) < p[u])) continue;
+        Point<2> a = *(it - 1), b = *it;
+        while (encroaches(a, b, p)) {
+          const Point<2> m = side_midpoint(a, b);
+          out.push_back(m);
+          if (p[u] < m[u]) b = m;
+          else if (p[u] > m[u]) a = m;
+          else break;
+        }
+      }
+    }
+  }
+  std::sort(out.begin(), out.end(), xy_less);
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 class Refiner {
  public:
   Refiner(const Box<2>& box, double min_angle_deg, std::size_t max_vertices, HpuStats& stats)
@@ -75,18 +135,25 @@ class Refiner {
     sin2_theta_ = s * s;
   }
 
-  void insert_inputs(std::span<const Point<2>> points, std::span<const Position<2>> qs) {
+  /// The side midpoints of step 2 (in (x, y) order), then the points in Morton order.
+  void insert_inputs(const Box<2>& box, std::span<const Point<2>> points, std::span<const Position<2>> qs) {
+    Tid hint = dt_.any_live();
+    for (const Point<2>& m : side_midpoints(box, points)) {
+      created_.clear();
+      if (dt_.insert(m, hint, created_) && !created_.empty()) hint = created_.back();
+      ++stats_.side_splits;
+    }
     std::vector<std::pair<std::uint64_t, std::size_t>> order(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) order[i] = {morton(qs[i]), i};
     std::sort(order.begin(), order.end());
-    Tid hint = dt_.any_live();
     for (const auto& [code, i] : order) {
       created_.clear();
       if (dt_.insert(points[i], hint, created_) && !created_.empty()) hint = created_.back();
     }
   }
 
-  /// Step 2: split every encroached box edge until none is.
+  /// Step 2's invariant after insert_inputs(): no box edge is encroached. It holds by
+  /// construction (side_midpoints); this pass would split any edge that is, and counts it.
   void split_encroached_sides() {
     std::vector<Tid> work;
     for (Tid t = 0; t < dt_.num_slots(); ++t)
@@ -235,12 +302,7 @@ class Refiner {
 
   /// Splits the box edge ab (a, b adjacent on a side) at its midpoint; new triangles in created_.
   void split_side(Vid a, Vid b, Tid hint) {
-    const Point<2>&pa = dt_.point(a), &pb = dt_.point(b);
-    const Point<2> mid{pa[0] + (pb[0] - pa[0]) * 0.5, pa[1] + (pb[1] - pa[1]) * 0.5};
-    if (mid == pa || mid == pb)
-      throw InputError(InputError::Kind::Resolution,
-                       "the mesh must split a box edge of length " + format_exact(std::sqrt(squared_length(pa, pb))) +
-                           " that double precision cannot split: the spread is beyond the mesh's resolution");
+    const Point<2> mid = side_midpoint(dt_.point(a), dt_.point(b));
     if (!dt_.insert(mid, hint, created_)) throw InvariantError("dynmesh: a box edge's midpoint is already a vertex");
     ++stats_.side_splits;
     check_size();
@@ -331,10 +393,12 @@ HpuMesh::HpuMesh(const Box<2>& box, std::span<const Point<2>> points, double min
   // A guard against a refinement that runs away, far above any size the tests have seen.
   const std::size_t max_vertices = 1000 * (points.size() + 4) + (std::size_t{1} << 20);
   Refiner refiner(box, min_angle_deg, max_vertices, stats_);
-  refiner.insert_inputs(points, qs);
+  refiner.insert_inputs(box, points, qs);
   refiner.split_encroached_sides();
   refiner.refine();
   triangles_ = refiner.triangles();
+  stats_.triangles_made = refiner.triangulation().num_made();
+  stats_.max_cavity = refiner.triangulation().max_cavity();
 }
 
 void HpuMesh::check_invariants() const {

@@ -12,8 +12,10 @@
 //   1. T := the Delaunay triangulation of the corners and the points (unique: degenerate
 //      cases follow a symbolic perturbation by (x, y) rank, src/delaunay.hpp).
 //   2. Sides: while a vertex lies strictly inside the diametral circle of a box edge
-//      (encroaches it), split the edge at its midpoint. The result is the unique fixed point
-//      (midpoints never encroach, and halving an edge only shrinks its circle).
+//      (encroaches it), split the edge at its midpoint (computed from its (x, y)-smaller
+//      end). The result is the unique fixed point (midpoints never encroach, and halving an
+//      edge only shrinks its circle); it is computed from the points alone, one path down
+//      the halvings per point, and inserted before them.
 //   3. A triangle is bad when one of its angles is below θ, computed by corner_angle_deg,
 //      the checker's own definition (so "no bad triangle" is exactly "the checker's bound
 //      holds"). Its key edge pq is its shortest (ties: the edge with the smaller ends in
@@ -68,6 +70,8 @@ struct HpuStats {
   std::size_t circumcentres = 0;  // of which circumcentres
   std::size_t side_splits = 0;    // box edges split at their midpoints
   std::size_t rounds = 0;
+  std::size_t triangles_made = 0;  // by every insertion, the final ones included: the work
+  std::size_t max_cavity = 0;      // the most triangles one insertion replaced
 };
 
 class HpuMesh {
