@@ -190,21 +190,43 @@ class Engine {
   void propagate();
 
   // ---------------------------------------------------------------- computation
+  // Inside run() or propagate() only (UsageError otherwise). Bodies run later, in program
+  // order (the trampoline, see the header): capture by value, never the stack.
+
+  /// Runs body(value) (or body(Engine&, value)) on the version of m visible now, and records
+  /// the read: when that value changes, propagate() undoes what body did and runs it again
+  /// in the same place in time. body's events belong to the read.
   template <class T, class F>
   void read(const Mod<T>& m, F&& body);
 
+  /// read(m, body), but a re-execution that issues an equal (m, body) finds the old read in
+  /// its window and reuses it with its whole subtree instead of running body again. body
+  /// must be equality comparable: use sac::fn<f>(args...).
   template <class T, class F>
   void memo_read(const Mod<T>& m, F&& body);
 
+  /// Adds a version of m holding value at the current time; readers later in the trace see
+  /// it. A write equal to the value it replaces is cut off: its readers are not affected.
   template <class T, class U>
   void write(Mod<T>& m, U&& value);
 
+  /// A T keyed by key: a re-execution that allocates under an equal key inside its window
+  /// gets the same object back (and its modifiables with their versions), so the work that
+  /// reads them is reused. On reuse `args` are ignored: the object is not rebuilt. Hence
+  /// the rule: the constructor arguments must be a function of the key, or a reused object
+  /// would differ from what a from-scratch run builds.
   template <class T, class K, class... A>
   T* alloc(const K& key, A&&... args);
 
+  /// A T with no key: never reused; destroyed when the allocation is undone (its read or
+  /// memo re-runs or is discarded). For objects no later re-execution needs to find.
   template <class T, class... A>
   T* make(A&&... args);
 
+  /// Calls f(Engine&) (or f()) memoized: a re-execution that issues an equal f inside its
+  /// window reuses the old call's trace (undoing what lies between and propagating the
+  /// affected reads inside it) and continues after it. f must be equality comparable and
+  /// hashable: use sac::fn<f>(args...).
   template <class F>
   void memo(F&& f);
 
