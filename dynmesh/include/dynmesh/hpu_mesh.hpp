@@ -5,8 +5,8 @@
 // with few Steiner points. It refines the Delaunay triangulation of the box's corners and
 // the points by off-centers processed in size classes, smallest first (Har-Peled & Üngör's
 // order, the seed's Figure 5), and treats the box's sides as segments, as Triangle does with
-// a .poly file. It is the oracle of the self-adjusting mesher and the baseline of its
-// overhead.
+// a .poly file. It is meant as the oracle and the baseline of the self-adjusting hpu mesh,
+// which does not exist yet: see "Next" below.
 //
 // The algorithm, with the choices the seed leaves open (ρ = 1/(2 sin θ)):
 //   1. T := the Delaunay triangulation of the corners and the points (unique: degenerate
@@ -38,6 +38,13 @@
 // Each step depends only on the current vertex set and on keys made of coordinates, never
 // on insertion order or addresses, so the mesh is a function of (box, point set, θ).
 // Constructions are plain doubles in one fixed sequence of operations.
+//
+// Next: the self-adjusting version needs every decision local, and these are not: whether a
+// bad triangle is still live depends on its circumcircle, which has no bound. The seed's
+// formulation is local by construction (loose pairs tested on leaves of radius ρ|pq|, the
+// crescent rule bounding the circumcentre used, points kept in quadtree cells by class), so
+// the twin is to be rewritten in that form, with this one as its reference for size and
+// quality, and then written on the runtime in the tree's trace.
 //
 // Invariants: check_invariants(): the triangulation's own invariants (Delaunay, tiling) and
 // the mesh contract through check_mesh (every angle ≥ θ, every input a vertex).
