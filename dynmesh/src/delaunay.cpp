@@ -155,11 +155,8 @@ Delaunay::Vid Delaunay::insert(const Point<2>& x, std::span<const Tid> cav, std:
   }
   const std::size_t first_new = created.size();
   // The boundary edges first, read before any slot is reused.
-  struct Edge {
-    Vid a, b;
-    Tid outside;
-  };
-  std::vector<Edge> edges;
+  std::vector<Edge>& edges = edges_;
+  edges.clear();
   for (Tid t : cav) {
     const Tri& T = tris_[t];
     for (int i = 0; i < 3; ++i)
@@ -202,9 +199,8 @@ std::optional<Delaunay::Vid> Delaunay::insert(const Point<2>& x, Tid hint, std::
   const Walk w = walk(hint, x);
   if (w.exit_edge >= 0) throw InvariantError("dynmesh: Delaunay insertion outside the box");
   if (vertex_at(w.t, x)) return std::nullopt;
-  std::vector<Tid> cav;
-  cavity(w.t, x, cav);
-  return insert(x, cav, created);
+  cavity(w.t, x, cavity_);
+  return insert(x, cavity_, created);
 }
 
 std::optional<std::pair<Delaunay::Tid, int>> Delaunay::box_edge_of(Tid t, Vid a, Vid b) const noexcept {

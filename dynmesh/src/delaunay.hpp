@@ -122,8 +122,15 @@ class Delaunay {
   std::size_t made_ = 0;
   std::size_t max_cavity_ = 0;
   mutable std::uint32_t epoch_ = 0;  // the last cavity()'s mark
-  // Scratch of insert(), indexed by vertex: the new triangle starting or ending there (all
-  // kNone between calls).
+  // Scratch of insert(), kept so that an insertion allocates nothing: the cavity of the
+  // locating insert(), the cavity's boundary edges, and by vertex the new triangle starting
+  // or ending there (all kNone between calls).
+  struct Edge {
+    Vid a, b;
+    Tid outside;
+  };
+  std::vector<Tid> cavity_;
+  std::vector<Edge> edges_;
   std::vector<Tid> first_of_, second_of_;
 };
 

@@ -18,6 +18,7 @@
 #include "dynmesh/predicates.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
 #include "locate_points.hpp"
+#include "z_order.hpp"
 
 namespace dynmesh {
 namespace {
@@ -44,19 +45,10 @@ bool pair_less(const Point<2>& a0, const Point<2>& a1, const Point<2>& b0, const
   return xy_less(ahi, bhi);
 }
 
-/// Morton code of a grid position's top 32 bits per axis: the insertion order of the points
-/// (any order gives the same triangulation; this one keeps the walks short).
+/// Z-order code of a grid position's top 32 bits per axis: the insertion order of the
+/// points (any order gives the same triangulation; this one keeps the walks short).
 std::uint64_t morton(const Position<2>& q) noexcept {
-  auto spread = [](std::uint64_t x) {
-    x &= 0xffff'ffffULL;
-    x = (x | (x << 16)) & 0x0000'ffff'0000'ffffULL;
-    x = (x | (x << 8)) & 0x00ff'00ff'00ff'00ffULL;
-    x = (x | (x << 4)) & 0x0f0f'0f0f'0f0f'0f0fULL;
-    x = (x | (x << 2)) & 0x3333'3333'3333'3333ULL;
-    x = (x | (x << 1)) & 0x5555'5555'5555'5555ULL;
-    return x;
-  };
-  return spread(q[0] >> 20) | (spread(q[1] >> 20) << 1);
+  return detail::z_order(static_cast<std::uint32_t>(q[0] >> 20), static_cast<std::uint32_t>(q[1] >> 20));
 }
 
 /// Of the leaf's apex height; Triangle uses 0.95 of the off-center distance too.
@@ -275,7 +267,11 @@ class Refiner {
   /// The off-center of pq for the counter-clockwise triangle p, q, t, in one fixed sequence
   /// of double operations, in a frame scaled by a power of two (exact) so that the products
   /// neither overflow nor underflow in any accepted box.
-  Point<2> off_center(const Point<2>& p, const Point<2>& q, const Point<2>& t) const noexcept {
+  struct OffCenter {
+    Point<2> at;
+    bool circumcentre;  // the circumcentre rather than the leaf's apex
+  };
+  OffCenter off_center(const Point<2>& p, const Point<2>& q, const Point<2>& t) const noexcept {
     double bx = q[0] - p[0], by = q[1] - p[1], cx = t[0] - p[0], cy = t[1] - p[1];
     const int e = std::ilogb(std::max({std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)}));
     bx = std::ldexp(bx, -e), by = std::ldexp(by, -e), cx = std::ldexp(cx, -e), cy = std::ldexp(cy, -e);
@@ -290,8 +286,7 @@ class Refiner {
     const double da = apex_height_ * apex_height_ * b2;
     const bool circumcentre = du <= da;
     const double rx = circumcentre ? ux : ax, ry = circumcentre ? uy : ay;
-    last_was_circumcentre_ = circumcentre;
-    return Point<2>{p[0] + std::ldexp(rx, e), p[1] + std::ldexp(ry, e)};
+    return OffCenter{Point<2>{p[0] + std::ldexp(rx, e), p[1] + std::ldexp(ry, e)}, circumcentre};
   }
 
   void check_size() const {
@@ -314,8 +309,7 @@ class Refiner {
 
   void split_triangle(Tid t) {
     const KeyEdge k = key_edge(t);
-    const Point<2> r = off_center(dt_.point(k.p), dt_.point(k.q), dt_.point(k.t));
-    const bool was_circumcentre = last_was_circumcentre_;
+    const auto [r, was_circumcentre] = off_center(dt_.point(k.p), dt_.point(k.q), dt_.point(k.t));
     if (!std::isfinite(r[0]) || !std::isfinite(r[1])) throw InvariantError("dynmesh: a non-finite off-center");
     const std::uint32_t gen = dt_.tri(t).gen;
     const auto still = [&] { return dt_.tri(t).alive && dt_.tri(t).gen == gen; };
@@ -370,7 +364,6 @@ class Refiner {
   std::map<int, std::vector<Entry>> buckets_;
   std::vector<Tid> created_, cavity_;
   std::vector<std::array<Vid, 2>> sides_, encroached_;
-  mutable bool last_was_circumcentre_ = false;
 };
 
 void validate_min_angle(double deg) {

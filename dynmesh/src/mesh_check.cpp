@@ -10,6 +10,7 @@
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/predicates.hpp"
+#include "z_order.hpp"
 
 namespace dynmesh {
 
@@ -263,7 +264,7 @@ class VertexTree {
   }
 
   std::uint64_t code(const Point<2>& p) const noexcept {
-    return morton(quantize((p[0] - x0_) * sx_), quantize((p[1] - y0_) * sy_));
+    return detail::z_order(quantize((p[0] - x0_) * sx_), quantize((p[1] - y0_) * sy_));
   }
 
   struct Bounds {
@@ -302,16 +303,6 @@ class VertexTree {
     if (t >= 0x1p32) return 0xffffffffu;
     return static_cast<std::uint32_t>(t);
   }
-  static std::uint64_t spread(std::uint32_t v) noexcept {
-    std::uint64_t x = v;
-    x = (x | (x << 16)) & 0x0000ffff0000ffffull;
-    x = (x | (x << 8)) & 0x00ff00ff00ff00ffull;
-    x = (x | (x << 4)) & 0x0f0f0f0f0f0f0f0full;
-    x = (x | (x << 2)) & 0x3333333333333333ull;
-    x = (x | (x << 1)) & 0x5555555555555555ull;
-    return x;
-  }
-  static std::uint64_t morton(std::uint32_t qx, std::uint32_t qy) noexcept { return spread(qx) | (spread(qy) << 1); }
 
   double x0_, y0_, sx_ = 0, sy_ = 0;   // the quantization: code() is monotone in x and in y
   std::vector<std::size_t> position_;  // vertex index -> place in points_ (kAbsent: not finite)

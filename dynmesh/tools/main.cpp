@@ -59,6 +59,11 @@ int main(int argc, char** argv) {
   // A radius in pixels: positive, and no larger than the drawing.
   const CLI::Validator radius_px = CLI::Range(0.01, 1000.0);
   const CLI::Validator any_count = whole_number(0, std::numeric_limits<std::size_t>::max());
+  // --svg-point-radius and --svg-max-points, which only mean something with `svg`.
+  auto add_svg_density = [&](CLI::App* cmd, CLI::Option* svg, double& radius, std::size_t& max_points) {
+    cmd->add_option("--svg-point-radius", radius, svg_radius_help)->check(radius_px)->needs(svg)->type_name("PX");
+    cmd->add_option("--svg-max-points", max_points, svg_max_help)->check(any_count)->needs(svg)->type_name("N");
+  };
 
   QuadtreeOptions q;
   CLI::App* quadtree = app.add_subcommand(
@@ -81,14 +86,7 @@ int main(int argc, char** argv) {
   quadtree->add_option("--cells", q.cells, "output: the final leaves as .cells")->required();
   quadtree->add_flag("--check", q.check, "also rebuild from scratch on the final points and fail if the trees differ");
   CLI::Option* quadtree_svg = quadtree->add_option("--svg", q.svg, "also draw the final tree and points (2D only)");
-  quadtree->add_option("--svg-point-radius", q.svg_point_radius, svg_radius_help)
-      ->check(radius_px)
-      ->needs(quadtree_svg)
-      ->type_name("PX");
-  quadtree->add_option("--svg-max-points", q.svg_max_points, svg_max_help)
-      ->check(any_count)
-      ->needs(quadtree_svg)
-      ->type_name("N");
+  add_svg_density(quadtree, quadtree_svg, q.svg_point_radius, q.svg_max_points);
   quadtree->add_flag("--force", q.force, force_help);
   quadtree->footer(
       "\nSynopsis (shared/FORMATS.md):\n"
@@ -124,14 +122,7 @@ int main(int argc, char** argv) {
   mesh->add_option("--vtk", me.vtk, "also write the mesh as legacy VTK");
   mesh->add_option("--msh", me.msh, "also write the mesh as Gmsh 2.2 ASCII");
   CLI::Option* mesh_svg = mesh->add_option("--svg", me.svg, "also draw the mesh and its input points");
-  mesh->add_option("--svg-point-radius", me.svg_point_radius, svg_radius_help)
-      ->check(radius_px)
-      ->needs(mesh_svg)
-      ->type_name("PX");
-  mesh->add_option("--svg-max-points", me.svg_max_points, svg_max_help)
-      ->check(any_count)
-      ->needs(mesh_svg)
-      ->type_name("N");
+  add_svg_density(mesh, mesh_svg, me.svg_point_radius, me.svg_max_points);
   mesh->add_flag("--check", me.check, "also mesh the final points from scratch and fail unless the meshes agree");
   mesh->add_flag("--stats", me.stats, "print a quality report on stderr");
   mesh->add_flag("--force", me.force, force_help);

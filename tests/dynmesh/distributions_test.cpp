@@ -81,6 +81,16 @@ TEST(Rng, NormalHasMeanZeroAndUnitVariance) {
   EXPECT_NEAR(s2 / n, 1.0, 0.02);
 }
 
+TEST(Distributions, PythonUniformMatchesCPython) {
+  // CPython: r = random.Random(1); [r.random() for _ in range(4)]; random.Random(2).random().
+  const auto pts = python_uniform(2);
+  EXPECT_EQ(pts[0][0], 0.13436424411240122);
+  EXPECT_EQ(pts[0][1], 0.8474337369372327);
+  EXPECT_EQ(pts[1][0], 0.763774618976614);
+  EXPECT_EQ(pts[1][1], 0.2550690257394217);
+  EXPECT_EQ(python_uniform(1, 2)[0][0], 0.9560342718892494);
+}
+
 TEST(Distributions, NamesRoundTrip) {
   EXPECT_EQ(all_distributions().size(), 7u);
   for (const Distribution dist : all_distributions()) EXPECT_EQ(parse_distribution(distribution_name(dist)), dist);

@@ -50,22 +50,6 @@ using namespace dynmesh;
 using namespace dynmesh_test;
 using Kind = InputError::Kind;
 
-const char* kind_name(Kind k) {
-  switch (k) {
-    case Kind::Io: return "Io";
-    case Kind::Malformed: return "Malformed";
-    case Kind::NotFinite: return "NotFinite";
-    case Kind::Count: return "Count";
-    case Kind::Duplicate: return "Duplicate";
-    case Kind::OutsideBox: return "OutsideBox";
-    case Kind::Resolution: return "Resolution";
-    case Kind::Absent: return "Absent";
-    case Kind::Present: return "Present";
-    case Kind::Empty: return "Empty";
-  }
-  return "?";
-}
-
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 

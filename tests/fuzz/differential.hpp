@@ -69,22 +69,6 @@ inline constexpr std::size_t kMaxBatch = 8;
 
 using Kind = InputError::Kind;
 
-inline const char* kind_name(Kind kind) {
-  switch (kind) {
-    case Kind::Io: return "Io";
-    case Kind::Malformed: return "Malformed";
-    case Kind::NotFinite: return "NotFinite";
-    case Kind::Count: return "Count";
-    case Kind::Duplicate: return "Duplicate";
-    case Kind::OutsideBox: return "OutsideBox";
-    case Kind::Resolution: return "Resolution";
-    case Kind::Absent: return "Absent";
-    case Kind::Present: return "Present";
-    case Kind::Empty: return "Empty";
-  }
-  return "?";
-}
-
 template <std::size_t d, class Traits>
 class Differential {
  public:

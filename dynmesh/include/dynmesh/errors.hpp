@@ -91,6 +91,24 @@ class InputError : public Error {
   std::vector<std::size_t> points_;
 };
 
+/// The enumerator's name ("Io", "Malformed", ...), for messages and test reports.
+constexpr const char* kind_name(InputError::Kind kind) noexcept {
+  using Kind = InputError::Kind;
+  switch (kind) {
+    case Kind::Io: return "Io";
+    case Kind::Malformed: return "Malformed";
+    case Kind::NotFinite: return "NotFinite";
+    case Kind::Count: return "Count";
+    case Kind::Duplicate: return "Duplicate";
+    case Kind::OutsideBox: return "OutsideBox";
+    case Kind::Resolution: return "Resolution";
+    case Kind::Absent: return "Absent";
+    case Kind::Present: return "Present";
+    case Kind::Empty: return "Empty";
+  }
+  return "?";
+}
+
 class InvariantError : public Error {
  public:
   using Error::Error;
