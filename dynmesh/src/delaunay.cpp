@@ -62,9 +62,59 @@ Delaunay::Tid Delaunay::new_tri(Vid a, Vid b, Vid c) {
   T.v = {a, b, c};
   T.n = {kNone, kNone, kNone};
   T.alive = true;
+  if (vtri_.size() < pts_.size()) vtri_.resize(pts_.size() + pts_.size() / 2, kNone);
+  vtri_[a] = vtri_[b] = vtri_[c] = t;
   ++live_;
   ++made_;
   return t;
+}
+
+void Delaunay::star(Vid v, std::vector<Vid>& out) const {
+  out.clear();
+  const Tid t0 = vtri_[v];
+  const auto at = [&](Tid t) {
+    const Tri& T = tris_[t];
+    return T.v[0] == v ? 0 : T.v[1] == v ? 1 : 2;
+  };
+  // Back up clockwise to a box side, if v is on one: across the edge v→a of (v, a, b).
+  Tid t = t0;
+  const Point<2>& p = pts_[v];
+  const bool boundary = p[0] == box_.origin[0] || p[1] == box_.origin[1] || p[0] == hi_[0] || p[1] == hi_[1];
+  while (boundary) {
+    const Tid u = tris_[t].n[prev(at(t))];
+    if (u == kNone || u == t0) break;
+    t = u;
+  }
+  const Tid first = t;
+  out.push_back(tris_[t].v[next(at(t))]);
+  for (;;) {  // counter-clockwise: across the edge v→b of (v, a, b)
+    const int i = at(t);
+    out.push_back(tris_[t].v[prev(i)]);
+    t = tris_[t].n[next(i)];
+    if (t == kNone) return;
+    if (t == first) {
+      out.pop_back();  // an interior vertex: the last neighbour is the first
+      return;
+    }
+  }
+}
+
+std::optional<std::pair<Delaunay::Tid, int>> Delaunay::left_of(Vid p, Vid q) const noexcept {
+  const Tid t0 = vtri_[p];
+  // Counter-clockwise around p, then clockwise from t0 when a box side stopped the first turn.
+  for (int dir = 0; dir < 2; ++dir) {
+    Tid t = t0;
+    for (;;) {
+      const Tri& T = tris_[t];
+      const int i = T.v[0] == p ? 0 : T.v[1] == p ? 1 : 2;
+      if (T.v[next(i)] == q) return std::pair{t, prev(i)};
+      const Tid u = dir == 0 ? T.n[next(i)] : T.n[prev(i)];
+      if (u == t0) return std::nullopt;  // all the way round: not a neighbour
+      if (u == kNone) break;
+      t = u;
+    }
+  }
+  return std::nullopt;
 }
 
 Delaunay::Tid Delaunay::any_live() const noexcept {

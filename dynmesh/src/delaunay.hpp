@@ -73,6 +73,16 @@ class Delaunay {
   std::size_t max_cavity() const noexcept { return max_cavity_; }
   /// Any live triangle (a walk's default start).
   Tid any_live() const noexcept;
+  /// A live triangle with corner v.
+  Tid incident(Vid v) const noexcept { return vtri_[v]; }
+
+  /// The neighbours of v in counter-clockwise order (a cycle for an interior vertex; from
+  /// one box side to the other for a vertex on the boundary).
+  void star(Vid v, std::vector<Vid>& out) const;
+  /// The live triangle with the directed edge p→q (q follows p counter-clockwise in it),
+  /// and the index of its third corner; nullopt when p→q is not an edge or the outside of
+  /// the box lies on its left.
+  std::optional<std::pair<Tid, int>> left_of(Vid p, Vid q) const noexcept;
 
   /// Walks from `start` (live) towards x: the triangle holding x in its closure, or the box
   /// side crossed when x is outside the box. Deterministic for a given triangulation: at each
@@ -131,6 +141,7 @@ class Delaunay {
   };
   std::vector<Tid> cavity_;
   std::vector<Edge> edges_;
+  std::vector<Tid> vtri_;  // by vertex: a live triangle with that corner
   std::vector<Tid> first_of_, second_of_;
 };
 

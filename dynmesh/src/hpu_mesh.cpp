@@ -6,7 +6,9 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
+#include <unordered_set>
 #include <numbers>
 #include <string>
 #include <utility>
@@ -27,9 +29,6 @@ using detail::Delaunay;
 using Tid = Delaunay::Tid;
 using Vid = Delaunay::Vid;
 
-constexpr int next(int i) noexcept { return i == 2 ? 0 : i + 1; }
-constexpr int prev(int i) noexcept { return i == 0 ? 2 : i - 1; }
-
 double squared_length(const Point<2>& a, const Point<2>& b) noexcept {
   const double dx = b[0] - a[0], dy = b[1] - a[1];
   return dx * dx + dy * dy;
@@ -43,12 +42,6 @@ bool pair_less(const Point<2>& a0, const Point<2>& a1, const Point<2>& b0, const
   const Point<2>& bhi = xy_less(b1, b0) ? b0 : b1;
   if (alo != blo) return xy_less(alo, blo);
   return xy_less(ahi, bhi);
-}
-
-/// Z-order code of a grid position's top 32 bits per axis: the insertion order of the
-/// points (any order gives the same triangulation; this one keeps the walks short).
-std::uint64_t morton(const Position<2>& q) noexcept {
-  return detail::z_order(static_cast<std::uint32_t>(q[0] >> 20), static_cast<std::uint32_t>(q[1] >> 20));
 }
 
 /// Of the leaf's apex height; Triangle uses 0.95 of the off-center distance too.
@@ -114,90 +107,63 @@ std::vector<Point<2>> side_midpoints(const Box<2>& box, std::span<const Point<2>
   return out;
 }
 
+/// DynHPU (the seed's Figure 5) on a Delaunay triangulation: see hpu_mesh.hpp.
 class Refiner {
  public:
   Refiner(const Box<2>& box, double min_angle_deg, std::size_t max_vertices, HpuStats& stats)
-      : dt_(box), theta_(min_angle_deg), max_vertices_(max_vertices), stats_(stats) {
-    // The apex of the leaf sits at height ρ + k = 1 / (2 tan(θ/2)) above pq: the triangle
-    // p q c' has the angle θ at c' exactly, which rounding would judge bad again and again
-    // (at 30° the refinement then never ends). Like Triangle, place it a little lower
-    // (kApexFactor), so that its triangle is strictly better than the bound.
+      : box_(box), dt_(box), max_vertices_(max_vertices), stats_(stats) {
     apex_height_ = kApexFactor * 0.5 / std::tan(min_angle_deg * (std::numbers::pi / 360.0));
-    const double s = std::sin(min_angle_deg * (std::numbers::pi / 180.0));
-    sin2_theta_ = s * s;
+    // k = √(ρ² − 1/4) = 1 / (2 tan θ), a little lower (kLeafMargin): a leaf that is slightly
+    // too small only ever calls more pairs loose, so every angle of the result clears θ by
+    // more than the checker's rounding.
+    leaf_height_ = kLeafMargin * 0.5 / std::tan(min_angle_deg * (std::numbers::pi / 180.0));
+    lo_[0] = box.origin[0], lo_[1] = box.origin[1];
+    hi_[0] = box.origin[0] + box.side, hi_[1] = box.origin[1] + box.side;
+    for (Vid v = 0; v < 4; ++v) note_side(v);
   }
 
-  /// The side midpoints of step 2 (in (x, y) order), then the points in Morton order.
-  void insert_inputs(const Box<2>& box, std::span<const Point<2>> points, std::span<const Position<2>> qs) {
+  void insert_inputs(std::span<const Point<2>> points) {
     Tid hint = dt_.any_live();
-    for (const Point<2>& m : side_midpoints(box, points)) {
+    for (const Point<2>& m : side_midpoints(box_, points)) {
       created_.clear();
-      if (dt_.insert(m, hint, created_) && !created_.empty()) hint = created_.back();
+      if (const auto v = dt_.insert(m, hint, created_)) {
+        note_side(*v);
+        hint = created_.empty() ? hint : created_.back();
+      }
       ++stats_.side_splits;
     }
     std::vector<std::pair<std::uint64_t, std::size_t>> order(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) order[i] = {morton(qs[i]), i};
+    for (std::size_t i = 0; i < points.size(); ++i) order[i] = {morton_of(points[i]), i};
     std::sort(order.begin(), order.end());
     for (const auto& [code, i] : order) {
       created_.clear();
-      if (dt_.insert(points[i], hint, created_) && !created_.empty()) hint = created_.back();
-    }
-  }
-
-  /// Step 2's invariant after insert_inputs(): no box edge is encroached. It holds by
-  /// construction (side_midpoints); this pass would split any edge that is, and counts it.
-  void split_encroached_sides() {
-    std::vector<Tid> work;
-    for (Tid t = 0; t < dt_.num_slots(); ++t)
-      if (dt_.tri(t).alive) work.push_back(t);
-    while (!work.empty()) {
-      const Tid t = work.back();
-      work.pop_back();
-      const auto& T = dt_.tri(t);
-      if (!T.alive) continue;
-      for (int i = 0; i < 3; ++i) {
-        if (T.n[i] != Delaunay::kNone) continue;
-        const Vid a = T.v[next(i)], b = T.v[prev(i)];
-        // No vertex encroaches ab unless the one opposite it does (the circumcircle of t is
-        // empty and holds the half of ab's diametral disc inside the box when t's angle
-        // there is not obtuse).
-        if (!encroaches(dt_.point(a), dt_.point(b), dt_.point(T.v[i]))) continue;
-        created_.clear();
-        split_side(a, b, t);
-        work.insert(work.end(), created_.begin(), created_.end());
-        break;
+      if (const auto v = dt_.insert(points[i], hint, created_)) {
+        note_side(*v);
+        hint = created_.empty() ? hint : created_.back();
       }
     }
   }
 
   void refine() {
-    for (Tid t = 0; t < dt_.num_slots(); ++t)
-      if (dt_.tri(t).alive) consider(t);
-    struct Item {
-      Triangle key;
-      Tid t;
-      std::uint32_t gen;
-      bool operator<(const Item& o) const { return key < o.key; }
-    };
-    std::vector<Item> items;
-    while (!buckets_.empty()) {
-      std::vector<Entry> round = std::move(buckets_.begin()->second);
-      buckets_.erase(buckets_.begin());
-      items.clear();
-      for (const Entry& e : round) {
-        const auto& T = dt_.tri(e.t);
-        if (T.alive && T.gen == e.gen)
-          items.push_back({canonical_triangle(dt_.point(T.v[0]), dt_.point(T.v[1]), dt_.point(T.v[2])), e.t, e.gen});
-      }
-      if (items.empty()) continue;
+    // The first entries: every vertex at the class of its shortest edge, in Z-order.
+    std::vector<std::pair<std::uint64_t, Vid>> order(dt_.num_vertices());
+    for (Vid v = 0; v < order.size(); ++v) order[v] = {morton_of(dt_.point(v)), v};
+    std::sort(order.begin(), order.end(), [&](const auto& a, const auto& b) {
+      if (a.first != b.first) return a.first < b.first;
+      return xy_less(dt_.point(a.second), dt_.point(b.second));
+    });
+    for (const auto& [code, v] : order) schedule(v, std::numeric_limits<int>::min());
+    while (!queues_.empty()) {
+      const auto it = queues_.begin();
+      const int j = it->first;
+      batch_.swap(it->second);
+      queues_.erase(it);
       ++stats_.rounds;
-      std::sort(items.begin(), items.end());
-      items.erase(std::unique(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.key == b.key; }),
-                  items.end());
-      for (const Item& it : items) {
-        const auto& T = dt_.tri(it.t);
-        if (T.alive && T.gen == it.gen) split_triangle(it.t);
-      }
+      pairs_.clear();
+      seen_.clear();
+      for (const Vid v : batch_) collect(v, j);
+      for (const auto& [p, q] : pairs_) process(p, q, j);
+      batch_.clear();
     }
   }
 
@@ -205,80 +171,186 @@ class Refiner {
   const Delaunay& triangulation() const noexcept { return dt_; }
 
  private:
-  struct Entry {
-    Tid t;
-    std::uint32_t gen;
-  };
-  struct KeyEdge {
-    Vid p, q, t;  // the triangle p, q, t is counter-clockwise; pq is its shortest edge
-  };
-
-  /// corner_angle_deg, the checker's definition, decides; a filter on sin² of the smallest
-  /// angle (opposite the shortest edge: sin = 2·area / (product of the two longer edges))
-  /// settles all but the near-ties first, since three atan2 per new triangle cost more
-  /// than the rest of its making.
-  bool bad(Tid t) const noexcept {
-    const auto& v = dt_.tri(t).v;
-    const Point<2>&a = dt_.point(v[0]), &b = dt_.point(v[1]), &c = dt_.point(v[2]);
-    const double ux = b[0] - a[0], uy = b[1] - a[1], wx = c[0] - a[0], wy = c[1] - a[1];
-    const double m = std::max({std::abs(ux), std::abs(uy), std::abs(wx), std::abs(wy)});
-    if (m > 0x1p-200 && m < 0x1p200) {  // no overflow or underflow in fourth powers
-      const double cross = ux * wy - uy * wx;
-      const double lab = ux * ux + uy * uy, lac = wx * wx + wy * wy;
-      const double lbc = (wx - ux) * (wx - ux) + (wy - uy) * (wy - uy);
-      const double lmin = std::min({lab, lac, lbc});
-      const double longer = lab == lmin ? lac * lbc : lac == lmin ? lab * lbc : lab * lac;
-      const double sin2 = cross * cross / longer;
-      if (sin2 > sin2_theta_ * (1 + 1e-9)) return false;
-      if (sin2 < sin2_theta_ * (1 - 1e-9)) return true;
-    }
-    return corner_angle_deg(a, b, c) < theta_ || corner_angle_deg(b, c, a) < theta_ ||
-           corner_angle_deg(c, a, b) < theta_;
-  }
-
-  KeyEdge key_edge(Tid t) const noexcept {
-    const auto& v = dt_.tri(t).v;
-    int best = 0;
-    double best_len = 0;
-    for (int i = 0; i < 3; ++i) {
-      const Point<2>&a = dt_.point(v[next(i)]), &b = dt_.point(v[prev(i)]);
-      const double len = squared_length(a, b);
-      if (i == 0 || len < best_len ||
-          (len == best_len && pair_less(a, b, dt_.point(v[next(best)]), dt_.point(v[prev(best)])))) {
-        best = i;
-        best_len = len;
-      }
-    }
-    return KeyEdge{v[next(best)], v[prev(best)], v[best]};
-  }
+  static constexpr double kLeafMargin = 1.0 - 0x1p-30;
+  static constexpr Vid kNone = Delaunay::kNone;
 
   static int size_class(double squared) noexcept { return std::ilogb(squared) >> 1; }
+  int edge_class(Vid a, Vid b) const noexcept { return size_class(squared_length(dt_.point(a), dt_.point(b))); }
 
-  void consider(Tid t) {
-    if (!bad(t)) return;
-    const KeyEdge k = key_edge(t);
-    buckets_[size_class(squared_length(dt_.point(k.p), dt_.point(k.q)))].push_back({t, dt_.tri(t).gen});
+  std::uint64_t morton_of(const Point<2>& p) const noexcept {
+    const auto axis = [&](unsigned a) {
+      const double u = (p[a] - lo_[a]) / box_.side * 0x1p32;
+      return static_cast<std::uint32_t>(std::clamp(u, 0.0, 0x1p32 - 1));
+    };
+    return detail::z_order(axis(0), axis(1));
   }
 
-  void consider_created() {
-    for (Tid c : created_) consider(c);
+  bool on_boundary(Vid v) const noexcept {
+    const Point<2>& p = dt_.point(v);
+    return p[0] == lo_[0] || p[0] == hi_[0] || p[1] == lo_[1] || p[1] == hi_[1];
   }
 
-  /// The off-center of pq for the counter-clockwise triangle p, q, t, in one fixed sequence
-  /// of double operations, in a frame scaled by a power of two (exact) so that the products
-  /// neither overflow nor underflow in any accepted box.
+  /// Sides: 0 bottom, 1 right, 2 top, 3 left; keyed by the coordinate along the side.
+  void note_side(Vid v) {
+    const Point<2>& p = dt_.point(v);
+    if (p[1] == lo_[1]) sides_[0][p[0]] = v;
+    if (p[0] == hi_[0]) sides_[1][p[1]] = v;
+    if (p[1] == hi_[1]) sides_[2][p[0]] = v;
+    if (p[0] == lo_[0]) sides_[3][p[1]] = v;
+  }
+
+  /// Queues v at the class of its shortest edge, or at `floor` if that is later.
+  void schedule(Vid v, int floor) {
+    dt_.star(v, star_);
+    int c = std::numeric_limits<int>::max();
+    for (const Vid q : star_) c = std::min(c, edge_class(v, q));
+    queues_[std::max(c, floor)].push_back(v);
+  }
+
+  /// p→q is ccw-loose: its ccw-leaf holds no vertex. t is the third corner of the triangle on
+  /// its left (kNone: the outside of the box), u the one on its right. When pq is a Delaunay
+  /// edge, t and u are the vertices nearest the leaf on either side, so they decide.
+  bool loose(Vid p, Vid q, Vid t, Vid u) const noexcept {
+    if (t == kNone) return false;
+    const Point<2>&P = dt_.point(p), &Q = dt_.point(q);
+    if (pencil(P, Q, leaf_height_, dt_.point(t)) < 0) return false;
+    return u == kNone || pencil(P, Q, leaf_height_, dt_.point(u)) >= 0;
+  }
+
+  /// Figure 5, line 7, for one vertex: its loose pairs of class ≤ j, in (x, y) order of their
+  /// ends; then v goes to the queue of its next longer edge's class.
+  void collect(Vid v, int j) {
+    ++stats_.entries;
+    dt_.star(v, star_);
+    const bool cycle = !on_boundary(v);
+    const std::size_t d = star_.size();
+    int next_class = std::numeric_limits<int>::max();
+    local_.clear();
+    for (std::size_t i = 0; i < d; ++i) {
+      const Vid q = star_[i];
+      const int c = edge_class(v, q);
+      if (c > j) {
+        next_class = std::min(next_class, c);
+        continue;
+      }
+      const Vid left = i + 1 < d ? star_[i + 1] : cycle ? star_[0] : kNone;
+      const Vid right = i > 0 ? star_[i - 1] : cycle ? star_[d - 1] : kNone;
+      if (loose(v, q, left, right)) local_.push_back({v, q});
+      if (loose(q, v, right, left)) local_.push_back({q, v});
+    }
+    std::sort(local_.begin(), local_.end(), [&](const auto& a, const auto& b) {
+      if (dt_.point(a[0]) != dt_.point(b[0])) return xy_less(dt_.point(a[0]), dt_.point(b[0]));
+      return xy_less(dt_.point(a[1]), dt_.point(b[1]));
+    });
+    for (const auto& pr : local_)
+      if (seen_.insert((std::uint64_t{pr[0]} << 32) | pr[1]).second) pairs_.push_back(pr);
+    if (next_class != std::numeric_limits<int>::max()) queues_[next_class].push_back(v);
+  }
+
+  /// Figure 5, lines 10-14, for the ccw side of p→q.
+  void process(Vid p, Vid q, int j) {
+    for (;;) {
+      const auto e = dt_.left_of(p, q);
+      if (!e) return;
+      const auto [t, k] = *e;
+      const auto& T = dt_.tri(t);
+      const Vid tv = T.v[k];
+      Vid uv = kNone;
+      if (const Tid o = T.n[k]; o != kNone)
+        for (const Vid w : dt_.tri(o).v)
+          if (w != p && w != q) uv = w;
+      if (!loose(p, q, tv, uv)) return;
+      ++stats_.loose_pairs;
+      const auto [r, was_circumcentre] = off_center(dt_.point(p), dt_.point(q), dt_.point(tv));
+      if (!std::isfinite(r[0]) || !std::isfinite(r[1])) throw InvariantError("dynmesh: a non-finite off-center");
+      if (!(r[0] >= lo_[0] && r[0] <= hi_[0] && r[1] >= lo_[1] && r[1] <= hi_[1])) {
+        split_crossed(dt_.point(p), dt_.point(q), r, j);
+        continue;
+      }
+      const Delaunay::Walk w = dt_.walk(t, r);
+      if (w.exit_edge >= 0) throw InvariantError("dynmesh: an off-center in the box walked out of it");
+      if (dt_.vertex_at(w.t, r))
+        throw InputError(InputError::Kind::Resolution,
+                         "an off-center falls on the vertex " + format_exact(r[0]) + " " + format_exact(r[1]) +
+                             ": the spread is beyond the mesh's resolution");
+      dt_.cavity(w.t, r, cavity_);
+      dt_.cavity_box_edges(cavity_, sides_found_);
+      encroached_.clear();
+      for (const auto& s : sides_found_)
+        if (encroaches(dt_.point(s[0]), dt_.point(s[1]), r)) encroached_.push_back(s);
+      if (!encroached_.empty()) {
+        std::sort(encroached_.begin(), encroached_.end(), [&](const auto& x, const auto& y) {
+          return pair_less(dt_.point(x[0]), dt_.point(x[1]), dt_.point(y[0]), dt_.point(y[1]));
+        });
+        for (const auto& s : encroached_) split_side(s[0], s[1], j);
+        continue;
+      }
+      created_.clear();
+      const Vid rv = dt_.insert(r, cavity_, created_);
+      ++stats_.off_centers;
+      if (was_circumcentre) ++stats_.circumcentres;
+      check_size();
+      schedule(rv, j);
+      return;
+    }
+  }
+
+  /// The off-center r of a loose pair lies outside the box: split the box edge that the
+  /// segment from pq's midpoint to r crosses first (both ends lie in the leaf, so the
+  /// crossing does too, and halving the edges around it puts a vertex into the leaf).
+  void split_crossed(const Point<2>& p, const Point<2>& q, const Point<2>& r, int j) {
+    const double m[2] = {0.5 * p[0] + 0.5 * q[0], 0.5 * p[1] + 0.5 * q[1]};
+    int side = -1;
+    double best = 2;
+    const auto consider = [&](int s, unsigned axis, double bound) {
+      const double f = (bound - m[axis]) / (r[axis] - m[axis]);
+      if (f < best) best = f, side = s;
+    };
+    if (r[1] < lo_[1]) consider(0, 1, lo_[1]);
+    if (r[0] > hi_[0]) consider(1, 0, hi_[0]);
+    if (r[1] > hi_[1]) consider(2, 1, hi_[1]);
+    if (r[0] < lo_[0]) consider(3, 0, lo_[0]);
+    const unsigned along = side % 2 == 0 ? 0 : 1;
+    const double x = std::clamp(m[along] + best * (r[along] - m[along]), lo_[along], hi_[along]);
+    const auto& line = sides_[side];
+    auto it = line.upper_bound(x);
+    if (it == line.end()) --it;
+    if (it == line.begin()) ++it;
+    split_side(std::prev(it)->second, it->second, j);
+  }
+
+  void split_side(Vid a, Vid b, int j) {
+    const Point<2> mid = side_midpoint(dt_.point(a), dt_.point(b));
+    created_.clear();
+    const auto v = dt_.insert(mid, dt_.incident(a), created_);
+    if (!v) throw InvariantError("dynmesh: a box edge's midpoint is already a vertex");
+    note_side(*v);
+    ++stats_.side_splits;
+    check_size();
+    schedule(*v, j);
+  }
+
+  void check_size() const {
+    if (dt_.num_vertices() > max_vertices_)
+      throw InvariantError("dynmesh: hpu refinement did not terminate (over " + std::to_string(max_vertices_) +
+                           " vertices)");
+  }
+
   struct OffCenter {
     Point<2> at;
-    bool circumcentre;  // the circumcentre rather than the leaf's apex
+    bool circumcentre;
   };
+  /// The off-center of pq for the counter-clockwise triangle p, q, t, t being pq's Delaunay
+  /// neighbour on the left: the apex of the leaf, or the circumcentre of p, q, t when that is
+  /// no farther from pq's midpoint (the crescent holds t). One fixed sequence of double
+  /// operations, in a frame scaled by a power of two (exact) so that the products neither
+  /// overflow nor underflow in any accepted box.
   OffCenter off_center(const Point<2>& p, const Point<2>& q, const Point<2>& t) const noexcept {
     double bx = q[0] - p[0], by = q[1] - p[1], cx = t[0] - p[0], cy = t[1] - p[1];
     const int e = std::ilogb(std::max({std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)}));
     bx = std::ldexp(bx, -e), by = std::ldexp(by, -e), cx = std::ldexp(cx, -e), cy = std::ldexp(cy, -e);
-    // The midpoint of pq and the apex c' = m + (ρ + k)·J(q − p), J(x, y) = (−y, x).
     const double mx = 0.5 * bx, my = 0.5 * by;
     const double ax = mx - apex_height_ * by, ay = my + apex_height_ * bx;
-    // The circumcentre of p, q, t (relative to p).
     const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
     const double d = 2.0 * (bx * cy - by * cx);
     const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
@@ -289,81 +361,19 @@ class Refiner {
     return OffCenter{Point<2>{p[0] + std::ldexp(rx, e), p[1] + std::ldexp(ry, e)}, circumcentre};
   }
 
-  void check_size() const {
-    if (dt_.num_vertices() > max_vertices_)
-      throw InvariantError("dynmesh: hpu refinement did not terminate (over " + std::to_string(max_vertices_) +
-                           " vertices)");
-  }
-
-  /// Splits the box edge ab (a, b adjacent on a side) at its midpoint; new triangles in created_.
-  void split_side(Vid a, Vid b, Tid hint) {
-    const Point<2> mid = side_midpoint(dt_.point(a), dt_.point(b));
-    if (!dt_.insert(mid, hint, created_)) throw InvariantError("dynmesh: a box edge's midpoint is already a vertex");
-    ++stats_.side_splits;
-    check_size();
-  }
-
-  void requeue(Tid t) {
-    if (dt_.tri(t).alive) consider(t);
-  }
-
-  void split_triangle(Tid t) {
-    const KeyEdge k = key_edge(t);
-    const auto [r, was_circumcentre] = off_center(dt_.point(k.p), dt_.point(k.q), dt_.point(k.t));
-    if (!std::isfinite(r[0]) || !std::isfinite(r[1])) throw InvariantError("dynmesh: a non-finite off-center");
-    const std::uint32_t gen = dt_.tri(t).gen;
-    const auto still = [&] { return dt_.tri(t).alive && dt_.tri(t).gen == gen; };
-    const Delaunay::Walk w = dt_.walk(t, r);
-    if (w.exit_edge >= 0) {
-      // Only rounding puts an off-center outside the box (no box edge is encroached, so
-      // circumcentres lie inside it): split the side the walk left by.
-      const auto& T = dt_.tri(w.t);
-      created_.clear();
-      split_side(T.v[next(w.exit_edge)], T.v[prev(w.exit_edge)], w.t);
-      consider_created();
-      if (still()) requeue(t);
-      return;
-    }
-    if (dt_.vertex_at(w.t, r))
-      throw InputError(InputError::Kind::Resolution,
-                       "an off-center falls on the vertex " + format_exact(r[0]) + " " + format_exact(r[1]) +
-                           ": the spread is beyond the mesh's resolution");
-    dt_.cavity(w.t, r, cavity_);
-    dt_.cavity_box_edges(cavity_, sides_);
-    encroached_.clear();
-    for (const auto& s : sides_)
-      if (encroaches(dt_.point(s[0]), dt_.point(s[1]), r)) encroached_.push_back(s);
-    if (!encroached_.empty()) {
-      std::sort(encroached_.begin(), encroached_.end(), [&](const auto& x, const auto& y) {
-        return pair_less(dt_.point(x[0]), dt_.point(x[1]), dt_.point(y[0]), dt_.point(y[1]));
-      });
-      Tid hint = w.t;
-      for (const auto& s : encroached_) {
-        created_.clear();
-        split_side(s[0], s[1], dt_.tri(hint).alive ? hint : dt_.any_live());
-        consider_created();
-        if (!created_.empty()) hint = created_.front();
-      }
-      if (still()) requeue(t);
-      return;
-    }
-    created_.clear();
-    dt_.insert(r, cavity_, created_);
-    ++stats_.off_centers;
-    if (was_circumcentre) ++stats_.circumcentres;
-    check_size();
-    consider_created();
-  }
-
+  Box<2> box_;
   Delaunay dt_;
-  double theta_;
-  double apex_height_ = 0;
-  double sin2_theta_ = 0;
+  double lo_[2], hi_[2];
+  double apex_height_ = 0, leaf_height_ = 0;
   std::size_t max_vertices_;
   HpuStats& stats_;
-  std::map<int, std::vector<Entry>> buckets_;
+  std::map<int, std::vector<Vid>> queues_;
+  std::map<double, Vid> sides_[4];
+  std::vector<Vid> batch_, star_;
+  std::vector<std::array<Vid, 2>> pairs_, local_;
+  std::unordered_set<std::uint64_t> seen_;
   std::vector<Tid> created_, cavity_;
-  std::vector<std::array<Vid, 2>> sides_, encroached_;
+  std::vector<std::array<Vid, 2>> sides_found_, encroached_;
 };
 
 void validate_min_angle(double deg) {
@@ -386,8 +396,7 @@ HpuMesh::HpuMesh(const Box<2>& box, std::span<const Point<2>> points, double min
   // A guard against a refinement that runs away, far above any size the tests have seen.
   const std::size_t max_vertices = 1000 * (points.size() + 4) + (std::size_t{1} << 20);
   Refiner refiner(box, min_angle_deg, max_vertices, stats_);
-  refiner.insert_inputs(box, points, qs);
-  refiner.split_encroached_sides();
+  refiner.insert_inputs(points);
   refiner.refine();
   triangles_ = refiner.triangles();
   stats_.triangles_made = refiner.triangulation().num_made();

@@ -15,6 +15,7 @@
 #include "dynmesh/predicates.hpp"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Exact_rational.h>
 
 namespace dynmesh {
 
@@ -37,6 +38,13 @@ int detail::incircle_exact(const Point<2>& a, const Point<2>& b, const Point<2>&
   // CGAL evaluates the full lifted determinant, so collinear a, b, c get its sign, as promised.
   return static_cast<int>(Kernel::Side_of_oriented_circle_2()(to_kernel(a), to_kernel(b),
                                                               to_kernel(c), to_kernel(d)));
+}
+
+int detail::pencil_exact(const Point<2>& p, const Point<2>& q, double h, const Point<2>& x) noexcept {
+  using Q = CGAL::Exact_rational;
+  const Q px(p[0]), py(p[1]), qx(q[0]), qy(q[1]), xx(x[0]), xy(x[1]), hh(h);
+  const Q det = (xx - px) * (xx - qx) + (xy - py) * (xy - qy) - 2 * hh * ((qx - px) * (xy - py) - (qy - py) * (xx - px));
+  return CGAL::sign(det);
 }
 
 bool encroaches(const Point<2>& a, const Point<2>& b, const Point<2>& x) noexcept {

@@ -103,6 +103,48 @@ TEST(HpuDelaunay, CocircularGridAndPointsOnTheSides) {
   }
 }
 
+/// star() and left_of() against the triangle list: the neighbours of each vertex, in
+/// counter-clockwise order, and the triangle on the left of each directed edge.
+TEST(HpuDelaunay, StarsAndLeftTrianglesMatchTheTriangles) {
+  const Box<2> box{{0, 0}, 6};
+  std::vector<Point<2>> pts;
+  for (int i = 0; i <= 6; ++i)  // a cocircular grid with points on the sides, and random ones
+    for (int j = 0; j <= 6; ++j) pts.push_back({double(i), double(j)});
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(0.0, 6.0);
+  for (int i = 0; i < 200; ++i) pts.push_back({u(rng), u(rng)});
+  Delaunay dt(box);
+  std::vector<Delaunay::Tid> created;
+  for (const auto& p : pts) dt.insert(p, dt.any_live(), created);
+  dt.check_invariants();
+  std::vector<std::vector<std::pair<Delaunay::Vid, Delaunay::Vid>>> left(dt.num_vertices());  // (q, third)
+  for (Delaunay::Tid t = 0; t < dt.num_slots(); ++t) {
+    const auto& T = dt.tri(t);
+    if (!T.alive) continue;
+    for (int i = 0; i < 3; ++i) left[T.v[i]].push_back({T.v[(i + 1) % 3], T.v[(i + 2) % 3]});
+  }
+  std::vector<Delaunay::Vid> star;
+  for (Delaunay::Vid v = 0; v < dt.num_vertices(); ++v) {
+    SCOPED_TRACE("vertex " + std::to_string(v));
+    dt.star(v, star);
+    const auto& p = dt.point(v);
+    const bool boundary = p[0] == 0 || p[0] == 6 || p[1] == 0 || p[1] == 6;
+    // One triangle per consecutive pair of neighbours (and per wrap-around for an interior vertex).
+    ASSERT_EQ(star.size(), left[v].size() + (boundary ? 1 : 0));
+    for (std::size_t i = 0; i + (boundary ? 1 : 0) < star.size(); ++i) {
+      const auto q = star[i], r = star[(i + 1) % star.size()];
+      EXPECT_NE(std::find(left[v].begin(), left[v].end(), std::pair{q, r}), left[v].end());
+      const auto e = dt.left_of(v, q);
+      ASSERT_TRUE(e);
+      EXPECT_EQ(dt.tri(e->first).v[e->second], r);
+    }
+    if (boundary) {
+      EXPECT_FALSE(dt.left_of(v, star.back()));  // the outside is on its left
+    }
+    EXPECT_FALSE(dt.left_of(v, v));
+  }
+}
+
 TEST(HpuDelaunay, CheckerCatchesABrokenTriangulation) {
   Delaunay dt(Box<2>{{0, 0}, 1});
   std::vector<Delaunay::Tid> created;

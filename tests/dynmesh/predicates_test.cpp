@@ -32,6 +32,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <span>
 #include <string>
@@ -560,6 +561,54 @@ TEST(Predicates, MixedMagnitudesAgreeWithGmp) {
   const Tally c = check(circle);
   EXPECT_AGREES(c);
   EXPECT_GT(c.exact_zeros, 0u);
+}
+
+// --- the pencil of circles through p and q (DynHPU's leaves) -------------------------------
+
+/// The definition, in rationals: is |x − c|² − |p − c|² (c = m + h·J(q − p)) positive?
+int pencil_reference(const Point<2>& p, const Point<2>& q, double h, const Point<2>& x) {
+  const mpq_class px(p[0]), py(p[1]), qx(q[0]), qy(q[1]), xx(x[0]), xy(x[1]), hh(h);
+  const mpq_class cx = (px + qx) / 2 - hh * (qy - py), cy = (py + qy) / 2 + hh * (qx - px);
+  const mpq_class d = (xx - cx) * (xx - cx) + (xy - cy) * (xy - cy) - (px - cx) * (px - cx) - (py - cy) * (py - cy);
+  return sgn(d);
+}
+
+TEST(Predicates, PencilAgreesWithTheCircleDefinition) {
+  constexpr std::uint64_t kSeed = 20261123;
+  SCOPED_TRACE(seed_trace(kSeed));
+  RandomPoints gen(kSeed);
+  std::mt19937_64 rng(kSeed);
+  // The leaves' and apexes' heights at 1°, 20.7° and 30°, exact dyadic ones, 0 and negative.
+  const std::array<double, 9> heights{0.5 / std::tan(std::numbers::pi / 180), 0.5 / std::tan(20.7 * std::numbers::pi / 180),
+                                      0.5 / std::tan(std::numbers::pi / 6), 0.95 * 0.5 / std::tan(15 * std::numbers::pi / 180),
+                                      0.5, 1.0, 0.0, -0.75, 3.0};
+  std::size_t zeros = 0;
+  for (std::size_t i = 0; i < kRandomCases / 4; ++i) {
+    const int mix = gen.next_mix();
+    gen.recenter();
+    const Point<2> p = gen.point(mix), q = gen.point(mix), x = gen.point(mix);
+    const double h = heights[rng() % heights.size()];
+    const int want = pencil_reference(p, q, h, x);
+    zeros += want == 0;
+    ASSERT_EQ(dynmesh::pencil(p, q, h, x), want) << dynmesh::to_string<2>(p) << dynmesh::to_string<2>(q) << " h=" << h
+                                                  << " x=" << dynmesh::to_string<2>(x);
+  }
+  EXPECT_GT(zeros, 0u);  // p, q or x repeated, or on the circle: the exact path is reached
+  // Points on a circle with a dyadic centre, and their neighbours one ulp away: p = (0, 0),
+  // q = (2, 0), h = 0.5 has centre (1, 1) and radius √2.
+  const Point<2> p{0, 0}, q{2, 0};
+  for (const Point<2>& on : {Point<2>{2, 2}, Point<2>{0, 2}, Point<2>{1 + std::sqrt(2.0), 1}}) {
+    for (int dx = -2; dx <= 2; ++dx)
+      for (int dy = -2; dy <= 2; ++dy) {
+        Point<2> x = on;
+        for (int k = 0; k < std::abs(dx); ++k) x[0] = std::nextafter(x[0], dx < 0 ? -1e300 : 1e300);
+        for (int k = 0; k < std::abs(dy); ++k) x[1] = std::nextafter(x[1], dy < 0 ? -1e300 : 1e300);
+        EXPECT_EQ(dynmesh::pencil(p, q, 0.5, x), pencil_reference(p, q, 0.5, x)) << dynmesh::to_string<2>(x);
+      }
+  }
+  EXPECT_EQ(dynmesh::pencil(p, q, 0.5, Point<2>{2, 2}), 0);
+  EXPECT_EQ(dynmesh::pencil(p, q, 0.5, Point<2>{1, 1}), -1);
+  EXPECT_EQ(dynmesh::pencil(p, q, 0.5, Point<2>{1, -1}), 1);
 }
 
 }  // namespace

@@ -8,48 +8,51 @@
 // a .poly file. It is meant as the oracle and the baseline of the self-adjusting hpu mesh,
 // which does not exist yet: see "Next" below.
 //
-// The algorithm, with the choices the seed leaves open (ρ = 1/(2 sin θ)):
-//   1. T := the Delaunay triangulation of the corners and the points (unique: degenerate
-//      cases follow a symbolic perturbation by (x, y) rank, src/delaunay.hpp).
-//   2. Sides: while a vertex lies strictly inside the diametral circle of a box edge
-//      (encroaches it), split the edge at its midpoint (computed from its (x, y)-smaller
-//      end). The result is the unique fixed point (midpoints never encroach, and halving an
-//      edge only shrinks its circle); it is computed from the points alone, one path down
-//      the halvings per point, and inserted before them.
-//   3. A triangle is bad when one of its angles is below θ, computed by corner_angle_deg,
-//      the checker's own definition (so "no bad triangle" is exactly "the checker's bound
-//      holds"). Its key edge pq is its shortest (ties: the edge with the smaller ends in
-//      (x, y) order), oriented so that the triangle lies on its left; its size class is
-//      ⌊log2 |pq|⌋ (from the double exponent of |pq|²). Every bad triangle is in the
-//      bucket of its class.
-//   4. Rounds: take the smallest class holding a live bad triangle; its round is every
-//      live bad triangle of that class, in the order of their canonical corners. Each, if
-//      still live, gets its off-center r: the apex c' = m + (ρ + k)·J(q − p) of pq's leaf
-//      (k = √(ρ² − 1/4), m the midpoint, J the +90° turn), or the circumcentre when that
-//      is no farther from m than c' (Üngör's off-center; DESIGN.md's crescent rule picks
-//      the same point when the triangle's third corner is pq's Delaunay neighbour).
-//      Triangles made by the round go to their buckets and are handled by later rounds:
-//      rounds are the FIFO of the seed taken one generation at a time.
-//   5. Sides again: if r lies outside the box, the box edge the walk towards r leaves by is
-//      split at its midpoint; if r encroaches box edges on its cavity's boundary, those are
-//      split (in (x, y) order of their ends) instead of inserting r. The triangle, if still
-//      live, goes back to its bucket.
-//   6. When no bucket holds a live triangle, the triangulation is the mesh.
-// Each step depends only on the current vertex set and on keys made of coordinates, never
-// on insertion order or addresses, so the mesh is a function of (box, point set, θ).
-// Constructions are plain doubles in one fixed sequence of operations.
+// The algorithm is the seed's Figure 5 on loose pairs, with the choices it leaves open made
+// as follows (ρ = 1/(2 sin θ), k = √(ρ² − 1/4) = 1/(2 tan θ); DESIGN.md, "DynHPU"):
+//   1. Vertices: the box's corners, the points, and the midpoints that splitting encroached
+//      box edges adds (an edge's diametral disc holds its halves', and a point strictly
+//      inside one projects strictly inside the edge, so these form one path down the
+//      halvings per point, computed from the points alone). Candidates are edges of their
+//      Delaunay triangulation (unique: degenerate cases follow a symbolic perturbation by
+//      (x, y) rank, src/delaunay.hpp).
+//   2. Loose: p→q is ccw-loose when no vertex lies strictly inside its ccw-leaf, the disc
+//      through p and q with centre m + k·J(q − p) (m the midpoint, J the +90° turn), decided
+//      exactly by predicates.hpp's pencil(). For a Delaunay edge pq the leaf is empty exactly
+//      when neither neighbour (left t, right u) is inside it. k is taken 2^−30 lower than
+//      its value, so that "no loose pair" leaves every angle above θ by more than rounding.
+//      The outside of a box side is never a side of a pair.
+//   3. Classes: the class of pq is ⌊log2 |pq|⌋ (from the double exponent of |pq|²). Queue
+//      entries are vertices, Q_j a FIFO per class. A vertex enters at the class of its
+//      shortest edge; its entry in Q_j collects its loose pairs of class ≤ j (both sides,
+//      in (x, y) order of their ends) and re-enters it in the queue of its next longer
+//      edge's class. A new vertex enters at max(current class, its shortest edge's class).
+//      Since edges between old vertices only vanish and every new edge has a new end, each
+//      pair is collected at its class while it is an edge, and nothing loose remains.
+//   4. A while-iteration of class j (a "round") takes all of Q_j, collects, de-duplicates the
+//      pairs in collection order and processes them in that order: a pair still loose gets
+//      its off-center r, the apex c' = m + h·J(q − p) with h = 0.95·(ρ + k) as in Triangle
+//      (at h = ρ + k the new triangle's angle is θ exactly, which rounding would judge bad
+//      again), or the circumcentre of p, q, t when that is no farther from m (the crescent
+//      holds t). Entries made meanwhile go to later rounds.
+//   5. Sides are segments, as Triangle treats a .poly file: if r lies outside the box, the
+//      box edge crossed first by the segment from m to r is split at its midpoint (computed
+//      from the edge's (x, y)-smaller end); if r encroaches box edges (its cavity's sides),
+//      those are split instead; then the pair is tried again. The crossing lies in the
+//      leaf, so halving around it ends with a vertex in the leaf.
+//   6. When no queue holds an entry, the Delaunay triangulation is the mesh.
+// Every decision is a predicate on the current vertex set, or a key made of coordinates,
+// never insertion order or addresses, so the mesh is a function of (box, point set, θ); the
+// tests shuffle and reverse the input and compare bits. The triangulation only answers the
+// questions quickly (stars, neighbours, cavities): the self-adjusting version answers the
+// same questions from the quadtree's cells and must reach the same mesh.
 //
-// Next: the self-adjusting version needs every decision local, and these are not: whether a
-// bad triangle is still live depends on its circumcircle, which has no bound. The seed's
-// formulation is local by construction (loose pairs tested on leaves of radius ρ|pq|, the
-// crescent rule bounding the circumcentre used, points kept in quadtree cells by class), so
-// the twin is to be rewritten in that form, with this one as its reference for size and
-// quality, and then written on the runtime in the tree's trace.
+// Next: the self-adjusting version (DynamicMesh, Postprocess::Hpu) in the tree's trace.
 //
 // Invariants: check_invariants(): the triangulation's own invariants (Delaunay, tiling) and
 // the mesh contract through check_mesh (every angle ≥ θ, every input a vertex).
 // Complexity: O(n lg n + m) expected for m output vertices (walks from nearby triangles,
-// cavities of expected O(1) size), plus O(m log m) for the rounds' sorting.
+// cavities of expected O(1) size, O(1) entries per vertex, stars of O(1) size).
 // Paper: Acar & Hudson, Figure 5 and Appendix A (DynHPU); Har-Peled & Üngör, "A
 // time-optimal Delaunay refinement algorithm in two dimensions" (2005); Üngör,
 // "Off-centers" (2004); Ruppert (1995) and Shewchuk's Triangle for segments.
@@ -79,6 +82,8 @@ struct HpuStats {
   std::size_t rounds = 0;
   std::size_t triangles_made = 0;  // by every insertion, the final ones included: the work
   std::size_t max_cavity = 0;      // the most triangles one insertion replaced
+  std::size_t entries = 0;         // queue entries processed (vertex, class)
+  std::size_t loose_pairs = 0;     // loose pairs handled (each inserts or splits a side)
 };
 
 class HpuMesh {

@@ -29,11 +29,15 @@ namespace detail {
 /// The exact signs (CGAL), for the cases the inline filters below cannot settle.
 int orient2d_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept;
 int incircle_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept;
+int pencil_exact(const Point<2>& p, const Point<2>& q, double h, const Point<2>& x) noexcept;
 /// Shewchuk's bounds, ε = 2^−53: the error of the double evaluations below is at most
 /// bound × permanent when no intermediate value overflows or underflows.
 inline constexpr double kEpsilon = 0x1p-53;
 inline constexpr double kOrientBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
 inline constexpr double kIncircleBound = (10.0 + 96.0 * kEpsilon) * kEpsilon;
+/// For pencil(): a term carries at most 5ε of relative error (a rounded difference in each
+/// factor, the product, the h product, a sum) and the final difference ε more; 12ε leaves room.
+inline constexpr double kPencilBound = 12.0 * kEpsilon;
 /// The bounds assume that no product underflows or overflows. Differences of the
 /// coordinates that are 0 or within [2^−lo, 2^hi] guarantee it: for orient2d (degree 2)
 /// products of at least 2^−1000; for incircle (degree 4) lifts and products of at least
@@ -89,6 +93,30 @@ inline int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, con
     if (-det > bound) return -1;
   }
   return detail::incircle_exact(a, b, c, d);
+}
+
+/// The circles through p and q form a pencil; its member with centre m + h·J(q − p) (m the
+/// midpoint, J the +90° turn) is the ccw-leaf of pq for h = k and the circle of the apex
+/// for h = ρ + k (DESIGN.md, DynHPU). Returns the sign of (x−p)·(x−q) − 2h·orient(p, q, x),
+/// which is −1 exactly when x lies strictly inside that circle, 0 on it, +1 outside. Exact
+/// for finite p, q, x and h.
+inline int pencil(const Point<2>& p, const Point<2>& q, double h, const Point<2>& x) noexcept {
+  const double apx = x[0] - p[0], apy = x[1] - p[1], aqx = x[0] - q[0], aqy = x[1] - q[1];
+  const double bx = q[0] - p[0], by = q[1] - p[1];
+  const double d1 = apx * aqx, d2 = apy * aqy;
+  const double c1 = bx * apy, c2 = by * apx;
+  const double h2 = 2.0 * h;
+  const double det = (d1 + d2) - h2 * (c1 - c2);
+  const double permanent = std::fabs(d1) + std::fabs(d2) + std::fabs(h2) * (std::fabs(c1) + std::fabs(c2));
+  constexpr double lo = 0x1p-400, hi = 0x1p400;
+  if (detail::in_range(apx, lo, hi) && detail::in_range(apy, lo, hi) && detail::in_range(aqx, lo, hi) &&
+      detail::in_range(aqy, lo, hi) && detail::in_range(bx, lo, hi) && detail::in_range(by, lo, hi) &&
+      detail::in_range(h, 0x1p-60, 0x1p60)) {
+    const double bound = detail::kPencilBound * permanent;
+    if (det > bound) return 1;
+    if (-det > bound) return -1;
+  }
+  return detail::pencil_exact(p, q, h, x);
 }
 
 /// True when x lies strictly inside the circle with diameter ab, i.e. (a−x)·(b−x) < 0: x
