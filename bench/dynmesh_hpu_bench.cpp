@@ -8,7 +8,7 @@
 // angle >= the bound, tiling, inputs present: checked = 1), and reported with its size, its
 // ratio to the peers' sizes, and its angle histogram (10-degree bins, every angle of every
 // triangle). Output: a table, or CSV with --csv:
-//   input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,checked
+//   input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,entries_per_vertex,checked
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
@@ -56,10 +56,11 @@ int main(int argc, char** argv) {
   app.add_flag("--histogram", histogram, "print each mesh's angle histogram");
   CLI11_PARSE(app, argc, argv);
 
-  if (csv) std::printf("input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,checked\n");
+  if (csv)
+    std::printf("input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,entries_per_vertex,checked\n");
   else
-    std::printf("%-9s %6s %9s %9s %9s %8s %8s %9s %6s %7s\n", "input", "angle", "seconds", "vertices", "triangles",
-                "vs_Tri", "vs_CGAL", "min_angle", "rounds", "checked");
+    std::printf("%-9s %6s %9s %9s %9s %8s %8s %9s %6s %8s %7s\n", "input", "angle", "seconds", "vertices", "triangles",
+                "vs_Tri", "vs_CGAL", "min_angle", "rounds", "entries", "checked");
   bool all_ok = true;
   for (const std::size_t n : ns) {
     const auto pts = python_uniform(n, 1);
@@ -82,14 +83,15 @@ int main(int argc, char** argv) {
       const std::string input = "unif1e" + std::to_string(n == 10000 ? 4 : n == 100000 ? 5 : 0);
       const double vt = double(mesh.num_vertices()) / peer.triangle_vertices;
       const double vc = double(mesh.num_vertices()) / peer.cgal_vertices;
+      const double per_vertex = double(stats.entries) / double(mesh.num_vertices());  // queue entries
       if (csv)
-        std::printf("%s,%.1f,%.4f,%zu,%zu,%.4f,%.4f,%.3f,%zu,%d\n", input.c_str(), peer.angle, bench::median(times),
-                    mesh.num_vertices(), mesh.num_triangles(), vt, vc, report.min_angle_deg, stats.rounds,
-                    report.ok() ? 1 : 0);
-      else
-        std::printf("%-9s %6.1f %9.4f %9zu %9zu %8.3f %8.3f %9.3f %6zu %7d\n", input.c_str(), peer.angle,
+        std::printf("%s,%.1f,%.4f,%zu,%zu,%.4f,%.4f,%.3f,%zu,%.3f,%d\n", input.c_str(), peer.angle,
                     bench::median(times), mesh.num_vertices(), mesh.num_triangles(), vt, vc, report.min_angle_deg,
-                    stats.rounds, report.ok() ? 1 : 0);
+                    stats.rounds, per_vertex, report.ok() ? 1 : 0);
+      else
+        std::printf("%-9s %6.1f %9.4f %9zu %9zu %8.3f %8.3f %9.3f %6zu %8.3f %7d\n", input.c_str(), peer.angle,
+                    bench::median(times), mesh.num_vertices(), mesh.num_triangles(), vt, vc, report.min_angle_deg,
+                    stats.rounds, per_vertex, report.ok() ? 1 : 0);
       if (histogram) {
         const MeshStats ms = mesh_stats(mesh);
         std::printf("  angle histogram (%s, %.1f deg):", input.c_str(), peer.angle);

@@ -11,6 +11,7 @@
 #include <unordered_set>
 #include <numbers>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -152,7 +153,12 @@ class Refiner {
       if (a.first != b.first) return a.first < b.first;
       return xy_less(dt_.point(a.second), dt_.point(b.second));
     });
-    for (const auto& [code, v] : order) schedule(v, std::numeric_limits<int>::min());
+    for (const auto& [code, v] : order) {
+      dt_.star(v, star_);
+      int c = std::numeric_limits<int>::max();
+      for (const Vid q : star_) c = std::min(c, edge_class(v, q));
+      queues_[c].push_back({v, true});
+    }
     while (!queues_.empty()) {
       const auto it = queues_.begin();
       const int j = it->first;
@@ -161,7 +167,7 @@ class Refiner {
       ++stats_.rounds;
       pairs_.clear();
       seen_.clear();
-      for (const Vid v : batch_) collect(v, j);
+      for (const Entry& e : batch_) collect(e.v, j, e.birth);
       for (const auto& [p, q] : pairs_) process(p, q, j);
       batch_.clear();
     }
@@ -199,12 +205,25 @@ class Refiner {
     if (p[0] == lo_[0]) sides_[3][p[1]] = v;
   }
 
-  /// Queues v at the class of its shortest edge, or at `floor` if that is later.
-  void schedule(Vid v, int floor) {
-    dt_.star(v, star_);
-    int c = std::numeric_limits<int>::max();
-    for (const Vid q : star_) c = std::min(c, edge_class(v, q));
-    queues_[std::max(c, floor)].push_back(v);
+  /// A queue entry: a vertex, and whether this is its first (it then collects its shorter
+  /// pairs too: a side's midpoint can have edges of classes already done).
+  struct Entry {
+    Vid v;
+    bool birth;
+  };
+
+  /// The squared circumradius of a, b, c in one fixed sequence of double operations, from
+  /// the corner that is smallest in (x, y) order, so that any reader of the same triangle
+  /// gets the same bits.
+  double circumradius2(Vid a, Vid b, Vid c) const noexcept {
+    const Point<2>*P = &dt_.point(a), *Q = &dt_.point(b), *R = &dt_.point(c);
+    if (xy_less(*Q, *P) && xy_less(*Q, *R)) std::tie(P, Q, R) = std::tuple{Q, R, P};
+    else if (xy_less(*R, *P) && xy_less(*R, *Q)) std::tie(P, Q, R) = std::tuple{R, P, Q};
+    const double bx = (*Q)[0] - (*P)[0], by = (*Q)[1] - (*P)[1], cx = (*R)[0] - (*P)[0], cy = (*R)[1] - (*P)[1];
+    const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+    const double d = 2.0 * (bx * cy - by * cx);
+    const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
+    return ux * ux + uy * uy;
   }
 
   /// p→q is ccw-loose: its ccw-leaf holds no vertex. t is the third corner of the triangle on
@@ -217,22 +236,24 @@ class Refiner {
     return u == kNone || pencil(P, Q, leaf_height_, dt_.point(u)) >= 0;
   }
 
-  /// Figure 5, line 7, for one vertex: its loose pairs of class ≤ j, in (x, y) order of their
-  /// ends; then v goes to the queue of its next longer edge's class.
-  void collect(Vid v, int j) {
+  /// Figure 5, line 7, for one vertex: its loose pairs of class j (≤ j at its first entry),
+  /// in (x, y) order of their ends. v enters Q_{j+1} unless it has no edge of a class above j
+  /// and no triangle whose circumradius exceeds 2^{j+1}: a rule that reads only the vertices
+  /// within 2^{j+2} of v, so that the self-adjusting version decides it from nearby cells.
+  void collect(Vid v, int j, bool birth) {
     ++stats_.entries;
     dt_.star(v, star_);
     const bool cycle = !on_boundary(v);
     const std::size_t d = star_.size();
-    int next_class = std::numeric_limits<int>::max();
+    bool go_on = false;
+    const double big = std::ldexp(1.0, 2 * (j + 1));
     local_.clear();
     for (std::size_t i = 0; i < d; ++i) {
       const Vid q = star_[i];
       const int c = edge_class(v, q);
-      if (c > j) {
-        next_class = std::min(next_class, c);
-        continue;
-      }
+      if (i + 1 < d || cycle) go_on = go_on || circumradius2(v, q, star_[(i + 1) % d]) > big;
+      if (c > j) go_on = true;
+      if (birth ? c > j : c != j) continue;
       const Vid left = i + 1 < d ? star_[i + 1] : cycle ? star_[0] : kNone;
       const Vid right = i > 0 ? star_[i - 1] : cycle ? star_[d - 1] : kNone;
       if (loose(v, q, left, right)) local_.push_back({v, q});
@@ -244,7 +265,7 @@ class Refiner {
     });
     for (const auto& pr : local_)
       if (seen_.insert((std::uint64_t{pr[0]} << 32) | pr[1]).second) pairs_.push_back(pr);
-    if (next_class != std::numeric_limits<int>::max()) queues_[next_class].push_back(v);
+    if (go_on) queues_[j + 1].push_back({v, false});
   }
 
   /// Figure 5, lines 10-14, for the ccw side of p→q.
@@ -290,7 +311,7 @@ class Refiner {
       ++stats_.off_centers;
       if (was_circumcentre) ++stats_.circumcentres;
       check_size();
-      schedule(rv, j);
+      queues_[j].push_back({rv, true});
       return;
     }
   }
@@ -327,7 +348,7 @@ class Refiner {
     note_side(*v);
     ++stats_.side_splits;
     check_size();
-    schedule(*v, j);
+    queues_[j].push_back({*v, true});
   }
 
   void check_size() const {
@@ -367,9 +388,10 @@ class Refiner {
   double apex_height_ = 0, leaf_height_ = 0;
   std::size_t max_vertices_;
   HpuStats& stats_;
-  std::map<int, std::vector<Vid>> queues_;
+  std::map<int, std::vector<Entry>> queues_;
   std::map<double, Vid> sides_[4];
-  std::vector<Vid> batch_, star_;
+  std::vector<Entry> batch_;
+  std::vector<Vid> star_;
   std::vector<std::array<Vid, 2>> pairs_, local_;
   std::unordered_set<std::uint64_t> seen_;
   std::vector<Tid> created_, cavity_;
