@@ -28,6 +28,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <sac/chunk_cache.hpp>
 
 #include "bench_stats.hpp"
 
@@ -178,6 +179,9 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Engines are built one after another: keep their freed chunks warm, as the figures in
+  // RESULTS.md were measured (sac/chunk_cache.hpp; a user's default is 64 MiB).
+  sac::set_chunk_cache_limit(std::size_t{1} << 30);
   CLI::App app{"dynmesh_bench: self-adjusting quadtree vs the static oracle"};
   int dim = 2;
   std::string dist_name = "uniform";

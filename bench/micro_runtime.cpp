@@ -18,6 +18,8 @@
 #include <vector>
 
 #include "sac/sac.hpp"
+#include "sac/detail/order_list.hpp"
+#include "sac/detail/stamp_queue.hpp"
 
 namespace {
 

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <sac/chunk_cache.hpp>
 
 #include "sacapps/app.hpp"
 
@@ -120,6 +121,9 @@ std::vector<std::string> split(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Engines are built one after another: keep their freed chunks warm, as the figures in
+  // RESULTS.md were measured (sac/chunk_cache.hpp; a user's default is 64 MiB).
+  sac::set_chunk_cache_limit(std::size_t{1} << 30);
   CLI::App cli{"sac_suite: the classic self-adjusting computation benchmarks"};
   std::string apps_arg;
   std::size_t n = 100000;

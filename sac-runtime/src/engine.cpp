@@ -1,12 +1,15 @@
 // The engine's non-template machinery: change propagation, undo, memo matching, checks.
 #include "sac/engine.hpp"
 
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <map>
 #include <ostream>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "sac/hash.hpp"
@@ -19,6 +22,56 @@ using detail::ReadNode;
 using detail::VersionBase;
 
 namespace {
+
+/// The record whose stamp at `offset` is s (container_of), const when s is.
+template <class N, class S>
+N* record_at(S* s, std::size_t offset) {
+  using Byte = std::conditional_t<std::is_const_v<S>, const char, char>;
+  return reinterpret_cast<N*>(reinterpret_cast<Byte*>(s) - offset);
+}
+
+/// A stamp kind as a type: the first argument visit_record passes.
+template <StampKind K>
+using Kind = std::integral_constant<StampKind, K>;
+
+/// The one decoder of stamp kinds: calls f(Kind<k>{}, record) for k = s->kind(), with the
+/// record s belongs to typed by k (ReadNode for ReadStart/ReadEnd, VersionBase for Write,
+/// AllocNode for Alloc, MemoNode for MemoStart/MemoEnd; s itself for Sentinel and User),
+/// const when s is. f is typically [&]<StampKind K>(Kind<K>, auto* rec) { if constexpr ... }.
+template <class S, class F>
+void visit_record(S* s, F&& f) {
+  constexpr bool c = std::is_const_v<S>;
+  using Read = std::conditional_t<c, const ReadNode, ReadNode>;
+  using Version = std::conditional_t<c, const VersionBase, VersionBase>;
+  using Alloc = std::conditional_t<c, const AllocNode, AllocNode>;
+  using Memo = std::conditional_t<c, const MemoNode, MemoNode>;
+  switch (s->kind()) {
+    case StampKind::ReadStart:
+      f(Kind<StampKind::ReadStart>{}, record_at<Read>(s, offsetof(ReadNode, start)));
+      break;
+    case StampKind::ReadEnd:
+      f(Kind<StampKind::ReadEnd>{}, record_at<Read>(s, offsetof(ReadNode, end)));
+      break;
+    case StampKind::Write:
+      f(Kind<StampKind::Write>{}, record_at<Version>(s, offsetof(VersionBase, stamp)));
+      break;
+    case StampKind::Alloc:
+      f(Kind<StampKind::Alloc>{}, record_at<Alloc>(s, offsetof(AllocNode, stamp)));
+      break;
+    case StampKind::MemoStart:
+      f(Kind<StampKind::MemoStart>{}, record_at<Memo>(s, offsetof(MemoNode, start)));
+      break;
+    case StampKind::MemoEnd:
+      f(Kind<StampKind::MemoEnd>{}, record_at<Memo>(s, offsetof(MemoNode, end)));
+      break;
+    case StampKind::Sentinel:
+      f(Kind<StampKind::Sentinel>{}, s);
+      break;
+    case StampKind::User:
+      f(Kind<StampKind::User>{}, s);
+      break;
+  }
+}
 
 /// The checker's set of record addresses: open addressing in one array. A node-based hash
 /// set allocated per element, which dominated check_invariants() in the sanitizer build,
@@ -353,7 +406,7 @@ void Engine::discard_pending() noexcept {
   reruns_.clear();
   body_mark_ = 0;
   close_floor_ = 0;
-  release_pending();  // the allocations are in the trace; destroy_all frees them there
+  pending_.clear();  // the allocations are in the trace; destroy_all frees them there
 }
 
 void Engine::enqueue(ReadNode* r) {
@@ -395,35 +448,48 @@ void Engine::propagate() {
 
 // ------------------------------------------------------------------ memoization
 
+namespace {
+
+// A matchable record's interval in the trace; an allocation's is its one stamp.
+std::pair<Stamp*, Stamp*> interval(ReadNode* r) { return {&r->start, &r->end}; }
+std::pair<Stamp*, Stamp*> interval(AllocNode* n) { return {&n->stamp, &n->stamp}; }
+std::pair<Stamp*, Stamp*> interval(MemoNode* n) { return {&n->start, &n->end}; }
+
+}  // namespace
+
+template <class N, class Candidates, class Matches>
+N* Engine::earliest_match(Candidates&& candidates, Matches&& matches) const {
+  N* best = nullptr;
+  candidates([&](N* n) {
+    const auto [start, end] = interval(n);
+    if (matches(n) && in_window(start, end) && (!best || order_.less(start, interval(best).first)))
+      best = n;
+  });
+  return best;
+}
+
 ReadNode* Engine::find_read_match(const ModBase& m, const detail::ReadOps* ops,
                                   const void* closure) const {
-  ReadNode* best = nullptr;
-  for (VersionBase* v = m.newest_; v; v = v->older())
-    for (ReadNode* r = v->readers; r; r = r->rnext)
-      if (r->ops == ops && ops->equal(r, closure) && in_window(&r->start, &r->end) &&
-          (!best || order_.less(&r->start, &best->start)))
-        best = r;
-  return best;
+  return earliest_match<ReadNode>(
+      [&](auto&& offer) {
+        for (VersionBase* v = m.newest_; v; v = v->older())
+          for (ReadNode* r = v->readers; r; r = r->rnext) offer(r);
+      },
+      [&](const ReadNode* r) { return r->ops == ops && ops->equal(r, closure); });
 }
 
 AllocNode* Engine::find_alloc_match(const detail::AllocOps* ops, std::size_t h,
                                     const void* key) const {
-  AllocNode* best = nullptr;
-  for (AllocNode* n = allocs_.bucket(h); n; n = n->hnext)
-    if (n->ops == ops && ops->key_equal(n, key) && in_window(&n->stamp, &n->stamp) &&
-        (!best || order_.less(&n->stamp, &best->stamp)))
-      best = n;
-  return best;
+  return earliest_match<AllocNode>(
+      [&](auto&& offer) { for (AllocNode* n = allocs_.bucket(h); n; n = n->hnext) offer(n); },
+      [&](const AllocNode* n) { return n->ops == ops && ops->key_equal(n, key); });
 }
 
 MemoNode* Engine::find_memo_match(const detail::MemoOps* ops, std::size_t h,
                                   const void* closure) const {
-  MemoNode* best = nullptr;
-  for (MemoNode* n = memos_.bucket(h); n; n = n->hnext)
-    if (n->ops == ops && ops->equal(n, closure) && in_window(&n->start, &n->end) &&
-        (!best || order_.less(&n->start, &best->start)))
-      best = n;
-  return best;
+  return earliest_match<MemoNode>(
+      [&](auto&& offer) { for (MemoNode* n = memos_.bucket(h); n; n = n->hnext) offer(n); },
+      [&](const MemoNode* n) { return n->ops == ops && ops->equal(n, closure); });
 }
 
 void Engine::memo_hit(Stamp* start, Stamp* end) {
@@ -448,29 +514,19 @@ void Engine::link_alloc(AllocNode* n, std::size_t h) {
   if (window_end_) {
     allocs_.insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
   } else {
-    const std::size_t i = pending_count_ % kPendingPerSegment;
-    if (i == 0)
-      pending_segments_.push_back(static_cast<PendingAlloc*>(detail::Pool::acquire_huge_chunk()));
-    pending_segments_.back()[i] = PendingAlloc{n, h};
-    ++pending_count_;
+    pending_.push_back(PendingAlloc{n, h});
   }
-}
-
-void Engine::release_pending() noexcept {
-  for (PendingAlloc* seg : pending_segments_) detail::Pool::release_huge_chunk(seg);
-  pending_segments_.clear();
-  pending_count_ = 0;
 }
 
 void Engine::index_pending_allocs() {
-  if (pending_count_ == 0) return;
-  allocs_.reserve(allocs_.size() + pending_count_,
+  if (pending_.empty()) return;
+  allocs_.reserve(allocs_.size() + pending_.size(),
                   [](const AllocNode* x) { return x->ops->hash(x); });
-  for (std::size_t i = 0; i < pending_count_; ++i) {
-    const PendingAlloc& p = pending_segments_[i / kPendingPerSegment][i % kPendingPerSegment];
+  for (std::size_t i = 0; i < pending_.size(); ++i) {
+    const PendingAlloc& p = pending_[i];
     allocs_.insert_reserved(p.node, p.hash);
   }
-  release_pending();
+  pending_.clear();
 }
 
 void Engine::link_memo(MemoNode* n, std::size_t h) {
@@ -489,9 +545,9 @@ void Engine::undo_between(Stamp* a, Stamp* b) {
 }
 
 void Engine::undo(Stamp* s) {
-  switch (s->kind()) {
-    case StampKind::ReadStart: {
-      ReadNode* r = detail::read_of_start(s);
+  visit_record(s, [this]<StampKind K>(Kind<K>, auto* rec) {
+    if constexpr (K == StampKind::ReadStart) {
+      ReadNode* r = rec;
       ++stats_.events_undone;
       --stats_.live_events;
       detach(r);
@@ -500,15 +556,10 @@ void Engine::undo(Stamp* s) {
         ++stats_.queue_removes;
       }
       r->flags |= detail::kReadDead;
-      break;
-    }
-    case StampKind::ReadEnd: {
-      ReadNode* r = detail::read_of_end(s);
-      destroy(r);
-      break;
-    }
-    case StampKind::Write: {
-      VersionBase* v = detail::version_of(s);
+    } else if constexpr (K == StampKind::ReadEnd || K == StampKind::MemoEnd) {
+      destroy(rec);
+    } else if constexpr (K == StampKind::Write) {
+      VersionBase* v = rec;
       ++stats_.events_undone;
       --stats_.live_events;
       VersionBase* older = v->older();
@@ -525,33 +576,20 @@ void Engine::undo(Stamp* s) {
         }
       }
       destroy(v);
-      break;
-    }
-    case StampKind::Alloc: {
-      AllocNode* n = detail::alloc_of(s);
+    } else if constexpr (K == StampKind::Alloc) {
+      AllocNode* n = rec;
       ++stats_.events_undone;
       --stats_.live_events;
       if (n->ops->key_equal) allocs_.erase(n, n->ops->hash(n));
       deferred_.push_back(n);  // objects may still be referenced until propagate() ends
-      break;
-    }
-    case StampKind::MemoStart: {
-      MemoNode* n = detail::memo_of_start(s);
+    } else if constexpr (K == StampKind::MemoStart) {
+      MemoNode* n = rec;
       ++stats_.events_undone;
       --stats_.live_events;
       memos_.erase(n, n->ops->hash(n));
       n->flags |= detail::kReadDead;
-      break;
     }
-    case StampKind::MemoEnd: {
-      MemoNode* n = detail::memo_of_end(s);
-      destroy(n);
-      break;
-    }
-    case StampKind::Sentinel:
-    case StampKind::User:
-      break;
-  }
+  });
 }
 
 void Engine::unlink_version(VersionBase* v) {
@@ -577,44 +615,13 @@ void Engine::destroy_all() noexcept {
   // Tear-down without undo semantics: destroy every record once. Valid even when poisoned.
   for (Stamp* s = order_.base()->next(); s;) {
     Stamp* nx = s->next();
-    switch (s->kind()) {
-      case StampKind::ReadStart: {
-        ReadNode* r = detail::read_of_start(s);
-        if (!(r->flags & detail::kReadEndLinked)) {  // its body threw: no end stamp
-          destroy(r);
-        }
-        break;
+    visit_record(s, [this]<StampKind K>(Kind<K>, auto* rec) {
+      if constexpr (K == StampKind::ReadStart || K == StampKind::MemoStart) {
+        if (!(rec->flags & detail::kReadEndLinked)) destroy(rec);  // its body threw: no end stamp
+      } else if constexpr (K != StampKind::Sentinel && K != StampKind::User) {
+        destroy(rec);
       }
-      case StampKind::ReadEnd: {
-        ReadNode* r = detail::read_of_end(s);
-        destroy(r);
-        break;
-      }
-      case StampKind::Write: {
-        VersionBase* v = detail::version_of(s);
-        destroy(v);
-        break;
-      }
-      case StampKind::Alloc: {
-        AllocNode* n = detail::alloc_of(s);
-        destroy(n);
-        break;
-      }
-      case StampKind::MemoStart: {
-        MemoNode* n = detail::memo_of_start(s);
-        if (!(n->flags & detail::kReadEndLinked)) {
-          destroy(n);
-        }
-        break;
-      }
-      case StampKind::MemoEnd: {
-        MemoNode* n = detail::memo_of_end(s);
-        destroy(n);
-        break;
-      }
-      default:
-        break;
-    }
+    });
     s = nx;
   }
   free_deferred();
@@ -655,35 +662,22 @@ MemoryBreakdown Engine::memory_breakdown() const {
   // Each record once, at its first stamp (a read's or memo entry's end stamp is in the
   // same record).
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
-    switch (s->kind()) {
-      case StampKind::ReadStart: {
-        const ReadNode* r = reinterpret_cast<const ReadNode*>(s);
-        add(b.reads, r->ops->size, sizeof(ReadNode), 0);
-        ++read_sizes[block_of(r->ops->size)];
-        break;
-      }
-      case StampKind::Write: {
-        const VersionBase* v = reinterpret_cast<const VersionBase*>(s);
-        add(b.versions, v->ops->size, sizeof(VersionBase), 0);
-        break;
-      }
-      case StampKind::Alloc: {
-        const AllocNode* n = reinterpret_cast<const AllocNode*>(s);
-        if (n->ops->key_equal)
-          add(b.keyed_allocs, n->ops->size, sizeof(AllocNode),
-              reinterpret_cast<const detail::KeyedAllocOps*>(n->ops)->key_bytes);
+    visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
+      if constexpr (K == StampKind::ReadStart) {
+        add(b.reads, rec->ops->size, sizeof(ReadNode), 0);
+        ++read_sizes[block_of(rec->ops->size)];
+      } else if constexpr (K == StampKind::Write) {
+        add(b.versions, rec->ops->size, sizeof(VersionBase), 0);
+      } else if constexpr (K == StampKind::Alloc) {
+        if (rec->ops->key_equal)
+          add(b.keyed_allocs, rec->ops->size, sizeof(AllocNode),
+              reinterpret_cast<const detail::KeyedAllocOps*>(rec->ops)->key_bytes);
         else
-          add(b.plain_allocs, n->ops->size, sizeof(AllocNode), 0);
-        break;
+          add(b.plain_allocs, rec->ops->size, sizeof(AllocNode), 0);
+      } else if constexpr (K == StampKind::MemoStart) {
+        add(b.memos, rec->ops->size, sizeof(MemoNode), 0);
       }
-      case StampKind::MemoStart: {
-        const MemoNode* n = reinterpret_cast<const MemoNode*>(s);
-        add(b.memos, n->ops->size, sizeof(MemoNode), 0);
-        break;
-      }
-      default:
-        break;
-    }
+    });
   }
   for (const VersionBase* v : bases_) add(b.inputs, v->ops->size, sizeof(VersionBase), 0);
   b.read_sizes.assign(read_sizes.begin(), read_sizes.end());
@@ -696,7 +690,7 @@ MemoryBreakdown Engine::memory_breakdown() const {
   b.deferred_bytes = deferred_.capacity() * sizeof(AllocNode*);
   b.engine_vectors = bases_.capacity() * sizeof(VersionBase*) + tasks_.capacity() * sizeof(Task) +
                      reruns_.capacity() * sizeof(RerunContext) + issued_.capacity() * sizeof(Task) +
-                     pending_segments_.capacity() * sizeof(PendingAlloc*);
+                     pending_.directory_bytes();
   b.pool_reserved = pool_.reserved_bytes();
   return b;
 }
@@ -720,9 +714,9 @@ void Engine::check_invariants() const {
   AddressSet mods(stats_.live_events / 2);  // the modifiables read or written
   AddressSet reads(stats_.live_events / 2);
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
-    switch (s->kind()) {
-      case StampKind::ReadStart: {
-        const ReadNode* r = reinterpret_cast<const ReadNode*>(s);
+    visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
+      if constexpr (K == StampKind::ReadStart) {
+        const ReadNode* r = rec;
         ++events;
         if (r->flags & detail::kReadDead) fail("dead read in the trace");
         if (!(r->flags & detail::kReadEndLinked)) fail("read without end stamp");
@@ -735,32 +729,23 @@ void Engine::check_invariants() const {
         mods.insert(r->mod);
         if (r->qpos != kNotQueued) fail("read still queued");
         stack.push_back({&r->end, false});
-        break;
-      }
-      case StampKind::ReadEnd: {
+      } else if constexpr (K == StampKind::ReadEnd) {
         if (stack.empty() || stack.back().close != s || stack.back().is_memo)
           fail("read intervals not well nested");
         stack.pop_back();
-        break;
-      }
-      case StampKind::Write: {
-        const VersionBase* v = reinterpret_cast<const VersionBase*>(s);
+      } else if constexpr (K == StampKind::Write) {
+        const VersionBase* v = rec;
         ++events;
         mods.insert(v->mod());
         bool found = false;
         for (const VersionBase* x = v->mod()->newest_; x; x = x->older())
           if (x == v) found = true;
         if (!found) fail("write not in its modifiable's version list");
-        break;
-      }
-      case StampKind::Alloc: {
-        const AllocNode* n = reinterpret_cast<const AllocNode*>(s);
+      } else if constexpr (K == StampKind::Alloc) {
         ++events;
-        if (n->ops->key_equal) ++nkeyed;
-        break;
-      }
-      case StampKind::MemoStart: {
-        const MemoNode* n = reinterpret_cast<const MemoNode*>(s);
+        if (rec->ops->key_equal) ++nkeyed;
+      } else if constexpr (K == StampKind::MemoStart) {
+        const MemoNode* n = rec;
         ++events;
         ++nmemo;
         if (n->flags & detail::kReadDead) fail("dead memo entry in the trace");
@@ -768,17 +753,14 @@ void Engine::check_invariants() const {
             !order_.less(&n->start, &n->end))
           fail("memo entry without a proper end stamp");
         stack.push_back({&n->end, true});
-        break;
-      }
-      case StampKind::MemoEnd: {
+      } else if constexpr (K == StampKind::MemoEnd) {
         if (stack.empty() || stack.back().close != s || !stack.back().is_memo)
           fail("memo intervals not well nested");
         stack.pop_back();
-        break;
-      }
-      default:
+      } else {
         fail("unexpected stamp kind");
-    }
+      }
+    });
   }
   if (!stack.empty()) fail("unclosed intervals at the end of the trace");
   if (events != stats_.live_events) fail("live event count mismatch");
@@ -838,34 +820,21 @@ void Engine::dump_dot(std::ostream& os) const {
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     std::string name = "e" + std::to_string(id++);
     const std::string& parent = stack.back().first;
-    switch (s->kind()) {
-      case StampKind::ReadStart: {
-        const ReadNode* r = reinterpret_cast<const ReadNode*>(s);
+    visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
+      if constexpr (K == StampKind::ReadStart) {
         os << "  " << name << " [label=\"read\"];\n  " << parent << " -> " << name << ";\n  "
-           << mod_name(r->mod) << " -> " << name << " [style=dashed];\n";
-        stack.push_back({name, &r->end});
-        break;
-      }
-      case StampKind::ReadEnd:
-        break;
-      case StampKind::Write: {
-        const VersionBase* v = reinterpret_cast<const VersionBase*>(s);
+           << mod_name(rec->mod) << " -> " << name << " [style=dashed];\n";
+        stack.push_back({name, &rec->end});
+      } else if constexpr (K == StampKind::Write) {
         os << "  " << name << " [shape=diamond, label=\"write\"];\n  " << parent << " -> " << name
-           << ";\n  " << name << " -> " << mod_name(v->mod()) << " [style=dashed];\n";
-        break;
-      }
-      case StampKind::Alloc:
+           << ";\n  " << name << " -> " << mod_name(rec->mod()) << " [style=dashed];\n";
+      } else if constexpr (K == StampKind::Alloc) {
         os << "  " << name << " [shape=note, label=\"alloc\"];\n  " << parent << " -> " << name << ";\n";
-        break;
-      case StampKind::MemoStart: {
-        const MemoNode* n = reinterpret_cast<const MemoNode*>(s);
+      } else if constexpr (K == StampKind::MemoStart) {
         os << "  " << name << " [shape=octagon, label=\"memo\"];\n  " << parent << " -> " << name << ";\n";
-        stack.push_back({name, &n->end});
-        break;
+        stack.push_back({name, &rec->end});
       }
-      default:
-        break;
-    }
+    });
     while (stack.size() > 1 && stack.back().second == s) stack.pop_back();
   }
   os << "}\n";

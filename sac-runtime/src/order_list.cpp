@@ -1,5 +1,5 @@
 // Order-maintenance list: the slow paths (group relabel and split, top-level relabel, erase).
-#include "sac/order_list.hpp"
+#include "sac/detail/order_list.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,8 +1,11 @@
 // Pool chunk acquisition and release (the cold path).
 #include "sac/detail/pool.hpp"
 
+#include "sac/chunk_cache.hpp"
+
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <mutex>
 #include <vector>
@@ -13,7 +16,7 @@ namespace {
 
 // Freed huge chunks are kept for later pools (as malloc keeps freed heap), up to a bound,
 // so that engines created one after another do not pay the kernel's first-touch zeroing
-// again. SAC_CHUNK_CACHE_MB sets the bound (default 1024; 0 disables the cache).
+// again (sac/chunk_cache.hpp).
 class ChunkCache {
  public:
   static ChunkCache& instance() {
@@ -39,12 +42,37 @@ class ChunkCache {
     held_ += size;
     return true;
   }
+  /// Sets the bound and unmaps what lies beyond it, largest chunks first.
+  void limit(std::size_t bytes) {
+    std::lock_guard<std::mutex> lock(mu_);
+    limit_ = bytes;
+    std::sort(free_.begin(), free_.end(), [](const Entry& a, const Entry& b) { return a.size < b.size; });
+    while (held_ > limit_) {
+      ::munmap(free_.back().base, free_.back().size);
+      held_ -= free_.back().size;
+      free_.pop_back();
+    }
+  }
+  std::size_t limit() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return limit_;
+  }
+  std::size_t held() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return held_;
+  }
+  void trim() noexcept {
+    std::lock_guard<std::mutex> lock(mu_);
+    for (const Entry& e : free_) ::munmap(e.base, e.size);
+    free_.clear();
+    held_ = 0;
+  }
 
  private:
   ChunkCache() {
-    std::size_t mb = 1024;
-    if (const char* e = std::getenv("SAC_CHUNK_CACHE_MB")) mb = std::strtoull(e, nullptr, 10);
-    limit_ = mb << 20;
+    std::size_t bytes = kDefaultChunkCacheBytes;
+    if (const char* e = std::getenv("SAC_CHUNK_CACHE_MB")) bytes = std::strtoull(e, nullptr, 10) << 20;
+    limit_ = bytes;
   }
   struct Entry {
     void* base;
@@ -111,3 +139,12 @@ void Pool::release() noexcept {
 }
 
 }  // namespace sac::detail
+
+namespace sac {
+
+void set_chunk_cache_limit(std::size_t bytes) { detail::ChunkCache::instance().limit(bytes); }
+std::size_t chunk_cache_limit() noexcept { return detail::ChunkCache::instance().limit(); }
+std::size_t chunk_cache_bytes() noexcept { return detail::ChunkCache::instance().held(); }
+void trim_chunk_cache() noexcept { detail::ChunkCache::instance().trim(); }
+
+}  // namespace sac

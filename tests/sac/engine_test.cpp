@@ -28,6 +28,8 @@
 #include <vector>
 
 #include "../sanitized.hpp"
+#include "sac/detail/order_list.hpp"
+#include "sac/detail/trace_nodes.hpp"
 #include "sac/sac.hpp"
 
 namespace sac {

@@ -17,6 +17,8 @@
 #include <vector>
 
 #include "../sanitized.hpp"
+#include "sac/detail/ops.hpp"
+#include "sac/detail/trace_nodes.hpp"
 #include "sac/sac.hpp"
 
 namespace {

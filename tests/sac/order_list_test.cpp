@@ -1,4 +1,4 @@
-// Tests of sac/order_list.hpp: OrderList against a reference std::list of ids.
+// Tests of sac/detail/order_list.hpp: OrderList against a reference std::list of ids.
 //
 // Every operation is mirrored on a std::list<int>; after each batch the order list must hold
 // exactly the reference sequence (walking next() from base()), less() must agree with the
@@ -20,8 +20,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "sac/detail/order_list.hpp"
 #include "sac/errors.hpp"
-#include "sac/order_list.hpp"
 
 namespace sac {
 

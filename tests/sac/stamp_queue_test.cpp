@@ -1,4 +1,4 @@
-// Tests of sac/stamp_queue.hpp: StampQueue against a std::multiset ordered by reference
+// Tests of sac/detail/stamp_queue.hpp: StampQueue against a std::multiset ordered by reference
 // position.
 //
 // The elements own stamps linked in an OrderList; the reference order is a std::list of ids
@@ -17,9 +17,9 @@
 #include <string>
 #include <vector>
 
+#include "sac/detail/order_list.hpp"
+#include "sac/detail/stamp_queue.hpp"
 #include "sac/errors.hpp"
-#include "sac/order_list.hpp"
-#include "sac/stamp_queue.hpp"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SAC_SQ_TEST_SANITIZED 1

@@ -36,10 +36,12 @@
 // runs the check at its end and throws InvariantError on a violation.
 // Complexity: read/write/alloc O(1) amortized plus the version walk of the touched
 // modifiable; propagate() O(trace distance x log(queue size)) for monotone programs.
+// The machinery (records, ops tables, order list, queue, pool, trampoline) is in sac/detail/.
 #pragma once
 
 #include <concepts>
 #include <cstddef>
+#include <cstdint>
 #include <iosfwd>
 #include <new>
 #include <type_traits>
@@ -47,112 +49,21 @@
 #include <vector>
 
 #include "sac/detail/intrusive_hash.hpp"
+#include "sac/detail/ops.hpp"
+#include "sac/detail/order_list.hpp"
 #include "sac/detail/pool.hpp"
+#include "sac/detail/segment_array.hpp"
+#include "sac/detail/stamp_queue.hpp"
 #include "sac/detail/trace_nodes.hpp"
+#include "sac/detail/trampoline.hpp"
 #include "sac/errors.hpp"
 #include "sac/fn.hpp"
 #include "sac/hash.hpp"
 #include "sac/memory_breakdown.hpp"
 #include "sac/mod.hpp"
-#include "sac/order_list.hpp"
-#include "sac/stamp_queue.hpp"
 #include "sac/stats.hpp"
 
 namespace sac {
-
-namespace detail {
-
-struct ReadQueueTraits {
-  static const Stamp* stamp(const ReadNode* r) { return &r->start; }
-  static std::uint32_t& pos(ReadNode* r) { return r->qpos; }
-  static std::uint32_t pos(const ReadNode* r) { return r->qpos; }
-};
-
-template <class F, class T>
-void call_body(F& f, Engine& e, const T& v) {
-  if constexpr (std::is_invocable_v<F&, Engine&, const T&>) f(e, v);
-  else f(v);
-}
-
-template <class F>
-void call_thunk(F& f, Engine& e) {
-  if constexpr (std::is_invocable_v<F&, Engine&>) f(e);
-  else f();
-}
-
-template <class T>
-struct VersionOpsFor {
-  static void destroy(VersionBase* v) noexcept { static_cast<Version<T>*>(v)->~Version<T>(); }
-  static bool equal(const VersionBase* a, const VersionBase* b) {
-    if constexpr (std::equality_comparable<T>)
-      return static_cast<const Version<T>*>(a)->value == static_cast<const Version<T>*>(b)->value;
-    else
-      return false;  // no cut-off without operator==
-  }
-  static constexpr VersionOps ops{&destroy, &equal, sizeof(Version<T>)};
-};
-
-template <class T, class F>
-struct ReadOpsFor {
-  static void invoke(Engine& e, ReadNode* r, const VersionBase* v) {
-    call_body(static_cast<ReadNodeT<F>*>(r)->fn, e, static_cast<const Version<T>*>(v)->value);
-  }
-  static void destroy(ReadNode* r) noexcept { static_cast<ReadNodeT<F>*>(r)->~ReadNodeT<F>(); }
-  static bool equal(const ReadNode* r, const void* c) {
-    if constexpr (std::equality_comparable<F>)
-      return static_cast<const ReadNodeT<F>*>(r)->fn == *static_cast<const F*>(c);
-    else
-      return false;  // plain read() with a lambda: never matched
-  }
-  static constexpr ReadOps ops{&invoke, &destroy,
-                               std::equality_comparable<F> ? &equal : nullptr,
-                               sizeof(ReadNodeT<F>)};
-};
-
-/// A keyed allocation's ops table with the bytes of its key (and the padding before the
-/// object), for Engine::memory_breakdown(): ops is the first member of this standard-layout
-/// struct, so a record's ops pointer leads back here. Every ops table with key_equal set
-/// lives in one (AllocOpsFor).
-struct KeyedAllocOps {
-  AllocOps ops;
-  std::uint32_t key_bytes;
-};
-
-template <class T, class K>
-struct AllocOpsFor {
-  using N = AllocNodeT<T, K>;
-  static void destroy(AllocNode* n) noexcept { static_cast<N*>(n)->~N(); }
-  static bool key_equal(const AllocNode* n, const void* k) {
-    return static_cast<const N*>(n)->key == *static_cast<const K*>(k);
-  }
-  static std::size_t hash(const AllocNode* n) { return Hash<K>{}(static_cast<const N*>(n)->key); }
-  // The key follows the 32-byte AllocNode; the object follows the key at its alignment.
-  static constexpr std::size_t kObjectOffset =
-      (sizeof(AllocNode) + sizeof(K) + alignof(T) - 1) / alignof(T) * alignof(T);
-  static constexpr KeyedAllocOps keyed{{&destroy, &key_equal, &hash, sizeof(N)},
-                                       static_cast<std::uint32_t>(kObjectOffset - sizeof(AllocNode))};
-  static constexpr const AllocOps& ops = keyed.ops;
-};
-
-template <class T>
-struct PlainAllocOpsFor {
-  using N = PlainAllocNodeT<T>;
-  static void destroy(AllocNode* n) noexcept { static_cast<N*>(n)->~N(); }
-  static constexpr AllocOps ops{&destroy, nullptr, nullptr, sizeof(N)};
-};
-
-template <class F>
-struct MemoOpsFor {
-  using N = MemoNodeT<F>;
-  static void destroy(MemoNode* n) noexcept { static_cast<N*>(n)->~N(); }
-  static bool equal(const MemoNode* n, const void* c) {
-    return static_cast<const N*>(n)->fn == *static_cast<const F*>(c);
-  }
-  static std::size_t hash(const MemoNode* n) { return Hash<F>{}(static_cast<const N*>(n)->fn); }
-  static constexpr MemoOps ops{&destroy, &equal, &hash, sizeof(N)};
-};
-
-}  // namespace detail
 
 class Engine {
  public:
@@ -261,18 +172,10 @@ class Engine {
 
   using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits>;
 
-  // Work of the trampoline. Exec* carry a node that is not linked yet.
-  enum class TaskKind : std::uint8_t {
-    ExecRead, ExecMemoRead, ExecMemo, CloseRead, CloseMemo, Rerun, FinishRerun, DrainUntil
-  };
-  struct Task {
-    TaskKind kind;
-    void* node;   // the node, or for DrainUntil the stamp to drain up to
-  };
-  struct RerunContext {
-    Stamp* now;
-    Stamp* window_end;
-  };
+  // Work of the trampoline (sac/detail/trampoline.hpp).
+  using TaskKind = detail::TaskKind;
+  using Task = detail::Task;
+  using RerunContext = detail::RerunContext;
 
   void require_mutator(const char* what) const;
   void require_computation(const char* what) const {
@@ -331,6 +234,10 @@ class Engine {
                                       const void* key) const;
   detail::MemoNode* find_memo_match(const detail::MemoOps* ops, std::size_t h,
                                     const void* closure) const;
+  /// The earliest record that candidates(offer) offers, matches accepts and the window
+  /// holds; null if none (engine.cpp).
+  template <class N, class Candidates, class Matches>
+  N* earliest_match(Candidates&& candidates, Matches&& matches) const;
   void reuse_alloc(detail::AllocNode* n);
   void memo_hit(Stamp* start, Stamp* end);
   static void* closure_of(detail::ReadNode* r) { return static_cast<detail::ReadNode*>(r) + 1; }
@@ -368,17 +275,12 @@ class Engine {
   // Keyed allocations of the running run() with their hashes: nothing can look them up
   // before the run ends (there is no re-execution window), so they are indexed in one
   // presized pass at its end, reading this array sequentially and only storing into the
-  // (cold) records, instead of through log n table doublings that reload every record. The
-  // array lives in 2 MiB huge-page segments from the pool's chunk cache, so a warm run does
-  // not fault in fresh pages for it.
+  // (cold) records, instead of through log n table doublings that reload every record.
   struct PendingAlloc {
     detail::AllocNode* node;
     std::size_t hash;
   };
-  static constexpr std::size_t kPendingPerSegment = detail::Pool::kHugeChunk / sizeof(PendingAlloc);
-  std::vector<PendingAlloc*> pending_segments_;
-  std::size_t pending_count_ = 0;
-  void release_pending() noexcept;
+  detail::SegmentArray<PendingAlloc> pending_;
   std::vector<detail::VersionBase*> bases_;    // base versions; index kept in stamp.label
   std::vector<Task> tasks_;                    // the trampoline's stack
   std::vector<RerunContext> reruns_;           // contexts saved by the running re-executions

@@ -13,7 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "sac/order_list.hpp"
+#include "sac/detail/order_list.hpp"
 
 namespace sac {
 class Engine;

@@ -1,4 +1,4 @@
-// sac/stamp_queue.hpp — the change-propagation priority queue.
+// sac/detail/stamp_queue.hpp — the change-propagation priority queue.
 //
 // Purpose: affected reads wait here until change propagation re-executes them in time order.
 // A binary min-heap of T* ordered by the OrderList position of Traits::stamp(t); each element
@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "sac/detail/order_list.hpp"
 #include "sac/errors.hpp"
-#include "sac/order_list.hpp"
 
 namespace sac {
 

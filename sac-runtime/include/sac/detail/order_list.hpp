@@ -1,4 +1,4 @@
-// sac/order_list.hpp — order-maintenance list of timestamps (two-level).
+// sac/detail/order_list.hpp — order-maintenance list of timestamps (two-level).
 //
 // Purpose: every trace event owns a Stamp; the list keeps them in execution order and answers
 // "does a come before b?" in O(1). Follows Dietz & Sleator (STOC'87) and Bender, Cole,

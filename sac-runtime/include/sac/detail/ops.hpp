@@ -1,0 +1,114 @@
+// sac/detail/ops.hpp — the static ops tables of the trace records, one per instantiated type.
+//
+// Purpose: a record stores one pointer to its type's ops (destroy, compare, hash, invoke, size;
+// see trace_nodes.hpp) instead of a vtable; the Engine's templates fill it from the tables
+// here. Also the StampQueue traits of a read and the calls of a body with or without the
+// Engine.
+// Invariants: ops.size == sizeof(the record type); a table's equal/key_equal/hash are only
+// called on records that carry that same table, so the casts are exact; an ops table with
+// key_equal set is the `ops` member of a KeyedAllocOps.
+// Complexity: every entry O(1) plus the user's operator==, Hash and body.
+#pragma once
+
+#include <concepts>
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+
+#include "sac/detail/order_list.hpp"
+#include "sac/detail/trace_nodes.hpp"
+#include "sac/hash.hpp"
+
+namespace sac::detail {
+
+struct ReadQueueTraits {
+  static const Stamp* stamp(const ReadNode* r) { return &r->start; }
+  static std::uint32_t& pos(ReadNode* r) { return r->qpos; }
+  static std::uint32_t pos(const ReadNode* r) { return r->qpos; }
+};
+
+template <class F, class T>
+void call_body(F& f, Engine& e, const T& v) {
+  if constexpr (std::is_invocable_v<F&, Engine&, const T&>) f(e, v);
+  else f(v);
+}
+
+template <class F>
+void call_thunk(F& f, Engine& e) {
+  if constexpr (std::is_invocable_v<F&, Engine&>) f(e);
+  else f();
+}
+
+template <class T>
+struct VersionOpsFor {
+  static void destroy(VersionBase* v) noexcept { static_cast<Version<T>*>(v)->~Version<T>(); }
+  static bool equal(const VersionBase* a, const VersionBase* b) {
+    if constexpr (std::equality_comparable<T>)
+      return static_cast<const Version<T>*>(a)->value == static_cast<const Version<T>*>(b)->value;
+    else
+      return false;  // no cut-off without operator==
+  }
+  static constexpr VersionOps ops{&destroy, &equal, sizeof(Version<T>)};
+};
+
+template <class T, class F>
+struct ReadOpsFor {
+  static void invoke(Engine& e, ReadNode* r, const VersionBase* v) {
+    call_body(static_cast<ReadNodeT<F>*>(r)->fn, e, static_cast<const Version<T>*>(v)->value);
+  }
+  static void destroy(ReadNode* r) noexcept { static_cast<ReadNodeT<F>*>(r)->~ReadNodeT<F>(); }
+  static bool equal(const ReadNode* r, const void* c) {
+    if constexpr (std::equality_comparable<F>)
+      return static_cast<const ReadNodeT<F>*>(r)->fn == *static_cast<const F*>(c);
+    else
+      return false;  // plain read() with a lambda: never matched
+  }
+  static constexpr ReadOps ops{&invoke, &destroy,
+                               std::equality_comparable<F> ? &equal : nullptr,
+                               sizeof(ReadNodeT<F>)};
+};
+
+/// A keyed allocation's ops table with the bytes of its key (and the padding before the
+/// object), for Engine::memory_breakdown(): ops is the first member of this standard-layout
+/// struct, so a record's ops pointer leads back here. Every ops table with key_equal set
+/// lives in one (AllocOpsFor).
+struct KeyedAllocOps {
+  AllocOps ops;
+  std::uint32_t key_bytes;
+};
+
+template <class T, class K>
+struct AllocOpsFor {
+  using N = AllocNodeT<T, K>;
+  static void destroy(AllocNode* n) noexcept { static_cast<N*>(n)->~N(); }
+  static bool key_equal(const AllocNode* n, const void* k) {
+    return static_cast<const N*>(n)->key == *static_cast<const K*>(k);
+  }
+  static std::size_t hash(const AllocNode* n) { return Hash<K>{}(static_cast<const N*>(n)->key); }
+  // The key follows the 32-byte AllocNode; the object follows the key at its alignment.
+  static constexpr std::size_t kObjectOffset =
+      (sizeof(AllocNode) + sizeof(K) + alignof(T) - 1) / alignof(T) * alignof(T);
+  static constexpr KeyedAllocOps keyed{{&destroy, &key_equal, &hash, sizeof(N)},
+                                       static_cast<std::uint32_t>(kObjectOffset - sizeof(AllocNode))};
+  static constexpr const AllocOps& ops = keyed.ops;
+};
+
+template <class T>
+struct PlainAllocOpsFor {
+  using N = PlainAllocNodeT<T>;
+  static void destroy(AllocNode* n) noexcept { static_cast<N*>(n)->~N(); }
+  static constexpr AllocOps ops{&destroy, nullptr, nullptr, sizeof(N)};
+};
+
+template <class F>
+struct MemoOpsFor {
+  using N = MemoNodeT<F>;
+  static void destroy(MemoNode* n) noexcept { static_cast<N*>(n)->~N(); }
+  static bool equal(const MemoNode* n, const void* c) {
+    return static_cast<const N*>(n)->fn == *static_cast<const F*>(c);
+  }
+  static std::size_t hash(const MemoNode* n) { return Hash<F>{}(static_cast<const N*>(n)->fn); }
+  static constexpr MemoOps ops{&destroy, &equal, &hash, sizeof(N)};
+};
+
+}  // namespace sac::detail

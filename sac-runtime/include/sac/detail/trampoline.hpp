@@ -1,0 +1,42 @@
+// sac/detail/trampoline.hpp — the units of work of the Engine's trampoline.
+//
+// Purpose: read/memo_read/memo calls are recorded as Tasks when issued and run after the
+// issuing body returns, from an explicit stack (Engine::tasks_), so that deep recursion never
+// grows the C++ stack; closing an interval, re-executing a read and jumping over a reused
+// stretch are Tasks on the same stack.
+// Invariants: an Exec* task carries a record that is not in the trace yet; a Close* task's
+// record has its start stamp linked and not its end, whose link field chains the records to
+// close right after it (low bit set: a memo entry; 0 ends the chain); Engine::reruns_ holds
+// one RerunContext per FinishRerun on the stack.
+// Complexity: a task is 16 bytes; push and pop O(1).
+#pragma once
+
+#include <cstdint>
+
+#include "sac/detail/order_list.hpp"
+
+namespace sac::detail {
+
+enum class TaskKind : std::uint8_t {
+  ExecRead,      // link a new read, attach it and run its body
+  ExecMemoRead,  // ExecRead, unless an equal read in the window is reused
+  ExecMemo,      // link a new memo entry and run it, unless an equal one is reused
+  CloseRead,     // link the end stamp of a read (and of the closes chained onto it)
+  CloseMemo,     // the same for a memo entry
+  Rerun,         // re-execute an affected read inside its own interval
+  FinishRerun,   // undo what the re-execution did not redo; restore the saved context
+  DrainUntil     // re-execute the affected reads before a stamp, then continue after it
+};
+
+struct Task {
+  TaskKind kind;
+  void* node;   // the record, or for DrainUntil the stamp to drain up to
+};
+
+/// The insertion point and window a re-execution replaces, restored when it finishes.
+struct RerunContext {
+  Stamp* now;
+  Stamp* window_end;
+};
+
+}  // namespace sac::detail
