@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <unordered_set>
 #include <numbers>
 #include <string>
 #include <tuple>
@@ -166,7 +165,6 @@ class Refiner {
       queues_.erase(it);
       ++stats_.rounds;
       pairs_.clear();
-      seen_.clear();
       for (const Entry& e : batch_) collect(e.v, j, e.birth);
       for (const auto& [p, q] : pairs_) process(p, q, j);
       batch_.clear();
@@ -263,8 +261,10 @@ class Refiner {
       if (dt_.point(a[0]) != dt_.point(b[0])) return xy_less(dt_.point(a[0]), dt_.point(b[0]));
       return xy_less(dt_.point(a[1]), dt_.point(b[1]));
     });
-    for (const auto& pr : local_)
-      if (seen_.insert((std::uint64_t{pr[0]} << 32) | pr[1]).second) pairs_.push_back(pr);
+    // A pair collected twice (from both ends) is processed twice; the second time it is no
+    // longer loose, since looseness and edges, once lost, never come back as vertices are
+    // added. So no de-duplication is needed, and the result is that of the first.
+    pairs_.insert(pairs_.end(), local_.begin(), local_.end());
     if (go_on) queues_[j + 1].push_back({v, false});
   }
 
@@ -393,7 +393,6 @@ class Refiner {
   std::vector<Entry> batch_;
   std::vector<Vid> star_;
   std::vector<std::array<Vid, 2>> pairs_, local_;
-  std::unordered_set<std::uint64_t> seen_;
   std::vector<Tid> created_, cavity_;
   std::vector<std::array<Vid, 2>> sides_found_, encroached_;
 };

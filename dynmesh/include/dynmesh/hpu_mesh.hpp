@@ -29,8 +29,9 @@
 //      edge's class. A new vertex enters at max(current class, its shortest edge's class).
 //      Since edges between old vertices only vanish and every new edge has a new end, each
 //      pair is collected at its class while it is an edge, and nothing loose remains.
-//   4. A while-iteration of class j (a "round") takes all of Q_j, collects, de-duplicates the
-//      pairs in collection order and processes them in that order: a pair still loose gets
+//   4. A while-iteration of class j (a "round") takes all of Q_j, collects, and processes the
+//      pairs in collection order (a pair found from both ends is no longer loose the second
+//      time: looseness and edges, once lost, never return): a pair still loose gets
 //      its off-center r, the apex c' = m + h·J(q − p) with h = 0.95·(ρ + k) as in Triangle
 //      (at h = ρ + k the new triangle's angle is θ exactly, which rounding would judge bad
 //      again), or the circumcentre of p, q, t when that is no farther from m (the crescent
