@@ -8,13 +8,12 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <numbers>
 #include <string>
-#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "delaunay.hpp"
+#include "hpu_geometry.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh_check.hpp"
 #include "dynmesh/predicates.hpp"
@@ -28,95 +27,17 @@ namespace {
 using detail::Delaunay;
 using Tid = Delaunay::Tid;
 using Vid = Delaunay::Vid;
-
-double squared_length(const Point<2>& a, const Point<2>& b) noexcept {
-  const double dx = b[0] - a[0], dy = b[1] - a[1];
-  return dx * dx + dy * dy;
-}
-
-/// (x, y) order of unordered vertex pairs: the tie rule of key edges and side splits.
-bool pair_less(const Point<2>& a0, const Point<2>& a1, const Point<2>& b0, const Point<2>& b1) noexcept {
-  const Point<2>& alo = xy_less(a1, a0) ? a1 : a0;
-  const Point<2>& ahi = xy_less(a1, a0) ? a0 : a1;
-  const Point<2>& blo = xy_less(b1, b0) ? b1 : b0;
-  const Point<2>& bhi = xy_less(b1, b0) ? b0 : b1;
-  if (alo != blo) return xy_less(alo, blo);
-  return xy_less(ahi, bhi);
-}
-
-/// Of the leaf's apex height; Triangle uses 0.95 of the off-center distance too.
-constexpr double kApexFactor = 0.95;
-
-/// The midpoint of a box edge, from its (x, y)-smaller end: one formula whoever asks (the
-/// precomputation below and a split during refinement), so the same edge always gives the
-/// same bits. Throws InputError(Resolution) when double precision cannot split the edge.
-Point<2> side_midpoint(const Point<2>& p, const Point<2>& q) {
-  const Point<2>& a = xy_less(q, p) ? q : p;
-  const Point<2>& b = xy_less(q, p) ? p : q;
-  const Point<2> mid{a[0] + (b[0] - a[0]) * 0.5, a[1] + (b[1] - a[1]) * 0.5};
-  if (mid == a || mid == b)
-    throw InputError(InputError::Kind::Resolution,
-                     "the mesh must split a box edge of length " + format_exact(std::sqrt(squared_length(a, b))) +
-                         " that double precision cannot split: the spread is beyond the mesh's resolution");
-  return mid;
-}
-
-/// Step 2 without a triangulation: the midpoints that splitting encroached box edges adds.
-/// An edge's diametral disc holds its halves' discs, and a point strictly inside one projects
-/// strictly inside the edge; midpoints and corners never encroach. So the edges split are
-/// exactly those some input encroaches, and for each input they form one path down the
-/// halving of the side edge its projection falls in. Inserting these before the inputs keeps
-/// their cavities small (splitting after the inputs made every split's cavity the fan of a
-/// line of points: quadratic on collinear input).
-std::vector<Point<2>> side_midpoints(const Box<2>& box, std::span<const Point<2>> points) {
-  const double lo[2] = {box.origin[0], box.origin[1]};
-  const double hi[2] = {box.origin[0] + box.side, box.origin[1] + box.side};
-  std::vector<Point<2>> out, side;
-  for (unsigned u = 0; u < 2; ++u) {  // the axis along the side
-    const unsigned w = 1 - u;         // the axis across it
-    for (const double c : {lo[w], hi[w]}) {
-      const auto at = [&](double t) {
-        Point<2> p;
-        p[u] = t;
-        p[w] = c;
-        return p;
-      };
-      side = {at(lo[u]), at(hi[u])};
-      for (const Point<2>& p : points)
-        if (p[w] == c) side.push_back(p);
-      std::sort(side.begin(), side.end(), [&](const Point<2>& a, const Point<2>& b) { return a[u] < b[u]; });
-      side.erase(std::unique(side.begin(), side.end()), side.end());
-      for (const Point<2>& p : points) {
-        if (p[w] == c) continue;
-        const auto it = std::upper_bound(side.begin(), side.end(), p[u],
-                                         [&](double t, const Point<2>& v) { return t < v[u]; });
-        if (it == side.begin() || it == side.end() || !((it - 1)->at(u) < p[u])) continue;
-        Point<2> a = *(it - 1), b = *it;
-        while (encroaches(a, b, p)) {
-          const Point<2> m = side_midpoint(a, b);
-          out.push_back(m);
-          if (p[u] < m[u]) b = m;
-          else if (p[u] > m[u]) a = m;
-          else break;
-        }
-      }
-    }
-  }
-  std::sort(out.begin(), out.end(), xy_less);
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
+using detail::pair_less;
+using detail::side_midpoint;
+using detail::side_midpoints;
 
 /// DynHPU (the seed's Figure 5) on a Delaunay triangulation: see hpu_mesh.hpp.
 class Refiner {
  public:
   Refiner(const Box<2>& box, double min_angle_deg, std::size_t max_vertices, HpuStats& stats)
       : box_(box), dt_(box), max_vertices_(max_vertices), stats_(stats) {
-    apex_height_ = kApexFactor * 0.5 / std::tan(min_angle_deg * (std::numbers::pi / 360.0));
-    // k = √(ρ² − 1/4) = 1 / (2 tan θ), a little lower (kLeafMargin): a leaf that is slightly
-    // too small only ever calls more pairs loose, so every angle of the result clears θ by
-    // more than the checker's rounding.
-    leaf_height_ = kLeafMargin * 0.5 / std::tan(min_angle_deg * (std::numbers::pi / 180.0));
+    apex_height_ = detail::apex_height(min_angle_deg);
+    leaf_height_ = detail::leaf_height(min_angle_deg);
     lo_[0] = box.origin[0], lo_[1] = box.origin[1];
     hi_[0] = box.origin[0] + box.side, hi_[1] = box.origin[1] + box.side;
     for (Vid v = 0; v < 4; ++v) note_side(v);
@@ -175,19 +96,10 @@ class Refiner {
   const Delaunay& triangulation() const noexcept { return dt_; }
 
  private:
-  static constexpr double kLeafMargin = 1.0 - 0x1p-30;
   static constexpr Vid kNone = Delaunay::kNone;
 
-  static int size_class(double squared) noexcept { return std::ilogb(squared) >> 1; }
-  int edge_class(Vid a, Vid b) const noexcept { return size_class(squared_length(dt_.point(a), dt_.point(b))); }
-
-  std::uint64_t morton_of(const Point<2>& p) const noexcept {
-    const auto axis = [&](unsigned a) {
-      const double u = (p[a] - lo_[a]) / box_.side * 0x1p32;
-      return static_cast<std::uint32_t>(std::clamp(u, 0.0, 0x1p32 - 1));
-    };
-    return detail::z_order(axis(0), axis(1));
-  }
+  int edge_class(Vid a, Vid b) const noexcept { return detail::edge_class(dt_.point(a), dt_.point(b)); }
+  std::uint64_t morton_of(const Point<2>& p) const noexcept { return detail::morton_of(box_, p); }
 
   bool on_boundary(Vid v) const noexcept {
     const Point<2>& p = dt_.point(v);
@@ -210,28 +122,16 @@ class Refiner {
     bool birth;
   };
 
-  /// The squared circumradius of a, b, c in one fixed sequence of double operations, from
-  /// the corner that is smallest in (x, y) order, so that any reader of the same triangle
-  /// gets the same bits.
   double circumradius2(Vid a, Vid b, Vid c) const noexcept {
-    const Point<2>*P = &dt_.point(a), *Q = &dt_.point(b), *R = &dt_.point(c);
-    if (xy_less(*Q, *P) && xy_less(*Q, *R)) std::tie(P, Q, R) = std::tuple{Q, R, P};
-    else if (xy_less(*R, *P) && xy_less(*R, *Q)) std::tie(P, Q, R) = std::tuple{R, P, Q};
-    const double bx = (*Q)[0] - (*P)[0], by = (*Q)[1] - (*P)[1], cx = (*R)[0] - (*P)[0], cy = (*R)[1] - (*P)[1];
-    const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
-    const double d = 2.0 * (bx * cy - by * cx);
-    const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
-    return ux * ux + uy * uy;
+    return detail::circumradius2(dt_.point(a), dt_.point(b), dt_.point(c));
   }
 
   /// p→q is ccw-loose: its ccw-leaf holds no vertex. t is the third corner of the triangle on
   /// its left (kNone: the outside of the box), u the one on its right. When pq is a Delaunay
   /// edge, t and u are the vertices nearest the leaf on either side, so they decide.
   bool loose(Vid p, Vid q, Vid t, Vid u) const noexcept {
-    if (t == kNone) return false;
-    const Point<2>&P = dt_.point(p), &Q = dt_.point(q);
-    if (pencil(P, Q, leaf_height_, dt_.point(t)) < 0) return false;
-    return u == kNone || pencil(P, Q, leaf_height_, dt_.point(u)) >= 0;
+    return detail::loose(dt_.point(p), dt_.point(q), leaf_height_, t == kNone ? nullptr : &dt_.point(t),
+                         u == kNone ? nullptr : &dt_.point(u));
   }
 
   /// Figure 5, line 7, for one vertex: its loose pairs of class j (≤ j at its first entry),
@@ -244,7 +144,7 @@ class Refiner {
     const bool cycle = !on_boundary(v);
     const std::size_t d = star_.size();
     bool go_on = false;
-    const double big = std::ldexp(1.0, 2 * (j + 1));
+    const double big = detail::continuation_radius2(j);
     local_.clear();
     for (std::size_t i = 0; i < d; ++i) {
       const Vid q = star_[i];
@@ -282,7 +182,7 @@ class Refiner {
           if (w != p && w != q) uv = w;
       if (!loose(p, q, tv, uv)) return;
       ++stats_.loose_pairs;
-      const auto [r, was_circumcentre] = off_center(dt_.point(p), dt_.point(q), dt_.point(tv));
+      const auto [r, was_circumcentre] = detail::off_center(dt_.point(p), dt_.point(q), dt_.point(tv), apex_height_);
       if (!std::isfinite(r[0]) || !std::isfinite(r[1])) throw InvariantError("dynmesh: a non-finite off-center");
       if (!(r[0] >= lo_[0] && r[0] <= hi_[0] && r[1] >= lo_[1] && r[1] <= hi_[1])) {
         split_crossed(dt_.point(p), dt_.point(q), r, j);
@@ -320,19 +220,7 @@ class Refiner {
   /// segment from pq's midpoint to r crosses first (both ends lie in the leaf, so the
   /// crossing does too, and halving the edges around it puts a vertex into the leaf).
   void split_crossed(const Point<2>& p, const Point<2>& q, const Point<2>& r, int j) {
-    const double m[2] = {0.5 * p[0] + 0.5 * q[0], 0.5 * p[1] + 0.5 * q[1]};
-    int side = -1;
-    double best = 2;
-    const auto consider = [&](int s, unsigned axis, double bound) {
-      const double f = (bound - m[axis]) / (r[axis] - m[axis]);
-      if (f < best) best = f, side = s;
-    };
-    if (r[1] < lo_[1]) consider(0, 1, lo_[1]);
-    if (r[0] > hi_[0]) consider(1, 0, hi_[0]);
-    if (r[1] > hi_[1]) consider(2, 1, hi_[1]);
-    if (r[0] < lo_[0]) consider(3, 0, lo_[0]);
-    const unsigned along = side % 2 == 0 ? 0 : 1;
-    const double x = std::clamp(m[along] + best * (r[along] - m[along]), lo_[along], hi_[along]);
+    const auto [side, x] = detail::side_crossed(box_, p, q, r);
     const auto& line = sides_[side];
     auto it = line.upper_bound(x);
     if (it == line.end()) --it;
@@ -355,31 +243,6 @@ class Refiner {
     if (dt_.num_vertices() > max_vertices_)
       throw InvariantError("dynmesh: hpu refinement did not terminate (over " + std::to_string(max_vertices_) +
                            " vertices)");
-  }
-
-  struct OffCenter {
-    Point<2> at;
-    bool circumcentre;
-  };
-  /// The off-center of pq for the counter-clockwise triangle p, q, t, t being pq's Delaunay
-  /// neighbour on the left: the apex of the leaf, or the circumcentre of p, q, t when that is
-  /// no farther from pq's midpoint (the crescent holds t). One fixed sequence of double
-  /// operations, in a frame scaled by a power of two (exact) so that the products neither
-  /// overflow nor underflow in any accepted box.
-  OffCenter off_center(const Point<2>& p, const Point<2>& q, const Point<2>& t) const noexcept {
-    double bx = q[0] - p[0], by = q[1] - p[1], cx = t[0] - p[0], cy = t[1] - p[1];
-    const int e = std::ilogb(std::max({std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)}));
-    bx = std::ldexp(bx, -e), by = std::ldexp(by, -e), cx = std::ldexp(cx, -e), cy = std::ldexp(cy, -e);
-    const double mx = 0.5 * bx, my = 0.5 * by;
-    const double ax = mx - apex_height_ * by, ay = my + apex_height_ * bx;
-    const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
-    const double d = 2.0 * (bx * cy - by * cx);
-    const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
-    const double du = (ux - mx) * (ux - mx) + (uy - my) * (uy - my);
-    const double da = apex_height_ * apex_height_ * b2;
-    const bool circumcentre = du <= da;
-    const double rx = circumcentre ? ux : ax, ry = circumcentre ? uy : ay;
-    return OffCenter{Point<2>{p[0] + std::ldexp(rx, e), p[1] + std::ldexp(ry, e)}, circumcentre};
   }
 
   Box<2> box_;

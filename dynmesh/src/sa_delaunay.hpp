@@ -16,6 +16,10 @@
 //   SaDelaunay::insert(x, hint)      walk from `hint` (live here) to x, collect the cavity,
 //                                    fan it from x
 //   SaDelaunay::insert_near(x, v)    insert(x, v.tri), v.tri read in the trace
+//   SaDelaunay::insert_with(x, h, k) insert's walk and cavity, then k decides: commit the
+//                                    fan (fan(e, dt, x, cavity)) or leave it (the mesher
+//                                    refuses off-centers that encroach a box edge)
+//   SaDelaunay::locate(p, t, k)      the walk alone, to the triangle holding p, passed to k
 //   SaDelaunay::read_star(v, k)      v's neighbours counter-clockwise, passed to k
 //   SaDelaunayProgram                the input list inserted in list order, each point from
 //                                    the previous one's triangle (QuadtreeMeshProgram style)
@@ -353,7 +357,44 @@ struct SaDelaunay {
   /// Inserts x (a vertex() inside the closed box, not yet in the triangulation) starting
   /// the walk at `hint`, which must be live at this point of the trace (read from a
   /// vertex's `tri` in the calling body, say: its corners are not read, its links are).
-  static void insert(sac::Engine& e, SaDelaunay* dt, SaVertex* x, SaTri* hint) { walk_at(e, dt, x, hint); }
+  static void insert(sac::Engine& e, SaDelaunay* dt, SaVertex* x, SaTri* hint) { walk_at(e, dt, x, hint, Commit{}); }
+
+  /// The continuation of an insertion that commits it: fan the cavity.
+  struct Commit {
+    friend bool operator==(const Commit&, const Commit&) = default;
+    std::size_t hash() const noexcept { return 0x9e37'79b9; }
+    template <class C>
+    void operator()(sac::Engine& e, SaDelaunay* dt, SaVertex* x, const C& w) const {
+      fan(e, dt, x, w);
+    }
+  };
+
+  /// Insertion with a say: walks from `hint` (as insert) and collects x's cavity, then calls
+  /// k(Engine&, SaDelaunay*, SaVertex* x, const Cavity&) in the body of the cavity's last
+  /// read, which may commit it (fan(e, dt, x, cavity)) or leave the triangulation as it is
+  /// (the refinement refuses an off-center that encroaches a box edge of its cavity). k must
+  /// be equality comparable and hashable (it is part of the walk's memo keys), and copyable.
+  template <class K>
+  static void insert_with(sac::Engine& e, SaDelaunay* dt, SaVertex* x, SaTri* hint, const K& k) {
+    walk_at(e, dt, x, hint, k);
+  }
+
+  /// Walks from t (live here) to the triangle holding p in its closure (p in the closed
+  /// box) by walk_at's rule, and calls k(Engine&, SaTri*) there, in the last read's body.
+  /// Memoized on (p, t, k), like the insertion's walk.
+  template <class K>
+  static void locate(sac::Engine& e, const Point<2>& p, SaTri* t, const K& k) {
+    const int exit = exit_edge(*t, p);
+    if (exit < 0) return k(e, t);
+    if (t->e[sa_index::at(exit)]->box_side)
+      throw InvariantError("dynmesh: SaDelaunay: locating " + to_string(p) + " outside the box");
+    e.memo_read(t->across(exit), sac::fn<&locate_via<K>>(std::pair{p[0], p[1]}, t, k));
+  }
+  template <class K>
+  static void locate_via(sac::Engine& e, SaTri* u, std::pair<double, double> p, SaTri* t, K k) {
+    (void)t;  // part of the memo key only
+    locate(e, Point<2>{p.first, p.second}, u, k);
+  }
 
   /// Inserts x starting from the triangle `near` points at (read here, so a change of it
   /// re-routes the walk).
@@ -388,22 +429,24 @@ struct SaDelaunay {
   }
 
   /// The walk at t (live now): leave through the exit edge, or start the cavity at t.
-  static void walk_at(sac::Engine& e, SaDelaunay* dt, SaVertex* x, SaTri* t) {
+  template <class K>
+  static void walk_at(sac::Engine& e, SaDelaunay* dt, SaVertex* x, SaTri* t, const K& k) {
     const int exit = exit_edge(*t, x->p);
     if (exit >= 0) {
       if (t->e[sa_index::at(exit)]->box_side)
         throw InvariantError("dynmesh: SaDelaunay: inserting " + to_string(x->p) + " outside the box");
-      return e.memo_read(t->across(exit), sac::fn<&walk_via>(dt, x, t));
+      return e.memo_read(t->across(exit), sac::fn<&walk_via<K>>(dt, x, t, k));
     }
     for (const SaVertex* c : t->v)
       if (c->p == x->p) throw InvariantError("dynmesh: SaDelaunay: " + to_string(x->p) + " inserted twice");
-    cavity_step(e, dt, x, Cavity{{t}, 0, 0, {}});
+    cavity_step(e, dt, x, Cavity{{t}, 0, 0, {}}, k);
   }
 
   /// The walk crossed t's exit edge into u.
-  static void walk_via(sac::Engine& e, SaTri* u, SaDelaunay* dt, SaVertex* x, SaTri* t) {
+  template <class K>
+  static void walk_via(sac::Engine& e, SaTri* u, SaDelaunay* dt, SaVertex* x, SaTri* t, K k) {
     (void)t;  // part of the memo key only
-    walk_at(e, dt, x, u);
+    walk_at(e, dt, x, u, k);
   }
 
   /// A boundary edge a→b of the cavity (counter-clockwise around it).
@@ -425,7 +468,8 @@ struct SaDelaunay {
   /// continues in the body), and fans the cavity when it is complete. Edges on the box and
   /// edges shared with a member need no read. The closures copy the search: a body may run
   /// again, so it must not consume what it captured.
-  static void cavity_step(sac::Engine& e, SaDelaunay* dt, SaVertex* x, Cavity w) {
+  template <class K>
+  static void cavity_step(sac::Engine& e, SaDelaunay* dt, SaVertex* x, Cavity w, const K& k) {
     using sa_index::at;
     using sa_index::next;
     using sa_index::prev;
@@ -442,19 +486,19 @@ struct SaDelaunay {
           return q != m && std::find(q->e.begin(), q->e.end(), ed) != q->e.end();
         };
         if (std::any_of(w.members.begin(), w.members.end(), shares)) continue;
-        e.read(m->across(w.edge), [dt, x, w](sac::Engine& e2, SaTri* u) {
+        e.read(m->across(w.edge), [dt, x, w, k](sac::Engine& e2, SaTri* u) {
           Cavity c = w;
           const SaTri* q = c.members[c.at];
           // u's corners are fixed: the test needs no read.
           if (u->in_conflict(x->p)) c.members.push_back(u);
           else c.boundary.push_back(Boundary{q->v[at(next(c.edge))], q->v[at(prev(c.edge))], q->e[at(c.edge)]});
           ++c.edge;
-          cavity_step(e2, dt, x, std::move(c));
+          cavity_step(e2, dt, x, std::move(c), k);
         });
         return;
       }
     }
-    fan(e, dt, x, w);
+    k(e, dt, x, std::as_const(w));
   }
 
   /// Replaces the cavity by the fan of x: keyed allocations and memoized writes only (no

@@ -1,0 +1,231 @@
+// hpu_geometry.hpp (private) — the pure geometry of the hpu mesh, shared by its static twin
+// (hpu_mesh.cpp, class Refiner) and its self-adjusting version (hpu_program.hpp).
+//
+// Purpose: both meshers must take the same decisions on the same bits, so every formula
+// that produces a coordinate or a class (side midpoints, off-centers, circumradii, size
+// classes, Morton codes, the leaf and apex heights) and the loose test live here once, as
+// functions of points only (no triangulation, no vertex ids).
+// Invariants: each function is one fixed sequence of double operations on its arguments;
+// where the result must not depend on the argument order (side_midpoint, circumradius2) it
+// first puts the arguments in (x, y) order.
+// Complexity: O(1) each; side_midpoints O(n log n + n·halvings).
+// Paper: Üngör, "Off-centers" (2004); Acar & Hudson, Figure 5 (DynHPU); Ruppert (1995) and
+// Shewchuk's Triangle for encroached subsegments.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+#include <span>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/errors.hpp"
+#include "dynmesh/mesh.hpp"
+#include "dynmesh/point.hpp"
+#include "dynmesh/predicates.hpp"
+#include "z_order.hpp"
+
+namespace dynmesh::detail {
+
+inline double squared_length(const Point<2>& a, const Point<2>& b) noexcept {
+  const double dx = b[0] - a[0], dy = b[1] - a[1];
+  return dx * dx + dy * dy;
+}
+
+/// (x, y) order of unordered point pairs: the tie rule of key edges and side splits.
+inline bool pair_less(const Point<2>& a0, const Point<2>& a1, const Point<2>& b0, const Point<2>& b1) noexcept {
+  const Point<2>& alo = xy_less(a1, a0) ? a1 : a0;
+  const Point<2>& ahi = xy_less(a1, a0) ? a0 : a1;
+  const Point<2>& blo = xy_less(b1, b0) ? b1 : b0;
+  const Point<2>& bhi = xy_less(b1, b0) ? b0 : b1;
+  if (alo != blo) return xy_less(alo, blo);
+  return xy_less(ahi, bhi);
+}
+
+/// Of the leaf's apex height; Triangle uses 0.95 of the off-center distance too.
+inline constexpr double kApexFactor = 0.95;
+/// k is taken this much lower (hpu_mesh.hpp, rule 2).
+inline constexpr double kLeafMargin = 1.0 - 0x1p-30;
+
+/// The apex height h = 0.95·(ρ + k) relative to |pq|, for the angle bound in degrees.
+inline double apex_height(double min_angle_deg) noexcept {
+  return kApexFactor * 0.5 / std::tan(min_angle_deg * (std::numbers::pi / 360.0));
+}
+
+/// The leaf height k = 1 / (2 tan θ), a little lower (kLeafMargin): a leaf that is slightly
+/// too small only ever calls more pairs loose, so every angle of the result clears θ by more
+/// than the checker's rounding.
+inline double leaf_height(double min_angle_deg) noexcept {
+  return kLeafMargin * 0.5 / std::tan(min_angle_deg * (std::numbers::pi / 180.0));
+}
+
+/// The size class of an edge of squared length `squared`: ⌊log2 |pq|⌋.
+inline int size_class(double squared) noexcept { return std::ilogb(squared) >> 1; }
+/// ⌊log2 |ab|⌋ as size_class(|ab|²) gives it, computed in a frame scaled by a power of two
+/// (exact), so that |ab|² neither overflows in a huge box nor underflows to 0 in a tiny one
+/// (fuzz_hpu_mesh found the int overflow that followed). a ≠ b.
+inline int edge_class(const Point<2>& a, const Point<2>& b) noexcept {
+  const double dx = b[0] - a[0], dy = b[1] - a[1];
+  const int e = std::ilogb(std::max(std::abs(dx), std::abs(dy)));
+  const double sx = std::ldexp(dx, -e), sy = std::ldexp(dy, -e);
+  return e + (std::ilogb(sx * sx + sy * sy) >> 1);
+}
+/// 4^(j+1): the squared circumradius above which a vertex of class j stays queued.
+inline double continuation_radius2(int j) noexcept { return std::ldexp(1.0, 2 * (std::clamp(j, -1100, 1100) + 1)); }
+
+/// The Morton code of p on the box's 2^32 grid (clamped): the initial queue order.
+inline std::uint64_t morton_of(const Box<2>& box, const Point<2>& p) noexcept {
+  const auto axis = [&](unsigned a) {
+    const double u = (p[a] - box.origin[a]) / box.side * 0x1p32;
+    return static_cast<std::uint32_t>(std::clamp(u, 0.0, 0x1p32 - 1));
+  };
+  return z_order(axis(0), axis(1));
+}
+
+/// (Morton, (x, y)) order of points in the box.
+inline bool morton_less(const Box<2>& box, const Point<2>& a, const Point<2>& b) noexcept {
+  const std::uint64_t ca = morton_of(box, a), cb = morton_of(box, b);
+  if (ca != cb) return ca < cb;
+  return xy_less(a, b);
+}
+
+/// The midpoint of a box edge, from its (x, y)-smaller end: one formula whoever asks (the
+/// precomputation and a split during refinement), so the same edge always gives the same
+/// bits. Throws InputError(Resolution) when double precision cannot split the edge.
+inline Point<2> side_midpoint(const Point<2>& p, const Point<2>& q) {
+  const Point<2>& a = xy_less(q, p) ? q : p;
+  const Point<2>& b = xy_less(q, p) ? p : q;
+  const Point<2> mid{a[0] + (b[0] - a[0]) * 0.5, a[1] + (b[1] - a[1]) * 0.5};
+  if (mid == a || mid == b)
+    throw InputError(InputError::Kind::Resolution,
+                     "the mesh must split a box edge of length " + format_exact(std::sqrt(squared_length(a, b))) +
+                         " that double precision cannot split: the spread is beyond the mesh's resolution");
+  return mid;
+}
+
+/// The midpoints that splitting encroached box edges adds, computed from the points alone,
+/// (x, y)-sorted. An edge's diametral disc holds its halves' discs, and a point strictly
+/// inside one projects strictly inside the edge; midpoints and corners never encroach. So
+/// the edges split are exactly those some input encroaches, and for each input they form
+/// one path down the halving of the side edge its projection falls in. Inserting these
+/// before the inputs keeps their cavities small (splitting after the inputs made every
+/// split's cavity the fan of a line of points: quadratic on collinear input).
+inline std::vector<Point<2>> side_midpoints(const Box<2>& box, std::span<const Point<2>> points) {
+  const double lo[2] = {box.origin[0], box.origin[1]};
+  const double hi[2] = {box.origin[0] + box.side, box.origin[1] + box.side};
+  std::vector<Point<2>> out, side;
+  for (unsigned u = 0; u < 2; ++u) {  // the axis along the side
+    const unsigned w = 1 - u;         // the axis across it
+    for (const double c : {lo[w], hi[w]}) {
+      const auto at = [&](double t) {
+        Point<2> p;
+        p[u] = t;
+        p[w] = c;
+        return p;
+      };
+      side = {at(lo[u]), at(hi[u])};
+      for (const Point<2>& p : points)
+        if (p[w] == c) side.push_back(p);
+      std::sort(side.begin(), side.end(), [&](const Point<2>& a, const Point<2>& b) { return a[u] < b[u]; });
+      side.erase(std::unique(side.begin(), side.end()), side.end());
+      for (const Point<2>& p : points) {
+        if (p[w] == c) continue;
+        const auto it = std::upper_bound(side.begin(), side.end(), p[u],
+                                         [&](double t, const Point<2>& v) { return t < v[u]; });
+        if (it == side.begin() || it == side.end() || !((it - 1)->at(u) < p[u])) continue;
+        Point<2> a = *(it - 1), b = *it;
+        while (encroaches(a, b, p)) {
+          const Point<2> m = side_midpoint(a, b);
+          out.push_back(m);
+          if (p[u] < m[u]) b = m;
+          else if (p[u] > m[u]) a = m;
+          else break;
+        }
+      }
+    }
+  }
+  std::sort(out.begin(), out.end(), xy_less);
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+/// The squared circumradius of a, b, c in one fixed sequence of double operations, from
+/// the corner that is smallest in (x, y) order, so that any reader of the same triangle
+/// gets the same bits.
+inline double circumradius2(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept {
+  const Point<2>*P = &a, *Q = &b, *R = &c;
+  if (xy_less(*Q, *P) && xy_less(*Q, *R)) std::tie(P, Q, R) = std::tuple{Q, R, P};
+  else if (xy_less(*R, *P) && xy_less(*R, *Q)) std::tie(P, Q, R) = std::tuple{R, P, Q};
+  const double bx = (*Q)[0] - (*P)[0], by = (*Q)[1] - (*P)[1], cx = (*R)[0] - (*P)[0], cy = (*R)[1] - (*P)[1];
+  const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+  const double d = 2.0 * (bx * cy - by * cx);
+  const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
+  return ux * ux + uy * uy;
+}
+
+/// p→q is ccw-loose: its ccw-leaf (height `leaf`) holds no vertex. t is the third corner of
+/// the triangle on its left (null: the outside of the box), u the one on its right (null:
+/// a box side). When pq is a Delaunay edge, t and u are the vertices nearest the leaf on
+/// either side, so they decide.
+inline bool loose(const Point<2>& p, const Point<2>& q, double leaf, const Point<2>* t, const Point<2>* u) noexcept {
+  if (!t) return false;
+  if (pencil(p, q, leaf, *t) < 0) return false;
+  return !u || pencil(p, q, leaf, *u) >= 0;
+}
+
+struct OffCenter {
+  Point<2> at;
+  bool circumcentre;
+};
+
+/// The off-center of pq for the counter-clockwise triangle p, q, t, t being pq's Delaunay
+/// neighbour on the left: the apex of the leaf (height `apex`), or the circumcentre of p,
+/// q, t when that is no farther from pq's midpoint (the crescent holds t). One fixed
+/// sequence of double operations, in a frame scaled by a power of two (exact) so that the
+/// products neither overflow nor underflow in any accepted box.
+inline OffCenter off_center(const Point<2>& p, const Point<2>& q, const Point<2>& t, double apex) noexcept {
+  double bx = q[0] - p[0], by = q[1] - p[1], cx = t[0] - p[0], cy = t[1] - p[1];
+  const int e = std::ilogb(std::max({std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)}));
+  bx = std::ldexp(bx, -e), by = std::ldexp(by, -e), cx = std::ldexp(cx, -e), cy = std::ldexp(cy, -e);
+  const double mx = 0.5 * bx, my = 0.5 * by;
+  const double ax = mx - apex * by, ay = my + apex * bx;
+  const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+  const double d = 2.0 * (bx * cy - by * cx);
+  const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
+  const double du = (ux - mx) * (ux - mx) + (uy - my) * (uy - my);
+  const double da = apex * apex * b2;
+  const bool circumcentre = du <= da;
+  const double rx = circumcentre ? ux : ax, ry = circumcentre ? uy : ay;
+  return OffCenter{Point<2>{p[0] + std::ldexp(rx, e), p[1] + std::ldexp(ry, e)}, circumcentre};
+}
+
+/// The box side the segment from pq's midpoint m to r (outside the box) crosses first
+/// (0 bottom, 1 right, 2 top, 3 left) and the crossing's coordinate along that side,
+/// clamped to the box.
+struct SideCrossing {
+  int side;
+  double along;
+};
+inline SideCrossing side_crossed(const Box<2>& box, const Point<2>& p, const Point<2>& q, const Point<2>& r) noexcept {
+  const double lo[2] = {box.origin[0], box.origin[1]};
+  const double hi[2] = {box.origin[0] + box.side, box.origin[1] + box.side};
+  const double m[2] = {0.5 * p[0] + 0.5 * q[0], 0.5 * p[1] + 0.5 * q[1]};
+  int side = -1;
+  double best = 2;
+  const auto consider = [&](int s, unsigned axis, double bound) {
+    const double f = (bound - m[axis]) / (r[axis] - m[axis]);
+    if (f < best) best = f, side = s;
+  };
+  if (r[1] < lo[1]) consider(0, 1, lo[1]);
+  if (r[0] > hi[0]) consider(1, 0, hi[0]);
+  if (r[1] > hi[1]) consider(2, 1, hi[1]);
+  if (r[0] < lo[0]) consider(3, 0, lo[0]);
+  const unsigned along = side % 2 == 0 ? 0 : 1;
+  return SideCrossing{side, std::clamp(m[along] + best * (r[along] - m[along]), lo[along], hi[along])};
+}
+
+}  // namespace dynmesh::detail

@@ -1,0 +1,383 @@
+// hpu_program_test.cpp — src/hpu_program.hpp, DynHPU's off-center refinement as a
+// self-adjusting program: from scratch (uniform, clustered, points near and on the box
+// sides, a grid) and after every update of a dynamic run, its triangles equal the static
+// twin HpuMesh's on the current points at 20.7°, 25° and 30°; the engine's and the
+// triangulation's invariants hold; the per-update trace distance is printed against the
+// from-scratch trace, and bounded to catch a program that re-runs everything.
+#include "hpu_program.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <deque>
+#include <iterator>
+#include <map>
+#include <memory>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <sac/engine.hpp>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/hpu_mesh.hpp"
+#include "dynmesh/mesh.hpp"
+#include "dynmesh/point.hpp"
+#include "hpu_geometry.hpp"
+#include "sa_delaunay.hpp"
+#include "../sanitized.hpp"
+
+namespace {
+
+using namespace dynmesh;
+using detail::HpuProgram;
+using detail::SaInputNode;
+using test_support::kSanitized;
+
+std::string tri_string(const Triangle& t) {
+  return to_string(t.v[0]) + " " + to_string(t.v[1]) + " " + to_string(t.v[2]);
+}
+
+/// Equal triangle lists, or the counts and the first few differences.
+testing::AssertionResult same_triangles(const std::vector<Triangle>& got, const std::vector<Triangle>& want) {
+  if (got == want) return testing::AssertionSuccess();
+  std::vector<Triangle> extra, missing;
+  std::set_difference(got.begin(), got.end(), want.begin(), want.end(), std::back_inserter(extra));
+  std::set_difference(want.begin(), want.end(), got.begin(), got.end(), std::back_inserter(missing));
+  auto r = testing::AssertionFailure() << got.size() << " triangles, the static twin has " << want.size() << "; "
+                                       << extra.size() << " extra, " << missing.size() << " missing";
+  for (std::size_t i = 0; i < std::min<std::size_t>(3, extra.size()); ++i) r << "\n  extra   " << tri_string(extra[i]);
+  for (std::size_t i = 0; i < std::min<std::size_t>(3, missing.size()); ++i)
+    r << "\n  missing " << tri_string(missing[i]);
+  return r;
+}
+
+/// The program on a mutator-owned input list: the inputs and their side midpoints in
+/// (Morton, xy) order. set_points() diffs the list, relinks it with Engine::set,
+/// propagates, and frees the nodes of points that left.
+class HpuHarness {
+ public:
+  HpuHarness(const Box<2>& box, const std::vector<Point<2>>& pts, double angle)
+      : box_(box), dt_{&registry_, box}, program_(&dt_, &head_, angle) {
+    relink(pts);
+    engine_.run([this](sac::Engine& e) { HpuProgram::main(e, &program_); });
+  }
+
+  void set_points(const std::vector<Point<2>>& pts) {
+    const std::vector<SaInputNode*> gone = relink(pts);
+    engine_.propagate();
+    for (SaInputNode* n : gone) {
+      ASSERT_TRUE(engine_.unused(n->next)) << "the trace still reads an erased node";
+      engine_.retire(n->next);
+      nodes_.erase(n->point);
+    }
+  }
+
+  std::vector<Triangle> triangles() const { return registry_.triangles(); }
+  void check() const {
+    engine_.check_invariants();
+    registry_.check_invariants(box_);
+  }
+  const sac::Stats& stats() const { return engine_.stats(); }
+
+ private:
+  /// Makes the list the sorted inputs and midpoints; returns the unlinked nodes.
+  std::vector<SaInputNode*> relink(const std::vector<Point<2>>& pts) {
+    std::set<Point<2>> all(pts.begin(), pts.end());
+    for (const auto& m : detail::side_midpoints(box_, pts)) all.insert(m);
+    all.erase(box_.origin);  // an input at the near corner: the box's own vertex already
+    std::vector<Point<2>> order(all.begin(), all.end());
+    std::sort(order.begin(), order.end(),
+              [this](const Point<2>& a, const Point<2>& b) { return detail::morton_less(box_, a, b); });
+    std::vector<SaInputNode*> gone;
+    for (const auto& [p, n] : nodes_)
+      if (!all.count(p)) gone.push_back(n.get());
+    std::vector<SaInputNode*> list;
+    for (const auto& p : order) {
+      auto& slot = nodes_[p];
+      if (!slot) slot = std::make_unique<SaInputNode>(p);
+      list.push_back(slot.get());
+    }
+    for (std::size_t i = 0; i < list.size(); ++i)
+      engine_.set(list[i]->next, i + 1 < list.size() ? list[i + 1] : nullptr);
+    engine_.set(head_, list.empty() ? nullptr : list.front());
+    return gone;
+  }
+
+  // Declared before the engine, so destroyed after it.
+  Box<2> box_;
+  detail::SaTriRegistry registry_;
+  std::map<Point<2>, std::unique_ptr<SaInputNode>> nodes_;
+  sac::Mod<SaInputNode*> head_;
+  sac::Engine engine_;
+  detail::SaDelaunay dt_;
+  HpuProgram program_;
+};
+
+std::string seed_note(std::uint64_t seed) {
+  std::printf("[ HpuProgram ] seed %llu\n", static_cast<unsigned long long>(seed));
+  return "seed " + std::to_string(seed);
+}
+
+constexpr double kAngles[] = {kHpuDefaultMinAngle, 25.0, 30.0};
+
+void expect_from_scratch(const Box<2>& box, const std::vector<Point<2>>& pts) {
+  for (const double angle : kAngles) {
+    SCOPED_TRACE("angle " + std::to_string(angle));
+    const HpuMesh twin(box, pts, angle);
+    HpuHarness h(box, pts, angle);
+    std::printf("[ HpuProgram ] n = %zu, %.1f°: %zu triangles, %zu off-centers, %zu side splits\n", pts.size(), angle,
+                twin.triangles().size(), twin.stats().off_centers, twin.stats().side_splits);
+    EXPECT_TRUE(same_triangles(h.triangles(), twin.triangles()));
+    EXPECT_NO_THROW(h.check());
+  }
+}
+
+// ------------------------------------------------------------------ from scratch
+
+TEST(HpuProgram, FromScratchUniform) {
+  const std::uint64_t seed = 101;
+  SCOPED_TRACE(seed_note(seed));
+  const Box<2> box{{0, 0}, 1};
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Point<2>> pts;
+  for (int i = 0; i < (kSanitized ? 80 : 300); ++i) pts.push_back({u(rng), u(rng)});
+  expect_from_scratch(box, pts);
+}
+
+TEST(HpuProgram, FromScratchClustered) {
+  const std::uint64_t seed = 103;
+  SCOPED_TRACE(seed_note(seed));
+  const auto pts = generate<2>(Distribution::Clusters, kSanitized ? 80 : 300, seed);
+  expect_from_scratch(derive_box<2>(pts), pts);
+}
+
+TEST(HpuProgram, FromScratchPointsNearAndOnTheSides) {
+  const std::uint64_t seed = 107;
+  SCOPED_TRACE(seed_note(seed));
+  const Box<2> box{{0, 0}, 4};
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.01, 3.99);
+  std::set<Point<2>> s;
+  for (int i = 0; i < (kSanitized ? 8 : 20); ++i) {
+    const double t = u(rng), w = u(rng) * 0.002;
+    // Points lie in [o, o + L) (box.hpp): on the near sides, close to all four.
+    s.insert({t, 0.0});                 // on the bottom
+    s.insert({0.0, t});                 // on the left
+    s.insert({3.999 - w, t});           // near the right
+    s.insert({t, 3.999 - w});           // near the top
+    s.insert({w + 0.001, u(rng)});      // near the left
+  }
+  s.insert({2.0, 0.0});
+  s.insert({0.0, 2.0});
+  s.insert({0.0, 0.0});  // the near corner, an input too
+  for (int i = 0; i < 10; ++i) s.insert({u(rng), u(rng)});
+  expect_from_scratch(box, std::vector<Point<2>>(s.begin(), s.end()));
+}
+
+TEST(HpuProgram, FromScratchSmallGrids) {
+  const std::uint64_t seed = 109;
+  SCOPED_TRACE(seed_note(seed));
+  const Box<2> box{{0, 0}, 8};
+  // A square grid (cocircular everywhere, nothing to refine) with one point on a side, and a
+  // grid of 1 × 1/4 cells (skinny cocircular triangles, refined).
+  for (const double dy : {1.0, 0.25}) {
+    SCOPED_TRACE("dy " + std::to_string(dy));
+    std::vector<Point<2>> pts;
+    for (int i = 1; i < 8; ++i)
+      for (double y = dy; y < 8.0; y += dy) pts.push_back({double(i), y});
+    pts.push_back({4.0, 0.0});
+    expect_from_scratch(box, pts);
+  }
+}
+
+// ------------------------------------------------------------------ updates
+
+/// Random updates (insert a fresh point or delete a present one), each propagated and
+/// compared with a fresh twin; the invariants every 10. Returns the per-update trace
+/// distances and sets `scratch` to the from-scratch event count.
+template <class Fresh>
+std::vector<std::uint64_t> run_updates(const Box<2>& box, std::vector<Point<2>> pts, Fresh fresh, double angle,
+                                       int updates, std::mt19937_64& rng, std::uint64_t& scratch) {
+  std::vector<std::uint64_t> distance;
+  HpuHarness h(box, pts, angle);
+  EXPECT_TRUE(same_triangles(h.triangles(), HpuMesh(box, pts, angle).triangles()));
+  scratch = h.stats().events_created;
+  for (int k = 0; k < updates; ++k) {
+    SCOPED_TRACE("update " + std::to_string(k));
+    if (!pts.empty() && rng() % 2 == 0) pts.erase(pts.begin() + static_cast<std::ptrdiff_t>(rng() % pts.size()));
+    else pts.push_back(fresh());
+    h.set_points(pts);
+    distance.push_back(h.stats().last_trace_distance);
+    const bool same = same_triangles(h.triangles(), HpuMesh(box, pts, angle).triangles());
+    EXPECT_TRUE(same);
+    if (!same) break;
+    if ((k + 1) % 10 == 0) {
+      EXPECT_NO_THROW(h.check());
+    }
+  }
+  return distance;
+}
+
+TEST(HpuProgram, EveryUpdateMatchesAFromScratchTwin) {
+  const std::uint64_t seed = 20261123;
+  SCOPED_TRACE(seed_note(seed));
+  const Box<2> box{{0, 0}, 1};
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const std::size_t n = kSanitized ? 60 : 200;
+  const int updates = kSanitized ? 15 : 60;
+  std::set<Point<2>> used;
+  const auto fresh = [&] {
+    for (;;) {
+      const Point<2> p{u(rng), u(rng)};
+      if (used.insert(p).second) return p;
+    }
+  };
+  std::vector<Point<2>> pts;
+  for (std::size_t i = 0; i < n; ++i) pts.push_back(fresh());
+  std::uint64_t scratch = 0;
+  const auto distance = run_updates(box, pts, fresh, kHpuDefaultMinAngle, updates, rng, scratch);
+  ASSERT_EQ(distance.size(), std::size_t(updates));
+  std::vector<std::uint64_t> sorted = distance;
+  std::sort(sorted.begin(), sorted.end());
+  double mean = 0;
+  for (auto x : distance) mean += double(x);
+  mean /= double(distance.size());
+  const auto pct = [&](double x) { return 100.0 * x / double(scratch); };
+  // Trace distance: events created + undone by the propagation (sac/stats.hpp).
+  std::printf("[ HpuProgram ] n = %zu, %d updates: from scratch %llu events; per update trace distance mean %.1f "
+              "(%.2f%%) median %llu (%.2f%%) max %llu (%.2f%%)\n",
+              n, updates, static_cast<unsigned long long>(scratch), mean, pct(mean),
+              static_cast<unsigned long long>(sorted[sorted.size() / 2]), pct(double(sorted[sorted.size() / 2])),
+              static_cast<unsigned long long>(sorted.back()), pct(double(sorted.back())));
+  // A figure, not a tight bound: a program that re-ran the refinement would be near 100%.
+  EXPECT_LT(mean, 0.25 * double(scratch));
+}
+
+/// Updates next to and on the box's near sides at 30°: side midpoints come and go with
+/// them (the mutator's list changes by more than one point), and the refinement splits
+/// sides.
+TEST(HpuProgram, UpdatesNearTheSidesAt30Degrees) {
+  const std::uint64_t seed = 127;
+  SCOPED_TRACE(seed_note(seed));
+  const Box<2> box{{0, 0}, 4};
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.01, 3.99);
+  std::set<Point<2>> used;
+  const auto fresh = [&] {
+    for (;;) {
+      const double t = u(rng), w = u(rng) * 0.01;
+      const std::uint64_t kind = rng() % 4;
+      const Point<2> p = kind == 0 ? Point<2>{t, 0.0} : kind == 1 ? Point<2>{0.0, t} : kind == 2 ? Point<2>{3.99 - w, t}
+                                                                                                 : Point<2>{t, u(rng)};
+      if (used.insert(p).second) return p;
+    }
+  };
+  std::vector<Point<2>> pts;
+  for (int i = 0; i < (kSanitized ? 20 : 60); ++i) pts.push_back(fresh());
+  std::uint64_t scratch = 0;
+  const auto distance = run_updates(box, pts, fresh, 30.0, kSanitized ? 10 : 40, rng, scratch);
+  double mean = 0;
+  for (auto x : distance) mean += double(x);
+  std::printf("[ HpuProgram ] near the sides, 30°: from scratch %llu events; per update trace distance mean %.1f\n",
+              static_cast<unsigned long long>(scratch), mean / double(std::max<std::size_t>(1, distance.size())));
+}
+
+}  // namespace
+
+namespace {
+
+// ------------------------------------------------------------------ the side crossed
+
+/// Sink of side_edge_at: the edge's end points, written to a modifiable the test reads.
+struct EdgeSink {
+  sac::Mod<std::pair<Point<2>, Point<2>>>* out;
+  friend bool operator==(const EdgeSink&, const EdgeSink&) = default;
+  std::size_t hash() const noexcept { return sac::Hash<void*>{}(out); }
+  void operator()(sac::Engine& e, detail::SaVertex* a, detail::SaVertex* b) const { e.write(*out, std::pair{a->p, b->p}); }
+};
+
+/// The refinement's side rule (never reached on the inputs above: no vertex encroaches a box
+/// edge, so an empty leaf crosses a side only in degenerate cases), tested on its own:
+/// side_edge_at on a triangulation with many side vertices equals the twin's
+/// std::map::upper_bound rule, for X at every side vertex, between them, and at both ends.
+TEST(HpuProgram, SideEdgeAtFollowsTheTwinsUpperBoundRule) {
+  const std::uint64_t seed = 113;
+  SCOPED_TRACE(seed_note(seed));
+  const Box<2> box{{0, 0}, 8};
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 8.0);
+  std::set<Point<2>> s;
+  for (int i = 0; i < 40; ++i) s.insert({u(rng), u(rng)});
+  for (int i = 0; i < 6; ++i) s.insert({u(rng), 0.0}), s.insert({0.0, u(rng)});
+  s.insert({0.0, 4.0});
+  std::vector<Point<2>> inputs(s.begin(), s.end());
+  for (const auto& m : detail::side_midpoints(box, inputs)) s.insert(m);
+  // The triangulation of the points, then queries in a second run.
+  detail::SaTriRegistry registry;
+  std::vector<std::unique_ptr<SaInputNode>> nodes;
+  std::deque<sac::Mod<std::pair<Point<2>, Point<2>>>> outs;
+  sac::Mod<SaInputNode*> head;
+  sac::Engine engine;
+  detail::SaDelaunay dt{&registry, box};
+  detail::SaDelaunayProgram program{&dt, &head};
+  for (const auto& p : s) nodes.push_back(std::make_unique<SaInputNode>(p));
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    engine.set(nodes[i]->next, i + 1 < nodes.size() ? nodes[i + 1].get() : nullptr);
+  engine.set(head, nodes.front().get());
+  engine.run([&](sac::Engine& e) { detail::SaDelaunayProgram::main(e, &program); });
+  detail::SaTri* start = nullptr;
+  std::set<Point<2>> verts;
+  for (detail::SaTri* t : registry.all())
+    if (t->alive()) {
+      start = t;
+      for (const auto* v : t->v) verts.insert(v->p);
+    }
+  ASSERT_NE(start, nullptr);
+  struct Query {
+    int side;
+    Point<2> x;
+    std::pair<Point<2>, Point<2>> want;
+  };
+  std::vector<Query> queries;
+  for (int side = 0; side < 4; ++side) {
+    const unsigned along = side % 2 == 0 ? 0 : 1;
+    const double across = side == 0 || side == 3 ? 0.0 : 8.0;
+    std::map<double, Point<2>> line;
+    for (const auto& p : verts)
+      if (p[1 - along] == across) line[p[along]] = p;
+    std::vector<double> xs{0.0, 8.0};
+    for (auto it = line.begin(); it != line.end(); ++it) {
+      xs.push_back(it->first);
+      if (std::next(it) != line.end()) xs.push_back(0.5 * (it->first + std::next(it)->first));
+    }
+    for (const double x : xs) {
+      auto it = line.upper_bound(x);
+      if (it == line.end()) --it;
+      if (it == line.begin()) ++it;
+      Point<2> p;
+      p[along] = x;
+      p[1 - along] = across;
+      queries.push_back({side, p, {std::prev(it)->second, it->second}});
+      outs.emplace_back();
+    }
+  }
+  engine.run([&](sac::Engine& e) {
+    for (std::size_t i = 0; i < queries.size(); ++i)
+      HpuProgram::side_edge_at(e, queries[i].side, queries[i].x, start, EdgeSink{&outs[i]});
+  });
+  for (std::size_t i = 0; i < queries.size(); ++i) {
+    auto got = outs[i].get();
+    if (xy_less(got.second, got.first)) std::swap(got.first, got.second);
+    EXPECT_EQ(got, queries[i].want) << "side " << queries[i].side << " at " << to_string(queries[i].x);
+  }
+}
+
+}  // namespace
