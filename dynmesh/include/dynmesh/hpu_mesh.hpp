@@ -5,8 +5,8 @@
 // with few Steiner points. It refines the Delaunay triangulation of the box's corners and
 // the points by off-centers processed in size classes, smallest first (Har-Peled & Üngör's
 // order, the seed's Figure 5), and treats the box's sides as segments, as Triangle does with
-// a .poly file. It is meant as the oracle and the baseline of the self-adjusting hpu mesh,
-// which does not exist yet: see "Next" below.
+// a .poly file. It is the oracle and the baseline of the self-adjusting hpu mesh
+// (src/hpu_program.hpp).
 //
 // The algorithm is the seed's Figure 5 on loose pairs, with the choices it leaves open made
 // as follows (ρ = 1/(2 sin θ), k = √(ρ² − 1/4) = 1/(2 tan θ); DESIGN.md, "DynHPU"):
@@ -48,15 +48,10 @@
 // questions quickly (stars, neighbours, cavities): the self-adjusting version answers the
 // same questions from the quadtree's cells and must reach the same mesh.
 //
-// Next: the self-adjusting version (DynamicMesh, Postprocess::Hpu), in the tree's trace. Its
-// first brick exists: src/sa_delaunay.hpp keeps the triangulation itself on the runtime
-// (vertices, edges with their two sides, triangles, as keyed allocations with modifiables;
-// walk, cavity and fan as memoized reads and writes), equal to delaunay.hpp's after every
-// update, at about 1% of the from-scratch trace per update at n = 1000. What remains: the
-// queues as modifiable lists by destination passing (per round the births, per class the
-// continuations), collect and process written on its stars and sides, the box-side rules,
-// inputs in the tree's Z-order, and the final triangles emitted per vertex so that the
-// change feed falls out of the trace.
+// The self-adjusting version: src/hpu_program.hpp runs this algorithm on the runtime, on
+// the self-adjusting triangulation of src/sa_delaunay.hpp, and is bit-identical to this twin
+// after every update (tests/dynmesh/hpu_program_test.cpp). Not yet wired into DynamicMesh:
+// the feed comes from a registry scan, and inputs come from a Morton list the mutator keeps.
 //
 // Invariants: check_invariants(): the triangulation's own invariants (Delaunay, tiling) and
 // the mesh contract through check_mesh (every angle ≥ θ, every input a vertex).
