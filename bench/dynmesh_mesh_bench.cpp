@@ -63,12 +63,13 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
   row.triangles_pp = static_cast<double>(m0.num_triangles()) / static_cast<double>(n);
   twin.reset();
 
-  { DynamicMesh warm(box, initial); }
+  const MeshOptions quadtree{.postprocess = Postprocess::Quadtree};
+  { DynamicMesh warm(box, initial, quadtree); }
   std::vector<double> sc;
   std::optional<DynamicMesh> mesh;
   for (int i = 0; i < reps; ++i) {
     mesh.reset();
-    sc.push_back(seconds([&] { mesh.emplace(box, initial); }));
+    sc.push_back(seconds([&] { mesh.emplace(box, initial, quadtree); }));
   }
   row.scratch_s = median(sc);
   row.bytes_pp = static_cast<double>(mesh->trace_bytes()) / static_cast<double>(n);

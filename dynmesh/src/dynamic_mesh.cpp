@@ -1,5 +1,6 @@
-// dynamic_mesh.cpp — DynamicMesh: QuadtreeCore<2> running QuadTreeRefine and the quadtree
-// postprocess in one trace, the mesh's own input rules, and the change feed.
+// dynamic_mesh.cpp — DynamicMesh: QuadtreeCore<2> running QuadTreeRefine and a postprocess
+// in one trace (the quadtree mesh, or the hpu mesh on its input list), the mesh's own input
+// rules, and the change feed.
 #include "dynmesh/dynamic_mesh.hpp"
 
 #include <algorithm>
@@ -10,8 +11,13 @@
 #include <utility>
 
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
+#include "dynmesh/mesh_check.hpp"
+#include "hpu_geometry.hpp"
+#include "hpu_inputs.hpp"
+#include "hpu_program.hpp"
 #include "quadtree_core.hpp"
 #include "quadtree_mesh_program.hpp"
+#include "sa_delaunay.hpp"
 
 namespace dynmesh {
 namespace detail {
@@ -48,23 +54,44 @@ const Box<2>& validated(const Box<2>& box) {
   return box;
 }
 
+/// The options, validated before anything is built.
+MeshOptions validated(MeshOptions o) {
+  if (o.postprocess == Postprocess::Hpu) validate_min_angle(o.min_angle);
+  return o;
+}
+
 struct MeshState {
-  MeshState(const Box<2>& box, MeshOptions opts) : options(opts), log(MeshGrid(validated(box))), core(box) {
+  MeshState(const Box<2>& box, MeshOptions opts)
+      : options(validated(opts)), log(MeshGrid(validated(box))), hpu_inputs(box), core(box),
+        dt{&registry, box}, hpu(&dt, &hpu_inputs.head(), options.min_angle) {
     program.dir = &core.dir;
     program.input = &core.head;
     program.log = &log;
   }
-  ~MeshState() { log.closing = true; }  // before core (and its engine) goes
+  ~MeshState() {  // before core (and its engine) goes
+    log.closing = true;
+    registry.close();
+  }
+
+  bool is_hpu() const noexcept { return options.postprocess == Postprocess::Hpu; }
 
   MeshOptions options;
   FeedLog log;
   CellCounts counts;
   MeshChange change;
   QuadtreeMeshProgram program{};
+  // The hpu mesh: its triangles' registry and its input list outlive the engine.
+  SaTriRegistry registry;
+  HpuInputs hpu_inputs;
   QuadtreeCore<2> core;
+  SaDelaunay dt;
+  HpuProgram hpu;
 
-  void validate(std::span<const Edit<2>> edits, const std::string& noun) const {
+  /// The whole batch against the quadtree's and the mesh's input rules; with hpu, also its
+  /// side midpoints (returned as the plan to commit). Changes nothing.
+  HpuInputs::Plan validate(std::span<const Edit<2>> edits, const std::string& noun) const {
     core.validate(edits, noun, MeshChecks{log.grid, counts});
+    return is_hpu() ? hpu_inputs.plan(edits) : HpuInputs::Plan{};
   }
   void count(std::span<const Edit<2>> edits) {
     const int level = std::max(log.grid.level_limit, 0);
@@ -75,13 +102,26 @@ struct MeshState {
       if (k == 0) counts.erase(c);
     }
   }
-  std::vector<PointId> update(std::span<const Edit<2>> edits) {
+  std::vector<PointId> update(std::span<const Edit<2>> edits, const HpuInputs::Plan& plan) {
+    if (is_hpu()) {
+      auto ids = core.update(edits, [&](sac::Engine& e) { hpu_inputs.commit(e, plan); });
+      hpu_inputs.release(core.rt);
+      count(edits);
+      change = registry.take_change();
+      return ids;
+    }
     log.created.clear();
     log.removed.clear();
     auto ids = core.update(edits);
     count(edits);
     collect_change();
     return ids;
+  }
+  /// The present points (for the hpu mesh's checkers).
+  std::vector<Point<2>> present() const {
+    std::vector<Point<2>> out;
+    for (const auto* n = core.first; n; n = n->succ) out.push_back(n->point);
+    return out;
   }
   /// The feed of the update just propagated: the triangles of the blocks it undid, less
   /// those of the blocks it made (a leaf re-made unchanged is no change).
@@ -120,17 +160,26 @@ void check_trees_of(const DynamicMesh& mesh, const MeshState& s) {
   std::sort(tree.begin(), tree.end());
   require_valid_tree<2>(qs, tree);
   // T': every point leaf has its block of same-size leaves.
-  require_refined_tree(mesh.refined_leaves(), mesh.size());
+  if (!s.is_hpu()) require_refined_tree(mesh.refined_leaves(), mesh.size());
+}
+
+/// The hpu mesh's own structures: the triangulation (Delaunay links, tiling, the feed's
+/// count) and the input list. O(n lg n).
+void check_hpu_structures(const MeshState& s) {
+  s.registry.check_invariants(s.core.box);
+  s.hpu_inputs.check_invariants(s.present());
 }
 
 /// Applies validated edits with one propagation. Built with the CMake option
 /// SAC_DEBUG_CHECKS, every checker then runs: check_invariants() but the engine's, which
 /// propagate() has just run.
-std::vector<PointId> checked_update(const DynamicMesh& mesh, MeshState& s, std::span<const Edit<2>> edits) {
-  std::vector<PointId> ids = s.update(edits);
+std::vector<PointId> checked_update(const DynamicMesh& mesh, MeshState& s, std::span<const Edit<2>> edits,
+                                    const HpuInputs::Plan& plan) {
+  std::vector<PointId> ids = s.update(edits, plan);
 #ifdef SAC_DEBUG_CHECKS
   s.core.check_own_invariants();
   check_trees_of(mesh, s);
+  if (s.is_hpu()) check_hpu_structures(s);
 #else
   (void)mesh;
 #endif
@@ -141,15 +190,20 @@ std::vector<PointId> checked_update(const DynamicMesh& mesh, MeshState& s, std::
 
 DynamicMesh::DynamicMesh(const Box<2>& box, std::span<const Point<2>> points, MeshOptions options)
     : s_(std::make_unique<detail::MeshState>(box, options)) {
-  if (options.postprocess != Postprocess::Quadtree)
-    throw InputError(InputError::Kind::Malformed, "the hpu postprocess is not available yet: use quadtree");
   std::vector<Edit<2>> edits;
   edits.reserve(points.size());
   for (const Point<2>& p : points) edits.push_back(Edit<2>{EditOp::Insert, p});
-  s_->validate(edits, "point");
+  const auto plan = s_->validate(edits, "point");
   validate_mesh_box(box);
-  auto* program = &s_->program;
-  s_->core.build(points, [program](sac::Engine& rt) { detail::QuadtreeMeshProgram::main(rt, program); });
+  if (s_->is_hpu()) {
+    s_->hpu_inputs.commit(s_->core.rt, plan);
+    auto* hpu = &s_->hpu;
+    s_->core.build(points, [hpu](sac::Engine& rt) { detail::HpuProgram::main(rt, hpu); });
+    s_->registry.clear_change();
+  } else {
+    auto* program = &s_->program;
+    s_->core.build(points, [program](sac::Engine& rt) { detail::QuadtreeMeshProgram::main(rt, program); });
+  }
   s_->count(edits);
   for (detail::LeafBlock* b : s_->log.created) b->slot = detail::LeafBlock::kOld;
   s_->log.created.clear();
@@ -161,24 +215,25 @@ DynamicMesh& DynamicMesh::operator=(DynamicMesh&&) noexcept = default;
 
 PointId DynamicMesh::insert(const Point<2>& p) {
   const Edit<2> e{EditOp::Insert, p};
-  s_->validate({&e, 1}, "");
-  return detail::checked_update(*this, *s_, {&e, 1}).front();
+  const auto plan = s_->validate({&e, 1}, "");
+  return detail::checked_update(*this, *s_, {&e, 1}, plan).front();
 }
 
 void DynamicMesh::erase(PointId id) {
   const Edit<2> e = s_->core.erase_edit(id);
-  detail::checked_update(*this, *s_, {&e, 1});
+  const auto plan = s_->validate({&e, 1}, "");
+  detail::checked_update(*this, *s_, {&e, 1}, plan);
 }
 
 void DynamicMesh::erase(const Point<2>& p) {
   const Edit<2> e{EditOp::Delete, p};
-  s_->validate({&e, 1}, "");
-  detail::checked_update(*this, *s_, {&e, 1});
+  const auto plan = s_->validate({&e, 1}, "");
+  detail::checked_update(*this, *s_, {&e, 1}, plan);
 }
 
 std::vector<PointId> DynamicMesh::apply(std::span<const Edit<2>> edits) {
-  s_->validate(edits, "edit");
-  return detail::checked_update(*this, *s_, edits);
+  const auto plan = s_->validate(edits, "edit");
+  return detail::checked_update(*this, *s_, edits, plan);
 }
 
 const Box<2>& DynamicMesh::box() const noexcept { return s_->core.box; }
@@ -190,6 +245,7 @@ const Point<2>& DynamicMesh::point(PointId id) const { return s_->core.point(id)
 std::vector<std::pair<PointId, Point<2>>> DynamicMesh::points() const { return s_->core.points(); }
 
 std::vector<Triangle> DynamicMesh::triangles() const {
+  if (s_->is_hpu()) return s_->registry.triangles();
   std::vector<Triangle> out;
   out.reserve(s_->log.live_count * 2);
   for (const detail::LeafBlock* b = s_->log.live; b; b = b->next) detail::triangulate_leaf(s_->log.grid, b->shape, out);
@@ -198,6 +254,7 @@ std::vector<Triangle> DynamicMesh::triangles() const {
 }
 
 std::size_t DynamicMesh::num_triangles() const noexcept {
+  if (s_->is_hpu()) return s_->registry.live_count();
   std::size_t k = 0;
   std::vector<Triangle> scratch;
   for (const detail::LeafBlock* b = s_->log.live; b; b = b->next) {
@@ -213,6 +270,7 @@ const MeshChange& DynamicMesh::last_change() const noexcept { return s_->change;
 
 std::vector<Leaf<2>> DynamicMesh::refined_leaves() const {
   std::vector<Leaf<2>> out;
+  if (s_->is_hpu()) return out;
   for (const detail::LeafBlock* b = s_->log.live; b; b = b->next) {
     std::uint32_t held = 0;
     if (b->shape.warped >= 0) {
@@ -228,7 +286,9 @@ std::vector<Leaf<2>> DynamicMesh::refined_leaves() const {
 const UpdateStats& DynamicMesh::last_update() const noexcept { return s_->core.last; }
 const sac::Stats& DynamicMesh::engine_stats() const noexcept { return s_->core.rt.stats(); }
 std::size_t DynamicMesh::trace_bytes() const {
-  return s_->core.bytes() + s_->counts.size() * (sizeof(CellId<2>) + 2 * sizeof(void*) + sizeof(std::int64_t));
+  std::size_t hpu = 0;
+  if (s_->is_hpu()) hpu = s_->hpu_inputs.bytes() + s_->registry.all().size() * sizeof(void*);
+  return s_->core.bytes() + hpu + s_->counts.size() * (sizeof(CellId<2>) + 2 * sizeof(void*) + sizeof(std::int64_t));
 }
 std::size_t DynamicMesh::record_bytes() const { return s_->core.rt.record_bytes(); }
 std::uint64_t DynamicMesh::live_events() const { return s_->core.rt.live_events(); }
@@ -237,6 +297,10 @@ void DynamicMesh::compact() { s_->core.compact(); }
 void DynamicMesh::check_invariants() const {
   s_->core.check_invariants();
   detail::check_trees_of(*this, *s_);
+  if (!s_->is_hpu()) return;
+  detail::check_hpu_structures(*s_);
+  require_valid_mesh(mesh(), box(), s_->present(),
+                     MeshCheckOptions{.min_angle_deg = s_->options.min_angle, .delaunay = true});
 }
 
 }  // namespace dynmesh

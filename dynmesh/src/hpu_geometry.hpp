@@ -31,6 +31,13 @@
 
 namespace dynmesh::detail {
 
+/// The hpu mesh's angle bound must be in [1, 30] degrees (hpu_mesh.hpp).
+inline void validate_min_angle(double deg) {
+  if (!(deg >= 1.0 && deg <= 30.0))
+    throw InputError(InputError::Kind::Malformed, "--min-angle for hpu must be between 1 and 30 degrees, got " +
+                                                      format_exact(deg));
+}
+
 inline double squared_length(const Point<2>& a, const Point<2>& b) noexcept {
   const double dx = b[0] - a[0], dy = b[1] - a[1];
   return dx * dx + dy * dy;
@@ -107,6 +114,19 @@ inline Point<2> side_midpoint(const Point<2>& p, const Point<2>& q) {
   return mid;
 }
 
+/// The midpoints of p's path down the halvings of the box edge a-b (a[u] < p[u] < b[u],
+/// u the axis along the side): while p encroaches the edge, its midpoint, then the half
+/// p projects into. Appended to out, longest edge first.
+inline void halving_path(Point<2> a, Point<2> b, const Point<2>& p, unsigned u, std::vector<Point<2>>& out) {
+  while (encroaches(a, b, p)) {
+    const Point<2> m = side_midpoint(a, b);
+    out.push_back(m);
+    if (p[u] < m[u]) b = m;
+    else if (p[u] > m[u]) a = m;
+    else break;
+  }
+}
+
 /// The midpoints that splitting encroached box edges adds, computed from the points alone,
 /// (x, y)-sorted. An edge's diametral disc holds its halves' discs, and a point strictly
 /// inside one projects strictly inside the edge; midpoints and corners never encroach. So
@@ -137,14 +157,7 @@ inline std::vector<Point<2>> side_midpoints(const Box<2>& box, std::span<const P
         const auto it = std::upper_bound(side.begin(), side.end(), p[u],
                                          [&](double t, const Point<2>& v) { return t < v[u]; });
         if (it == side.begin() || it == side.end() || !((it - 1)->at(u) < p[u])) continue;
-        Point<2> a = *(it - 1), b = *it;
-        while (encroaches(a, b, p)) {
-          const Point<2> m = side_midpoint(a, b);
-          out.push_back(m);
-          if (p[u] < m[u]) b = m;
-          else if (p[u] > m[u]) a = m;
-          else break;
-        }
+        halving_path(*(it - 1), *it, p, u, out);
       }
     }
   }

@@ -260,17 +260,11 @@ class Refiner {
   std::vector<std::array<Vid, 2>> sides_found_, encroached_;
 };
 
-void validate_min_angle(double deg) {
-  if (!(deg >= kHpuMinAngleLow && deg <= kHpuMinAngleHigh))
-    throw InputError(InputError::Kind::Malformed, "--min-angle for hpu must be between 1 and 30 degrees, got " +
-                                                      format_exact(deg));
-}
-
 }  // namespace
 
 HpuMesh::HpuMesh(const Box<2>& box, std::span<const Point<2>> points, double min_angle_deg)
     : box_(box), min_angle_(min_angle_deg), points_(points.begin(), points.end()) {
-  validate_min_angle(min_angle_deg);
+  detail::validate_min_angle(min_angle_deg);
   const auto qs = detail::locate_all(box, points);
   detail::check_separated(qs);  // duplicates and the spread's resolution, as T* reports them
   // What double coordinates cannot refine around (the quadtree mesh's rule: near points and

@@ -322,8 +322,14 @@ class QuadtreeCore {
     compact_mark = dir.size();
   }
 
+  struct NoHook {
+    void operator()(sac::Engine&) const noexcept {}
+  };
   /// Applies validated edits and propagates once; returns the ids of the insertions.
-  std::vector<PointId> update(std::span<const Edit<d>> edits) {
+  /// `before(engine)` runs after the points are linked, before the propagation: a program
+  /// that shares the trace relinks its own inputs there.
+  template <class Before = NoHook>
+  std::vector<PointId> update(std::span<const Edit<d>> edits, Before&& before = {}) {
     std::vector<PointId> ids;
     std::vector<Node*> gone;
     for (const Edit<d>& e : edits) {
@@ -336,6 +342,7 @@ class QuadtreeCore {
         gone.push_back(n);
       }
     }
+    before(rt);
     propagate();
     release(gone);
     maybe_compact();

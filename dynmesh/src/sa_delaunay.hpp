@@ -23,7 +23,8 @@
 //   SaDelaunay::read_star(v, k)      v's neighbours counter-clockwise, passed to k
 //   SaDelaunayProgram                the input list inserted in list order, each point from
 //                                    the previous one's triangle (QuadtreeMeshProgram style)
-//   SaTriRegistry                    outside the trace: the live triangles for the mutator
+//   SaTriRegistry                    outside the trace: the live triangles and the change
+//                                    feed (SaTriEvent records of births and deaths)
 //
 // Representation (everything that changes is a modifiable; corners never change, so
 // in-circle and orientation tests need no read):
@@ -218,6 +219,34 @@ class SaTriRegistry {
     return out;
   }
 
+  /// The live triangle count, kept by the feed's records (below). O(1).
+  std::size_t live_count() const noexcept { return live_; }
+
+  /// The change feed since the last call: the triangles that were live then and are not
+  /// now (removed) and the other way round (added), each sorted. A triangle's birth (its
+  /// fan) and death (a cavity's kill) each make a keyless SaTriEvent record in the trace;
+  /// propagation makes and undoes records, and the records' net count per triangle is the
+  /// change (a triangle re-made unchanged nets 0). O(e log e) for e events.
+  MeshChange take_change() {
+    std::sort(events_.begin(), events_.end());
+    MeshChange out;
+    for (std::size_t i = 0; i < events_.size();) {
+      std::size_t j = i;
+      int net = 0;
+      for (; j < events_.size() && events_[j].first == events_[i].first; ++j) net += events_[j].second;
+      if (net > 0) out.added.push_back(events_[i].first);
+      else if (net < 0) out.removed.push_back(events_[i].first);
+      if (net < -1 || net > 1) throw InvariantError("dynmesh: SaDelaunay: a triangle born or killed twice");
+      i = j;
+    }
+    events_.clear();
+    return out;
+  }
+  /// Drops the pending events (after run(): the whole mesh is new).
+  void clear_change() noexcept { events_.clear(); }
+  /// Call before the engine is destroyed: its records' destructors then log nothing.
+  void close() noexcept { closing_ = true; }
+
   /// Throws InvariantError naming the first broken rule (see the header). Mutator only. O(t).
   void check_invariants(const Box<2>& box) const {
     using sa_index::at;
@@ -261,11 +290,37 @@ class SaTriRegistry {
       if (x->p[0] == x0 || x->p[0] == x1 || x->p[1] == y0 || x->p[1] == y1) ++h;
     }
     if (live + h + 2 != 2 * verts.size()) fail("Euler's formula fails: the triangles do not tile the box");
+    if (live != live_) fail("the feed's live count is " + std::to_string(live_) + ", not " + std::to_string(live));
   }
 
  private:
   friend struct SaTri;
+  friend struct SaTriEvent;
+  void note(const Triangle& t, int d) {
+    if (closing_) return;
+    events_.emplace_back(t, d);
+    live_ = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(live_) + d);
+  }
   std::vector<SaTri*> all_;
+  std::vector<std::pair<Triangle, int>> events_;
+  std::size_t live_ = 0;
+  bool closing_ = false;
+};
+
+/// A birth (+1) or death (−1) of a triangle in the trace (make<SaTriEvent>): logged when
+/// made and, negated, when propagation undoes it. Holds the corners by value, since the
+/// triangle's own allocation may be undone first.
+struct SaTriEvent {
+  SaTriEvent(SaTriRegistry* r, const SaTri* t, int s)
+      : registry(r), tri{{t->v[0]->p, t->v[1]->p, t->v[2]->p}}, sign(s) {
+    registry->note(tri, sign);
+  }
+  ~SaTriEvent() { registry->note(tri, -sign); }
+  SaTriEvent(const SaTriEvent&) = delete;
+  SaTriEvent& operator=(const SaTriEvent&) = delete;
+  SaTriRegistry* registry;
+  Triangle tri;  // canonical: SaTri's corners are in canonical rotation
+  int sign;
 };
 
 inline SaTri::SaTri(const std::array<SaVertex*, 3>& corners, const std::array<SaEdge*, 3>& edges, SaTriRegistry* r)
@@ -344,6 +399,8 @@ struct SaDelaunay {
     }
     put_sides(e, s);
     put_sides(e, t);
+    e.make<SaTriEvent>(dt->registry, s, +1);
+    e.make<SaTriEvent>(dt->registry, t, +1);
     // Corners 0 and 1 are in s, 2 and 3 in t, for either diagonal.
     e.write(c[0]->tri, s);
     e.write(c[1]->tri, s);
@@ -545,6 +602,7 @@ struct SaDelaunay {
     using sa_index::next;
     using sa_index::prev;
     put_sides(e, t);
+    e.make<SaTriEvent>(t->registry, t, +1);
     const int ix = t->index_of(x);
     e.write(t->v[at(next(ix))]->tri, t);
     if (t->e[at(next(ix))]->box_side) e.write(t->v[at(prev(ix))]->tri, t);
@@ -553,6 +611,7 @@ struct SaDelaunay {
   static void kill(sac::Engine& e, SaVertex* x, SaTri* t) {
     (void)x;
     e.write(t->dead, true);
+    e.make<SaTriEvent>(t->registry, t, -1);
   }
   static void put_vertex(sac::Engine& e, SaVertex* v, SaTri* t) { e.write(v->tri, t); }
 

@@ -1,18 +1,21 @@
-// Tests of dynmesh/dynamic_mesh.hpp: differential against the static twin (QuadtreeMesh)
-// after every update, on random sequences with fixed, printed seeds; the checkers run on
-// every mesh; the change feed replays exactly; bad input leaves everything as it was.
+// Tests of dynmesh/dynamic_mesh.hpp: differential against the static twin (QuadtreeMesh,
+// or HpuMesh at 20.7°, 25° and 30°) after every update, on random sequences with fixed,
+// printed seeds; the checkers run on every mesh (Delaunay by exact predicates for hpu); the
+// change feed replays exactly; bad input leaves everything as it was.
 #include "dynamic_test_support.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "dynmesh/distributions.hpp"
 #include "dynmesh/dynamic_mesh.hpp"
+#include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/mesh_check.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
 
@@ -22,10 +25,15 @@ using namespace dynmesh;
 using dynmesh_test::kSlowBuild;
 using Kind = InputError::Kind;
 
-/// The mesh passes the checker with the quadtree bound and every point is a vertex.
-testing::AssertionResult good_mesh(const Mesh& mesh, const Box<2>& box, const std::vector<Point<2>>& points) {
+const MeshOptions kQuadtree{.postprocess = Postprocess::Quadtree};
+MeshOptions hpu(double angle) { return MeshOptions{.postprocess = Postprocess::Hpu, .min_angle = angle}; }
+
+/// The mesh passes the checker with the bound (and Delaunay) and every point is a vertex.
+testing::AssertionResult good_mesh(const Mesh& mesh, const Box<2>& box, const std::vector<Point<2>>& points,
+                                   double bound = kQuadtreeMinAngle, bool delaunay = false) {
   MeshCheckOptions opts;
-  opts.min_angle_deg = kQuadtreeMinAngle;
+  opts.min_angle_deg = bound;
+  opts.delaunay = delaunay;
   const MeshReport r = check_mesh(mesh, box, points, opts);
   if (!r.ok()) return testing::AssertionFailure() << r.summary();
   return testing::AssertionSuccess();
@@ -36,6 +44,16 @@ testing::AssertionResult agrees(const DynamicMesh& dyn, const std::vector<Point<
     dyn.check_invariants();
   } catch (const std::exception& e) {
     return testing::AssertionFailure() << "check_invariants: " << e.what();
+  }
+  if (dyn.options().postprocess == Postprocess::Hpu) {
+    const double bound = dyn.options().min_angle;
+    const HpuMesh twin(dyn.box(), points, bound);
+    const auto got = dyn.triangles();
+    if (got != twin.triangles())
+      return testing::AssertionFailure() << "triangles differ from the static twin HpuMesh: " << got.size()
+                                         << " vs " << twin.triangles().size();
+    if (dyn.num_triangles() != got.size()) return testing::AssertionFailure() << "num_triangles() is wrong";
+    return good_mesh(twin.mesh(), dyn.box(), points, bound, true);
   }
   const QuadtreeMesh twin(dyn.box(), points);
   twin.check_invariants();
@@ -48,18 +66,32 @@ testing::AssertionResult agrees(const DynamicMesh& dyn, const std::vector<Point<
 }
 
 /// Runs `updates` random single and batched updates from a start set, comparing after each.
+void run_differential_on(const Box<2>& box, const std::vector<Point<2>>& pool, std::size_t n, std::size_t updates,
+                         std::uint64_t seed, const MeshOptions& options);
+
 void run_differential(Distribution dist, std::size_t n, std::size_t updates, std::uint64_t seed,
-                      double spread = 0x1p20, bool dyadic_box = false) {
+                      double spread = 0x1p20, bool dyadic_box = false, const MeshOptions& options = kQuadtree) {
   SCOPED_TRACE("distribution " + std::string(distribution_name(dist)) + ", n " + std::to_string(n) + ", seed " +
                std::to_string(seed));
   auto pool = generate<2>(dist, 2 * n, seed, spread);
   Box<2> box = derive_box<2>(pool);
   if (dyadic_box) box = Box<2>{{-1.0, -1.0}, 4.0};
+  run_differential_on(box, pool, n, updates, seed, options);
+}
+
+/// The first n of `pool` from scratch, then random updates drawing on the rest.
+void run_differential_on(const Box<2>& box, const std::vector<Point<2>>& pool, std::size_t n, std::size_t updates,
+                         std::uint64_t seed, const MeshOptions& options) {
+  std::printf("[ DynamicMesh ] seed %llu, n %zu, %s\n", static_cast<unsigned long long>(seed), n,
+              options.postprocess == Postprocess::Hpu ? ("hpu " + std::to_string(options.min_angle)).c_str()
+                                                      : "quadtree");
+  SCOPED_TRACE(options.postprocess == Postprocess::Hpu ? "hpu, angle " + std::to_string(options.min_angle)
+                                                       : std::string("quadtree"));
   Rng rng(seed * 7 + 1);
   std::map<PointId, Point<2>> present;
   std::vector<Point<2>> absent(pool.begin() + static_cast<std::ptrdiff_t>(n), pool.end());
   std::vector<Point<2>> start(pool.begin(), pool.begin() + static_cast<std::ptrdiff_t>(n));
-  DynamicMesh dyn(box, start);
+  DynamicMesh dyn(box, start, options);
   for (std::size_t i = 0; i < start.size(); ++i) present[i] = start[i];
   auto current = [&] {
     std::vector<Point<2>> v;
@@ -144,8 +176,10 @@ TEST(DynamicMesh, TinySets) {
   for (const std::vector<Point<2>>& pts : std::vector<std::vector<Point<2>>>{
            {}, {{0.5, 0.5}}, {{0.3, 0.3}}, {{0.1, 0.7}}, {{0.25, 0.25}, {0.75, 0.75}}, {{0.0, 0.5}}, {{0.0, 0.0}}}) {
     SCOPED_TRACE(std::to_string(pts.size()) + " points");
-    DynamicMesh dyn(box, pts);
-    EXPECT_TRUE(agrees(dyn, pts));
+    for (const MeshOptions& o : {kQuadtree, hpu(kHpuDefaultMinAngle), hpu(30)}) {
+      DynamicMesh dyn(box, pts, o);
+      EXPECT_TRUE(agrees(dyn, pts));
+    }
   }
 }
 
@@ -159,7 +193,7 @@ TEST(DynamicMesh, BoxesItsDoublesCannotMeshAreRefused) {
       std::vector<Point<2>> pts;
       if (with_point) pts.push_back({box.origin[0] + box.side / 3, box.origin[1] + box.side / 3});
       try {
-        DynamicMesh dyn(box, pts);
+        DynamicMesh dyn(box, pts, kQuadtree);
         ADD_FAILURE() << "DynamicMesh accepted the box";
       } catch (const InputError& e) {
         EXPECT_EQ(e.kind(), Kind::Resolution) << e.what();
@@ -181,16 +215,16 @@ TEST(DynamicMesh, ExtremeBoxSidesAreMeshed) {
     const double o0 = box.origin[0], o1 = box.origin[1], side = box.side;
     const std::vector<Point<2>> pts = {
         {o0 + side * 0.3, o1 + side * 0.45}, {o0 + side * 0.7, o1 + side * 0.6}, {o0 + side * 0.5, o1 + side * 0.5000001}};
-    DynamicMesh dyn(box, pts);
+    DynamicMesh dyn(box, pts, kQuadtree);
     EXPECT_TRUE(agrees(dyn, pts));
     dyn.erase(pts[1]);
     EXPECT_TRUE(agrees(dyn, std::vector<Point<2>>{pts[0], pts[2]}));
   }
 }
 
-TEST(DynamicMesh, BadInputChangesNothing) {
+void bad_input_changes_nothing(const MeshOptions& options) {
   const auto pts = generate<2>(Distribution::Uniform, 50, 21);
-  DynamicMesh dyn(derive_box<2>(pts), pts);
+  DynamicMesh dyn(derive_box<2>(pts), pts, options);
   const auto before = dyn.triangles();
   const auto events = dyn.live_events();
   auto rejected = [&](Kind kind, auto&& f) {
@@ -215,6 +249,79 @@ TEST(DynamicMesh, BadInputChangesNothing) {
   rejected(Kind::Resolution, [&] { dyn.insert({pts[4][0] + 3 * box.side * 0x1p-52, pts[4][1]}); });
   const std::vector<Edit<2>> batch = {{EditOp::Insert, {0.5, 0.5}}, {EditOp::Delete, pts[0]}, {EditOp::Delete, pts[0]}};
   rejected(Kind::Absent, [&] { dyn.apply(batch); });
+}
+
+TEST(DynamicMesh, BadInputChangesNothing) { bad_input_changes_nothing(kQuadtree); }
+TEST(DynamicMeshHpu, BadInputChangesNothing) { bad_input_changes_nothing(hpu(kHpuDefaultMinAngle)); }
+
+TEST(DynamicMeshHpu, AnglesOutOfRangeAreRefused) {
+  const std::vector<Point<2>> pts = {{0.25, 0.5}, {0.5, 0.75}};
+  for (const double angle : {0.0, 0.99, 30.01, 45.0, -5.0, std::nan(""), HUGE_VAL}) {
+    SCOPED_TRACE("angle " + std::to_string(angle));
+    try {
+      DynamicMesh dyn(Box<2>{{0.0, 0.0}, 1.0}, pts, hpu(angle));
+      ADD_FAILURE() << "DynamicMesh accepted the angle";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.kind(), Kind::Malformed) << e.what();
+      EXPECT_NE(std::string(e.what()).find("--min-angle"), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(DynamicMeshHpu, DefaultIsHpuAtTheSeedsBound) {
+  const DynamicMesh dyn(Box<2>{{0.0, 0.0}, 1.0});
+  EXPECT_EQ(dyn.options().postprocess, Postprocess::Hpu);
+  EXPECT_EQ(dyn.options().min_angle, kHpuDefaultMinAngle);
+  EXPECT_TRUE(agrees(dyn, {}));
+}
+
+constexpr double kAngles[] = {kHpuDefaultMinAngle, 25.0, 30.0};
+
+TEST(DynamicMeshHpuDifferential, Uniform) {
+  for (const double a : kAngles) run_differential(Distribution::Uniform, 150, scaled(60), 31, 0x1p20, false, hpu(a));
+}
+TEST(DynamicMeshHpuDifferential, Clusters) {
+  for (const double a : kAngles) run_differential(Distribution::Clusters, 150, scaled(60), 32, 0x1p20, false, hpu(a));
+}
+TEST(DynamicMeshHpuDifferential, CocircularGrid) {
+  run_differential(Distribution::Grid, 120, scaled(60), 33, 0x1p20, false, hpu(kHpuDefaultMinAngle));
+  run_differential(Distribution::Grid, 120, scaled(40), 34, 0x1p20, false, hpu(30));
+}
+TEST(DynamicMeshHpuDifferential, Collinear) {
+  run_differential(Distribution::Collinear, 100, scaled(60), 35, 0x1p20, false, hpu(kHpuDefaultMinAngle));
+}
+TEST(DynamicMeshHpuDifferential, CellBoundaries) {
+  run_differential(Distribution::Boundary, 120, scaled(60), 36, 0x1p20, false, hpu(25));
+}
+TEST(DynamicMeshHpuDifferential, ShrinkingTo2e30) {
+  for (const double spread : {0x1p10, 0x1p20, 0x1p30})
+    run_differential(Distribution::Shrinking, 100, scaled(40), 37, spread, false, hpu(kHpuDefaultMinAngle));
+}
+TEST(DynamicMeshHpuDifferential, OnAndNearTheBoxSides) {
+  // Inputs exactly on the box's lower sides (they change the sides' vertices, so the side
+  // midpoints of every other input are recounted) and just inside every side.
+  Rng rng(38);
+  std::vector<Point<2>> pool;
+  for (int i = 0; i < 160; ++i) {
+    const double a = static_cast<double>(rng.below(1 << 20)) * 0x1p-20, b = static_cast<double>(1 + rng.below(999)) * 1e-3;
+    switch (i % 5) {
+      case 0: pool.push_back({a, 0.0}); break;
+      case 1: pool.push_back({0.0, a}); break;
+      case 2: pool.push_back({a, b * 1e-3}); break;
+      case 3: pool.push_back({1.0 - b * 1e-4, a}); break;
+      default: pool.push_back({a, static_cast<double>(rng.below(1 << 20)) * 0x1p-20}); break;
+    }
+  }
+  std::sort(pool.begin(), pool.end());
+  pool.erase(std::unique(pool.begin(), pool.end()), pool.end());
+  std::vector<Point<2>> shuffled;
+  while (!pool.empty()) {
+    const std::size_t i = rng.below(pool.size());
+    shuffled.push_back(pool[i]);
+    pool.erase(pool.begin() + static_cast<std::ptrdiff_t>(i));
+  }
+  for (const double a : {kHpuDefaultMinAngle, 30.0})
+    run_differential_on(Box<2>{{0.0, 0.0}, 1.0}, shuffled, shuffled.size() / 2, scaled(60), 38, hpu(a));
 }
 
 }  // namespace

@@ -5,15 +5,22 @@
 // program on sac-runtime, in one trace; after each insert / erase / batch, one propagate()
 // carries the change through the tree into the mesh, and the triangles it removed and added
 // are reported as the change feed (last_change()). The mesh is always exactly the static
-// twin's mesh of the current point set (QuadtreeMesh for Postprocess::Quadtree).
+// twin's mesh of the current point set: HpuMesh for Postprocess::Hpu (the default; the
+// program is src/hpu_program.hpp on src/sa_delaunay.hpp, reading the inputs and their side
+// midpoints from a list the mutator keeps, src/hpu_inputs.hpp), QuadtreeMesh for
+// Postprocess::Quadtree.
 //
 // Invariants (check_invariants()): the engine's invariants; the quadtree program's
-// invariants (DynamicQuadtree); the refined tree T' satisfies its rules; the live triangles
-// tile the box, every present point is a vertex, and no angle is below the bound. Built with
-// the CMake option SAC_DEBUG_CHECKS, every insert, erase and apply ends with
-// check_invariants().
+// invariants (DynamicQuadtree); quadtree: the refined tree T' satisfies its rules; hpu: the
+// triangulation's links and the input list; the live triangles tile the box, every present
+// point is a vertex, and no angle is below the bound (hpu: Delaunay too, by exact
+// predicates). Built with the CMake option SAC_DEBUG_CHECKS, every insert, erase and apply
+// ends with the structures' checks (not the O(n lg n) mesh contract).
 // Failure atomicity: every mutator call validates its whole input first; a call that throws
-// InputError leaves the mesh, the ids and the engine as they were.
+// InputError leaves the mesh, the ids and the engine as they were. (hpu: the validation is
+// the quadtree mesh's resolution rule plus the side midpoints; a refinement that still ran
+// out of double precision would throw from inside the propagation, which leaves the engine
+// unusable; no test or fuzz run has reached that.)
 // Determinism: the mesh depends only on the point set and the box.
 // Complexity: construction O(n lg n + |T'|) expected; each single-point update O(lg L/s)
 // expected trace distance; triangles() O(t log t).
@@ -34,16 +41,22 @@
 #include "dynmesh/box.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/edit.hpp"
+#include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
 
 namespace dynmesh {
 
+/// Hpu: DynHPU's off-center Delaunay mesh (the default; hpu_mesh.hpp). Quadtree: the
+/// quadtree's own triangulation (quadtree_mesh.hpp, angles ≥ 18.4°).
 enum class Postprocess { Quadtree, Hpu };
 
 struct MeshOptions {
-  Postprocess postprocess = Postprocess::Quadtree;
+  Postprocess postprocess = Postprocess::Hpu;
+  /// The hpu mesh's angle bound in degrees, 1 to 30 (InputError(Malformed) otherwise).
+  /// Ignored by the quadtree mesh, whose bound is fixed.
+  double min_angle = kHpuDefaultMinAngle;
 };
 
 namespace detail {
@@ -82,7 +95,8 @@ class DynamicMesh {
   Mesh mesh() const;
   /// The triangles removed and added by the last update (empty after construction).
   const MeshChange& last_change() const noexcept;
-  /// The leaves of the refined tree T', sorted.
+  /// The leaves of the refined tree T', sorted (quadtree; empty with hpu, which refines
+  /// no tree).
   std::vector<Leaf<2>> refined_leaves() const;
 
   const UpdateStats& last_update() const noexcept;
