@@ -107,7 +107,7 @@ int main(int argc, char** argv) {
           "--duplicates", [&me](const std::string& v) { me.skip_duplicates = v == "skip"; }, duplicates_help)
       ->check(CLI::IsMember({"error", "skip"}));
   mesh->add_option("--postprocess", me.postprocess,
-                   "hpu (the default: the off-center Delaunay mesh, from scratch; no --edits yet) or quadtree (the "
+                   "hpu (the default: the off-center Delaunay mesh; self-adjusting under --edits) or quadtree (the "
                    "self-adjusting quadtree mesh, angles >= 18.4)");
   CLI::Option* min_angle_opt =
       mesh->add_option("--min-angle", me.min_angle, "smallest angle in degrees (hpu: 1 to 30, default 20.7; quadtree: at most 18.4)")
@@ -154,11 +154,11 @@ int main(int argc, char** argv) {
       ->check(whole_number(0, kMaxCount));
   stability->add_option("--seed", s.seed, "random seed")->capture_default_str()->check(any_seed);
   stability->add_option("--postprocess", s.postprocess,
-                        "none (the default: the quadtree alone), quadtree (2D: the quadtree mesh too) or hpu (not "
-                        "available yet); "
+                        "none (the default: the quadtree alone), quadtree (2D: the quadtree mesh too) or hpu (2D: "
+                        "the off-center Delaunay mesh too); "
                         "with a mesh, trace_distance and seconds count the whole update, tree and mesh");
   CLI::Option* stability_angle_opt = stability->add_option(
-      "--min-angle", s.min_angle, "with a mesh: the smallest angle checked on the final mesh (quadtree: <= 18.4)");
+      "--min-angle", s.min_angle, "with a mesh: hpu's angle bound (1 to 30, default 20.7); quadtree: the smallest angle checked on the final mesh (<= 18.4)");
   stability->add_option("--csv", s.csv, "output CSV (appended to; header written when new or empty)")->required();
   stability->add_option("--plot", s.plot, "also plot every row of the CSV with gnuplot (SVG)");
   stability->add_flag("--force", s.force, force_help);

@@ -1,8 +1,9 @@
 // `dynmesh mesh` (2D): mesh a point file in its box, apply an edit script dynamically, write
 // the final mesh as .node/.ele (and optionally the change feed, VTK, MSH, SVG), shared/
-// FORMATS.md "dynmesh mesh (2D)". `--postprocess hpu` (the default) meshes the points from
-// scratch with HpuMesh, DynHPU's static twin; until the self-adjusting hpu mesh exists, it
-// refuses --edits with a clear message. `--postprocess quadtree` is the self-adjusting
+// FORMATS.md "dynmesh mesh (2D)". `--postprocess hpu` (the default) is DynHPU's off-center
+// Delaunay mesh: without --edits, its static twin HpuMesh (no trace: a fraction of the
+// memory); with --edits, the self-adjusting DynamicMesh, whose output is the same bytes as a
+// from-scratch run on the final points. `--postprocess quadtree` is the self-adjusting
 // quadtree mesh (DynamicMesh). Every error names the file and line it
 // comes from, as `dynmesh quadtree` does; every output is written aside and renamed into place
 // only after all of them were written (atomic_file.hpp), so a failed run leaves old files
@@ -51,14 +52,9 @@ using Kind = InputError::Kind;
 
 // The postprocess and angle options, checked before any file is read.
 PostprocessChoice check_mesh_options(const MeshCommandOptions& o) {
-  const PostprocessChoice choice =
-      check_postprocess(o.postprocess, /*allow_none=*/false,
-                        o.min_angle_given ? std::optional<double>(o.min_angle) : std::nullopt, /*static_hpu=*/true);
+  const PostprocessChoice choice = check_postprocess(
+      o.postprocess, /*allow_none=*/false, o.min_angle_given ? std::optional<double>(o.min_angle) : std::nullopt);
   if (o.outbase.empty()) throw InputError(Kind::Malformed, "-o needs a non-empty OUTBASE");
-  if (choice == PostprocessChoice::Hpu && !o.edits.empty())
-    throw InputError(Kind::Malformed,
-                     "--edits needs the self-adjusting mesh, which hpu does not have yet: pass --postprocess quadtree "
-                     "to apply edits (hpu meshes the points of POINTS from scratch)");
   return choice;
 }
 
@@ -147,13 +143,15 @@ std::vector<Point<2>> current_points(const DynamicMesh& mesh) {
 }  // namespace
 
 int run_mesh(const MeshCommandOptions& o) {
-  if (check_mesh_options(o) == PostprocessChoice::Hpu) return run_hpu_mesh(o);
-  const double bound = o.min_angle_given ? o.min_angle : kQuadtreeMinAngle;
+  const bool hpu = check_mesh_options(o) == PostprocessChoice::Hpu;
+  if (hpu && o.edits.empty()) return run_hpu_mesh(o);
+  const double bound = o.min_angle_given ? o.min_angle : hpu ? kHpuDefaultMinAngle : kQuadtreeMinAngle;
+  const std::string what = hpu ? "hpu mesh" : "quadtree mesh";
   if (!o.force) {
     const std::uint64_t points = points_held(o.points, o.edits);
-    guard_memory("building the quadtree mesh of " + std::to_string(points) + " points" +
+    guard_memory("building the " + what + " of " + std::to_string(points) + " points" +
                      (o.check ? " with --check" : ""),
-                 estimated_bytes(kQuadtreeMeshCost, points, o.check));
+                 estimated_bytes(hpu ? kHpuDynamicCost : kQuadtreeMeshCost, points, o.check));
   }
 
   std::optional<Phase> reading(std::in_place, "reading " + o.points);
@@ -166,10 +164,11 @@ int run_mesh(const MeshCommandOptions& o) {
   reading.reset();
 
   MeshOptions mesh_options;
-  mesh_options.postprocess = Postprocess::Quadtree;
+  mesh_options.postprocess = hpu ? Postprocess::Hpu : Postprocess::Quadtree;
+  if (hpu) mesh_options.min_angle = bound;
   std::optional<DynamicMesh> built;
   {
-    const Phase building("building the quadtree mesh of " + std::to_string(file.points.size()) + " points");
+    const Phase building("building the " + what + " of " + std::to_string(file.points.size()) + " points");
     try {
       built.emplace(box, std::span<const Point<2>>(file.points), mesh_options);
     } catch (const InputError& e) {

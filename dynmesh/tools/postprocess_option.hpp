@@ -1,10 +1,9 @@
 // dynmesh/tools/postprocess_option.hpp — the `--postprocess` and `--min-angle` options of
 // `dynmesh mesh` and `dynmesh stability` (shared/FORMATS.md), checked in one place.
 //
-// Purpose: both commands name a postprocess and may ask for an angle bound; the names, what
-// each command can do with hpu (mesh: a from-scratch HpuMesh; stability: nothing yet, since
-// the self-adjusting hpu mesh does not exist) and the bound each postprocess guarantees are
-// stated once here so the two commands cannot drift apart.
+// Purpose: both commands name a postprocess and may ask for an angle bound; the names, the
+// defaults and the bound each postprocess guarantees are stated once here so the two
+// commands cannot drift apart.
 // Invariants: check_postprocess either returns a choice whose bound is >= the requested
 // angle, or throws InputError (Malformed) before any file is read.
 // Complexity: O(1).
@@ -32,18 +31,14 @@ inline std::string angle_text(double deg) {
 }
 
 /// `name` is the option's value ("" is the command's default: `hpu` for mesh, `none` for
-/// stability, as `allow_none` says); `min_angle` is --min-angle when given. `static_hpu`:
-/// the command can use HpuMesh (mesh); otherwise hpu is refused as not available yet.
+/// stability, as `allow_none` says); `min_angle` is --min-angle when given.
 inline PostprocessChoice check_postprocess(const std::string& name, bool allow_none,
-                                           std::optional<double> min_angle, bool static_hpu = false) {
+                                           std::optional<double> min_angle) {
   using Kind = InputError::Kind;
   const std::string value = name.empty() ? (allow_none ? "none" : "hpu") : name;
   const std::string known = allow_none ? "none, quadtree or hpu" : "hpu or quadtree";
   PostprocessChoice choice;
   if (value == "hpu") {
-    if (!static_hpu)
-      throw InputError(Kind::Malformed,
-                       "the self-adjusting hpu mesh is not available yet (--postprocess quadtree measures the quadtree mesh)");
     choice = PostprocessChoice::Hpu;
   } else if (value == "quadtree") {
     choice = PostprocessChoice::Quadtree;
@@ -54,7 +49,7 @@ inline PostprocessChoice check_postprocess(const std::string& name, bool allow_n
   }
   if (min_angle) {
     if (choice == PostprocessChoice::None)
-      throw InputError(Kind::Malformed, "--min-angle needs a mesh: pass --postprocess quadtree");
+      throw InputError(Kind::Malformed, "--min-angle needs a mesh: pass --postprocess hpu or quadtree");
     if (choice == PostprocessChoice::Hpu) {
       if (!(*min_angle >= kHpuMinAngleLow && *min_angle <= kHpuMinAngleHigh))
         throw InputError(Kind::Malformed, "--min-angle for hpu must be between " + angle_text(kHpuMinAngleLow) +

@@ -83,10 +83,14 @@ template <std::size_t d>
 DynamicQuadtree<d> build(const Box<d>& box, std::span<const Point<d>> pts, const DynamicQuadtree<d>*) {
   return DynamicQuadtree<d>(box, pts);
 }
-inline DynamicMesh build(const Box<2>& box, std::span<const Point<2>> pts, const DynamicMesh*) {
-  MeshOptions options;
-  options.postprocess = Postprocess::Quadtree;
+inline DynamicMesh build(const Box<2>& box, std::span<const Point<2>> pts, const DynamicMesh*,
+                         const MeshOptions& options) {
   return DynamicMesh(box, pts, options);
+}
+template <std::size_t d>
+DynamicQuadtree<d> build(const Box<d>& box, std::span<const Point<d>> pts, const DynamicQuadtree<d>* t,
+                         const MeshOptions&) {
+  return build(box, pts, t);
 }
 
 template <std::size_t d>
@@ -97,7 +101,8 @@ inline Verification verify_final(const DynamicMesh& mesh, double min_angle) { re
 
 // `what` names the structure on stdout ("quadtree", "quadtree mesh"); `cost` is its memory.
 template <std::size_t d, class Structure>
-int run(const StabilityOptions& o, Distribution dist, const char* what, const MemoryCost& cost) {
+int run(const StabilityOptions& o, Distribution dist, const char* what, const MemoryCost& cost,
+        const MeshOptions& mesh_options = {}) {
   // On stderr, a 3D tree is called what it is.
   const char* structure_name = d == 3 ? "octree" : what;
   if (!o.force) {
@@ -112,7 +117,8 @@ int run(const StabilityOptions& o, Distribution dist, const char* what, const Me
   std::vector<Point<d>> pool(all.begin() + static_cast<std::ptrdiff_t>(o.n), all.end());
   all.resize(o.n);
   const Box<d> box = derive_box<d>(all);
-  Structure structure = build(box, std::span<const Point<d>>(all), static_cast<const Structure*>(nullptr));
+  Structure structure =
+      build(box, std::span<const Point<d>>(all), static_cast<const Structure*>(nullptr), mesh_options);
   UpdateDriver<d, Structure> driver(structure, std::move(pool), o.seed);
   building.reset();
   const double initial_spread = driver.log2_spread();
@@ -142,7 +148,8 @@ int run(const StabilityOptions& o, Distribution dist, const char* what, const Me
   {
     const Phase checking("checking against a from-scratch build of the " + std::to_string(structure.size()) +
                          " final points");
-    v = verify_final(structure, o.min_angle_given ? o.min_angle : kQuadtreeMinAngle);
+    const double bound = mesh_options.postprocess == Postprocess::Hpu ? mesh_options.min_angle : kQuadtreeMinAngle;
+    v = verify_final(structure, o.min_angle_given ? o.min_angle : bound);
   }
   if (!v.ok) throw InvariantError("verification failed after the updates: " + v.problem);
 
@@ -173,7 +180,12 @@ int run_stability(const StabilityOptions& o) {
     return o.dim == 3 ? run<3, DynamicQuadtree<3>>(o, *dist, "quadtree", kOctree3dCost)
                       : run<2, DynamicQuadtree<2>>(o, *dist, "quadtree", kQuadtree2dCost);
   if (o.dim != 2) throw InputError(Kind::Malformed, "--postprocess " + o.postprocess + " meshes in 2D only (--dim 2)");
-  return run<2, DynamicMesh>(o, *dist, "quadtree mesh", kQuadtreeMeshCost);
+  if (choice == PostprocessChoice::Quadtree)
+    return run<2, DynamicMesh>(o, *dist, "quadtree mesh", kQuadtreeMeshCost,
+                               MeshOptions{.postprocess = Postprocess::Quadtree});
+  return run<2, DynamicMesh>(o, *dist, "hpu mesh", kHpuDynamicCost,
+                             MeshOptions{.postprocess = Postprocess::Hpu,
+                                         .min_angle = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle});
 }
 
 }  // namespace dynmesh::tool

@@ -23,6 +23,7 @@
 #include <sac/errors.hpp>
 
 #include "dynmesh/dynamic_mesh.hpp"
+#include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/io.hpp"
@@ -98,9 +99,10 @@ Verification verify(const DynamicQuadtree<d>& tree) {
   return v;
 }
 
-/// The mesh's counterpart, for `mesh --check` and `stability --postprocess`: the engine and
-/// T' invariants, check_mesh with `min_angle_deg` on the final mesh, then the static twin on
-/// the final points must give the same canonical mesh.
+/// The mesh's counterpart, for `mesh --check` and `stability --postprocess`: the engine's
+/// and the mesh's invariants, check_mesh with `min_angle_deg` on the final mesh (hpu:
+/// Delaunay too), then the static twin (HpuMesh or QuadtreeMesh) on the final points must
+/// give the same canonical mesh; static_seconds is the twin's time.
 inline Verification verify(const DynamicMesh& dm, double min_angle_deg) {
   Verification v;
   std::vector<Point<2>> pts;
@@ -115,17 +117,18 @@ inline Verification verify(const DynamicMesh& dm, double min_angle_deg) {
     v.problem = "runtime invariant check failed: " + one_line(e.what());
     return v;
   }
+  const bool hpu = dm.options().postprocess == Postprocess::Hpu;
   MeshCheckOptions check_options;
   check_options.min_angle_deg = min_angle_deg;
+  check_options.delaunay = hpu;
   const MeshReport report = check_mesh(mesh, dm.box(), pts, check_options);
   if (!report.ok()) {
     v.problem = "mesh check failed: " + one_line(report.summary());
     return v;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const QuadtreeMesh scratch(dm.box(), pts);
+  const Mesh fresh = hpu ? HpuMesh(dm.box(), pts, dm.options().min_angle).mesh() : QuadtreeMesh(dm.box(), pts).mesh();
   v.static_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const Mesh fresh = scratch.mesh();
   if (fresh != mesh) {
     v.problem = "the dynamic mesh differs from a from-scratch mesh of the final " + std::to_string(pts.size()) +
                 " points (" + std::to_string(mesh.num_triangles()) + " vs " + std::to_string(fresh.num_triangles()) +

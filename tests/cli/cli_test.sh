@@ -135,8 +135,18 @@ case $case_name in
     [[ $(wc -l <mesh.csv) -eq 41 ]] || fail "mesh CSV: expected header + 40 rows"
     paste -d, <(tail -n +2 tree.csv) <(tail -n +2 mesh.csv) | awk -F, '$4 != $11 || $5 != $12 || $13 <= $6 { bad = 1; print }
       END { exit bad }' || fail "mesh rows do not follow the tree rows (same ops and spreads, larger distances)"
-    expect_error 1 'self-adjusting hpu mesh is not available yet' "$dynmesh" stability --dim 2 --dist uniform \
-      --n 50 --postprocess hpu --csv e.csv
+    # --postprocess hpu: the same updates through the tree and the hpu mesh, verified against
+    # a from-scratch HpuMesh at the end.
+    run "$dynmesh" stability --dim 2 --dist clusters --n 400 --updates 40 --seed 3 --postprocess hpu \
+      --min-angle 25 --csv hpu.csv
+    grep -q 'hpu mesh, clusters 2D' out.txt || fail "the hpu run did not say it measured the hpu mesh"
+    [[ $(wc -l <hpu.csv) -eq 41 ]] || fail "hpu CSV: expected header + 40 rows"
+    paste -d, <(tail -n +2 tree.csv) <(tail -n +2 hpu.csv) | awk -F, '$4 != $11 || $5 != $12 || $13 <= $6 { bad = 1; print }
+      END { exit bad }' || fail "hpu rows do not follow the tree rows (same ops and spreads, larger distances)"
+    expect_error 1 '--min-angle for hpu must be between 1 and 30 degrees, got 31' "$dynmesh" stability --dim 2 \
+      --dist uniform --n 50 --postprocess hpu --min-angle 31 --csv e.csv
+    expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess hpu \
+      --csv e.csv
     expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess quadtree \
       --csv e.csv
     expect_error 1 '--min-angle needs a mesh' "$dynmesh" stability --dim 2 --dist uniform --n 50 --min-angle 10 \
@@ -188,6 +198,23 @@ case $case_name in
     # More Steiner points at a higher bound.
     (($(head -1 a30.node | awk '{print $1}') > $(head -1 hpu.node | awk '{print $1}'))) ||
       fail "30 degrees did not add vertices over 20.7"
+    # --edits: the self-adjusting hpu mesh gives the bytes of a from-scratch run on the final
+    # points, one feed update per edit, and the same files with --batch.
+    run "$dynmesh" quadtree "$data/points2d.node" --cells box.cells
+    box=$(box_of box.cells)
+    for angle in 20.7 30; do
+      run "$dynmesh" mesh "$data/points2d.node" --min-angle "$angle" --edits "$data/edits2d.txt" -o "dyn$angle" \
+        --check --feed "dyn$angle.feed"
+      # shellcheck disable=SC2086  # the box is several numbers
+      run "$dynmesh" mesh "$data/final2d.txt" --min-angle "$angle" --box $box -o "scratch$angle"
+      cmp "dyn$angle.node" "scratch$angle.node" || fail "hpu $angle: dynamic .node differs from a from-scratch run"
+      cmp "dyn$angle.ele" "scratch$angle.ele" || fail "hpu $angle: dynamic .ele differs from a from-scratch run"
+    done
+    edits=$(grep -c '^[+-]' "$data/edits2d.txt")
+    [[ $(grep -c '^update ' dyn20.7.feed) -eq $edits ]] || fail "hpu feed: expected $edits updates"
+    run "$dynmesh" mesh "$data/points2d.node" --edits "$data/edits2d.txt" --batch 3 -o batch3 --check
+    cmp dyn20.7.node batch3.node || fail "hpu --batch 3 .node differs from single edits"
+    cmp dyn20.7.ele batch3.ele || fail "hpu --batch 3 .ele differs from single edits"
     ;;
 
   mesh) # the quadtree mesh after edits equals a from-scratch mesh of the final points
@@ -239,10 +266,11 @@ case $case_name in
     expect_error 1 'bad_number.txt:3: ' "$dynmesh" mesh "$data/bad_number.txt" "${qt[@]}" -o old
     expect_error 1 'duplicate.txt:5: ' "$dynmesh" mesh "$data/duplicate.txt" "${qt[@]}" -o old
     expect_error 1 'above the quadtree' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --min-angle 25 -o old
-    expect_error 1 'pass --postprocess quadtree to apply edits' "$dynmesh" mesh "$data/points2d.node" \
-      --postprocess hpu --edits "$data/edits2d.txt" -o old
-    expect_error 1 'pass --postprocess quadtree to apply edits' "$dynmesh" mesh "$data/points2d.node" \
-      --edits "$data/edits2d.txt" -o old
+    # The hpu mesh (the default) reports bad edits as the quadtree mesh does.
+    expect_error 1 'edits_absent.txt:3: ' "$dynmesh" mesh "$data/points2d.node" --edits "$data/edits_absent.txt" \
+      -o old --feed old.feed
+    expect_error 1 'edits_outside.txt:3: ' "$dynmesh" mesh "$data/points2d.node" --edits "$data/edits_outside.txt" \
+      --batch 2 -o old
     for angle in 0.5 30.5; do
       expect_error 1 "--min-angle for hpu must be between 1 and 30 degrees, got $angle" "$dynmesh" mesh \
         "$data/points2d.node" --min-angle "$angle" -o old
