@@ -1,5 +1,6 @@
-// dynmesh_mesh_bench — the self-adjusting quadtree mesh (DynamicMesh, tree and postprocess
-// in one trace) against its static twin (QuadtreeMesh), for bench/RESULTS.md.
+// dynmesh_mesh_bench — the self-adjusting meshes (DynamicMesh, tree and postprocess in one
+// trace) against their static twins (HpuMesh for --postprocess hpu, QuadtreeMesh for
+// quadtree), for bench/RESULTS.md.
 //
 // Method (as dynmesh_bench): the static twin's build is the median of three; the
 // self-adjusting build follows one untimed warm-up and is the median of `--reps`. Then U
@@ -12,6 +13,8 @@
 //   mean_distance,changed_per_update,bytes_per_point,vertices_per_point,triangles_per_point,
 //   verified
 // speedup = static twin's build / mean update (a user's alternative is re-meshing).
+// --tail K prints the K updates of largest trace distance to stderr (op, point, distance,
+// triangles changed): where the mean's tail comes from.
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -28,6 +31,7 @@
 #include "dynmesh/box.hpp"
 #include "dynmesh/distributions.hpp"
 #include "dynmesh/dynamic_mesh.hpp"
+#include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
 
 namespace {
@@ -46,7 +50,21 @@ struct Row {
   bool verified = false;
 };
 
-Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std::uint64_t seed) {
+/// The static twin's triangles of `pts`.
+std::vector<Triangle> twin_triangles(const Box<2>& box, const std::vector<Point<2>>& pts, const MeshOptions& o) {
+  if (o.postprocess == Postprocess::Hpu) return HpuMesh(box, pts, o.min_angle).triangles();
+  return QuadtreeMesh(box, pts).triangles();
+}
+
+struct Costly {
+  double distance;
+  bool insert;
+  Point<2> p;
+  std::size_t changed;
+};
+
+Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std::uint64_t seed,
+            const MeshOptions& options, std::size_t tail) {
   Row row;
   row.dist = std::string(distribution_name(dist));
   row.n = n;
@@ -55,21 +73,20 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
   const Box<2> box = derive_box<2>(pool);
 
   std::vector<double> st;
-  std::optional<QuadtreeMesh> twin;
-  for (int i = 0; i < 3; ++i) st.push_back(seconds([&] { twin.emplace(box, initial); }));
+  std::vector<Triangle> tris;
+  for (int i = 0; i < 3; ++i) st.push_back(seconds([&] { tris = twin_triangles(box, initial, options); }));
   row.static_s = median(st);
-  const Mesh m0 = twin->mesh();
+  const Mesh m0 = make_mesh(tris);
   row.vertices_pp = static_cast<double>(m0.num_vertices()) / static_cast<double>(n);
   row.triangles_pp = static_cast<double>(m0.num_triangles()) / static_cast<double>(n);
-  twin.reset();
+  tris = {};
 
-  const MeshOptions quadtree{.postprocess = Postprocess::Quadtree};
-  { DynamicMesh warm(box, initial, quadtree); }
+  { DynamicMesh warm(box, initial, options); }
   std::vector<double> sc;
   std::optional<DynamicMesh> mesh;
   for (int i = 0; i < reps; ++i) {
     mesh.reset();
-    sc.push_back(seconds([&] { mesh.emplace(box, initial, quadtree); }));
+    sc.push_back(seconds([&] { mesh.emplace(box, initial, options); }));
   }
   row.scratch_s = median(sc);
   row.bytes_pp = static_cast<double>(mesh->trace_bytes()) / static_cast<double>(n);
@@ -78,10 +95,14 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
   std::vector<PointId> ids;
   for (const auto& [id, p] : mesh->points()) ids.push_back(id);
   std::vector<double> all, dist_all, changed;
+  std::vector<Costly> costly;
   std::size_t next = n;
   for (std::size_t u = 0; u < updates; ++u) {
-    if (u % 2 == 0 && !ids.empty()) {
+    Point<2> at{};
+    const bool erase = u % 2 == 0 && !ids.empty();
+    if (erase) {
       const std::size_t k = static_cast<std::size_t>(rng.below(ids.size()));
+      at = mesh->point(ids[k]);
       mesh->erase(ids[k]);
       ids[k] = ids.back();
       ids.pop_back();
@@ -89,6 +110,7 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
       bool done = false;
       while (!done && next < pool.size()) {
         try {
+          at = pool[next];
           ids.push_back(mesh->insert(pool[next++]));
           done = true;
         } catch (const InputError&) {  // too close for the resolution: take the next one
@@ -99,7 +121,13 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
     all.push_back(mesh->last_update().seconds);
     dist_all.push_back(static_cast<double>(mesh->last_update().trace_distance));
     changed.push_back(static_cast<double>(mesh->last_change().removed.size() + mesh->last_change().added.size()));
+    if (tail) costly.push_back({dist_all.back(), !erase, at, static_cast<std::size_t>(changed.back())});
   }
+  std::sort(costly.begin(), costly.end(), [](const Costly& a, const Costly& b) { return a.distance > b.distance; });
+  for (std::size_t i = 0; i < std::min(tail, costly.size()); ++i)
+    std::fprintf(stderr, "costly: %s %.17g %.17g (box %.17g %.17g %.17g): distance %.0f, %zu triangles changed\n",
+                 costly[i].insert ? "insert" : "delete", costly[i].p[0], costly[i].p[1], box.origin[0], box.origin[1],
+                 box.side, costly[i].distance, costly[i].changed);
   row.update_us = mean(all) * 1e6;
   row.median_us = median(all) * 1e6;
   row.max_us = all.empty() ? 0 : *std::max_element(all.begin(), all.end()) * 1e6;
@@ -108,7 +136,7 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
 
   std::vector<Point<2>> cur;
   for (const auto& [id, p] : mesh->points()) cur.push_back(p);
-  row.verified = QuadtreeMesh(box, cur).triangles() == mesh->triangles();
+  row.verified = twin_triangles(box, cur, options) == mesh->triangles();
   return row;
 }
 
@@ -118,13 +146,19 @@ int main(int argc, char** argv) {
   // Engines are built one after another: keep their freed chunks warm, as the figures in
   // RESULTS.md were measured (sac/chunk_cache.hpp; a user's default is 64 MiB).
   sac::set_chunk_cache_limit(std::size_t{1} << 30);
-  CLI::App app{"dynmesh_mesh_bench: self-adjusting quadtree mesh vs its static twin"};
+  CLI::App app{"dynmesh_mesh_bench: self-adjusting meshes vs their static twins"};
   std::string dist_name = "uniform";
   std::vector<std::size_t> sizes{1000, 10000, 100000};
   std::size_t updates = 1000;
   int reps = 3;
   std::uint64_t seed = 1;
   bool csv = false;
+  std::string postprocess = "hpu";
+  double min_angle = kHpuDefaultMinAngle;
+  std::size_t tail = 0;
+  app.add_option("--postprocess", postprocess, "hpu or quadtree")->check(CLI::IsMember({"hpu", "quadtree"}));
+  app.add_option("--min-angle", min_angle, "hpu's angle bound (1 to 30)");
+  app.add_option("--tail", tail, "print the K costliest updates to stderr");
   app.add_option("--dist", dist_name, "point distribution");
   app.add_option("--n", sizes, "sizes (several allowed)")->delimiter(',');
   app.add_option("--updates", updates, "updates measured per size");
@@ -145,7 +179,9 @@ int main(int argc, char** argv) {
                 "scratch_s", "overhead", "update_us", "median_us", "max_us", "speedup", "distance", "changed",
                 "bytes/point", "V/pt", "T/pt", "verified");
   for (std::size_t n : sizes) {
-    const Row r = measure(*dist, n, updates, reps, seed);
+    const MeshOptions options{.postprocess = postprocess == "hpu" ? Postprocess::Hpu : Postprocess::Quadtree,
+                              .min_angle = min_angle};
+    const Row r = measure(*dist, n, updates, reps, seed, options, tail);
     const double overhead = r.scratch_s / r.static_s;
     const double speedup = r.static_s / (r.update_us * 1e-6);
     if (csv)
