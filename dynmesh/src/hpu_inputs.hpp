@@ -1,5 +1,6 @@
 // hpu_inputs.hpp (private) — the input list of the self-adjusting hpu mesh, kept by the
-// mutator: the input points and the side midpoints they need, in (Morton, xy) order.
+// mutator: the input points and the side midpoints they need, in insertion_less order
+// (hpu_geometry.hpp: BRIO rounds, then (Morton, xy)).
 //
 // Purpose: HpuProgram (hpu_program.hpp) reads one list, `head`, of the points it inserts
 // before refining: the inputs and side_midpoints(box, inputs) (hpu_geometry.hpp), the box's
@@ -20,7 +21,7 @@
 // follows, release() retires the nodes that left the list.
 //
 // Invariants (check_invariants): walking the list from head gives exactly the inputs and
-// their side midpoints less the near corner, each once, strictly in (Morton, xy) order;
+// their side midpoints less the near corner, each once, strictly in insertion_less order;
 // the counts equal a from-scratch count; every node in the map is in the list.
 // Complexity: plan + commit O(k (lg n + path)) for k edits off the sides (a path has O(lg
 // L/s) midpoints); O(n) for a batch holding an input on a side.
@@ -52,7 +53,7 @@ namespace dynmesh::detail {
 
 class HpuInputs {
  public:
-  explicit HpuInputs(const Box<2>& box) : box_(box), list_(MortonOrder{box}) {
+  explicit HpuInputs(const Box<2>& box) : box_(box), list_(InsertionOrder{box}) {
     for (int k = 0; k < 4; ++k) {
       const SideFrame f = frame(k);
       side_[k] = {box.origin[f.u], box.origin[f.u] + box.side};
@@ -176,7 +177,7 @@ class HpuInputs {
     for (const Point<2>& m : side_midpoints(box_, inputs)) want.insert(m);
     want.erase(box_.origin);
     std::vector<Point<2>> order(want.begin(), want.end());
-    std::sort(order.begin(), order.end(), MortonOrder{box_});
+    std::sort(order.begin(), order.end(), InsertionOrder{box_});
     std::size_t i = 0;
     for (const SaInputNode* n = head_.get(); n; n = n->next.get(), ++i) {
       if (i >= order.size()) fail("the list has more points than the inputs and their side midpoints");
@@ -203,9 +204,9 @@ class HpuInputs {
   }
 
  private:
-  struct MortonOrder {
+  struct InsertionOrder {
     Box<2> box;
-    bool operator()(const Point<2>& a, const Point<2>& b) const noexcept { return morton_less(box, a, b); }
+    bool operator()(const Point<2>& a, const Point<2>& b) const noexcept { return insertion_less(box, a, b); }
   };
   struct Entry {
     std::unique_ptr<SaInputNode> node;
@@ -253,7 +254,7 @@ class HpuInputs {
     e.set(n->next, after == list_.end() ? nullptr : after->second.node.get());
     e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next, n);
   }
-  void unlink(sac::Engine& e, std::map<Point<2>, Entry, MortonOrder>::iterator it) {
+  void unlink(sac::Engine& e, std::map<Point<2>, Entry, InsertionOrder>::iterator it) {
     const auto after = std::next(it);
     e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next,
           after == list_.end() ? nullptr : after->second.node.get());
@@ -262,7 +263,7 @@ class HpuInputs {
   }
 
   Box<2> box_;
-  std::map<Point<2>, Entry, MortonOrder> list_;
+  std::map<Point<2>, Entry, InsertionOrder> list_;
   std::array<std::set<double>, 4> side_;       // per side: the along coordinates of its vertices
   std::array<std::map<double, int>, 4> mids_;  // per side: midpoint (along coordinate) → paths
   std::vector<std::unique_ptr<SaInputNode>> gone_;

@@ -3,6 +3,7 @@
 #include "dynmesh/hpu_mesh.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -66,14 +67,22 @@ class Refiner {
   }
 
   void refine() {
-    // The first entries: every vertex at the class of its shortest edge, in Z-order.
-    std::vector<std::pair<std::uint64_t, Vid>> order(dt_.num_vertices());
-    for (Vid v = 0; v < order.size(); ++v) order[v] = {morton_of(dt_.point(v)), v};
-    std::sort(order.begin(), order.end(), [&](const auto& a, const auto& b) {
-      if (a.first != b.first) return a.first < b.first;
-      return xy_less(dt_.point(a.second), dt_.point(b.second));
+    // The first entries: every vertex at the class of its shortest edge; the corners first
+    // in (Morton, xy) order, then the rest in insertion_less order (hpu_geometry.hpp).
+    struct Key {
+      int level;
+      std::uint64_t code;
+      Vid v;
+    };
+    std::vector<Key> order(dt_.num_vertices());
+    for (Vid v = 0; v < order.size(); ++v)
+      order[v] = {v < 4 ? INT_MAX : detail::brio_level(dt_.point(v)), morton_of(dt_.point(v)), v};
+    std::sort(order.begin(), order.end(), [&](const Key& a, const Key& b) {
+      if (a.level != b.level) return a.level > b.level;
+      if (a.code != b.code) return a.code < b.code;
+      return xy_less(dt_.point(a.v), dt_.point(b.v));
     });
-    for (const auto& [code, v] : order) {
+    for (const auto& [level, code, v] : order) {
       dt_.star(v, star_);
       int c = std::numeric_limits<int>::max();
       for (const Vid q : star_) c = std::min(c, edge_class(v, q));

@@ -5,10 +5,11 @@
 // static twin HpuMesh (hpu_mesh.cpp, class Refiner) on the current input points, box and
 // angle, bit for bit. It makes the twin's decisions in the twin's order (hpu_mesh.hpp's
 // rules 1-6), on the same shared geometry (hpu_geometry.hpp):
-//   1. insert the input list (the inputs and their side midpoints, sorted by (Morton, xy);
-//      the mutator keeps it) in list order, each from the previous point's triangle, and
-//      build the list of initial vertices: the list with the box's corners merged in by
-//      (Morton, xy) — the twin's initial order;
+//   1. insert the input list (the inputs and their side midpoints in insertion_less order:
+//      BRIO rounds, Morton within a round; the mutator keeps it, hpu_inputs.hpp) in list
+//      order, each from the previous point's triangle, and build the list of initial
+//      vertices: the box's corners in (Morton, xy) order, then the list — the twin's
+//      initial order;
 //   2. the class of each initial vertex (its shortest edge's), after all insertions;
 //   3. per class j, smallest first: Q_j = (initial entries of class j, in initial order)
 //      ++ (continuations made during class j − 1); rounds: collect every entry of the
@@ -229,7 +230,10 @@ struct HpuProgram {
     std::sort(order.begin(), order.end(),
               [pg](const SaVertex* a, const SaVertex* b) { return morton_less(pg->box(), a->p, b->p); });
     pg->start->corners = order;  // main never re-runs: a plain field is enough
-    e.memo_read(*pg->input, sac::fn<&place>(pg, c[0], &pg->start->cells, 0));
+    // The initial vertices: the corners in (Morton, xy) order, then the list's.
+    sac::Mod<HpuCell*>* dest = &pg->start->cells;
+    for (SaVertex* v : order) dest = append_cell(e, v, dest);
+    e.memo_read(*pg->input, sac::fn<&place>(pg, c[0], dest));
     e.memo_read(pg->start->cells, sac::fn<&class_step>(pg, INT_MAX));
     e.memo(sac::fn<&refine_start>(pg));
   }
@@ -240,22 +244,14 @@ struct HpuProgram {
     return &c->next;
   }
 
-  /// Inserts n's point from prev's triangle and appends it (after the corners before it)
-  /// to the initial vertices; memoized on (n.next, x, …) as SaDelaunayProgram::place.
-  static void place(sac::Engine& e, SaInputNode* n, HpuProgram* pg, SaVertex* prev, sac::Mod<HpuCell*>* dest,
-                    int k) {
-    const auto& corners = pg->start->corners;
-    if (!n) {
-      for (; k < 4; ++k) dest = append_cell(e, corners[sa_index::at(k)], dest);
-      e.write(*dest, nullptr);
-      return;
-    }
+  /// Inserts n's point from prev's triangle and appends it to the initial vertices;
+  /// memoized on (n.next, x, …) as SaDelaunayProgram::place.
+  static void place(sac::Engine& e, SaInputNode* n, HpuProgram* pg, SaVertex* prev, sac::Mod<HpuCell*>* dest) {
+    if (!n) return e.write(*dest, nullptr);
     SaVertex* x = SaDelaunay::vertex(e, n->point);
     SaDelaunay::insert_near(e, pg->dt, x, prev);
-    for (; k < 4 && morton_less(pg->box(), corners[sa_index::at(k)]->p, x->p); ++k)
-      dest = append_cell(e, corners[sa_index::at(k)], dest);
     dest = append_cell(e, x, dest);
-    e.memo_read(n->next, sac::fn<&place>(pg, x, dest, k));
+    e.memo_read(n->next, sac::fn<&place>(pg, x, dest));
   }
 
   // ---------------------------------------------------------------- 2. initial classes
@@ -502,7 +498,7 @@ struct HpuProgram {
       for (const SaDelaunay::Boundary& bd : w.boundary)
         if (bd.edge->box_side && encroaches(bd.a->p, bd.b->p, x->p)) sp.s.emplace_back(bd.a, bd.b);
       if (sp.s.empty()) {
-        SaDelaunay::fan(e, dt, x, w);
+        SaDelaunay::fan(e, dt, x, w, c.pc);
         return done(e, birth(e, c, x));
       }
       std::sort(sp.s.begin(), sp.s.end(), [](const auto& u, const auto& v) {
@@ -529,7 +525,7 @@ struct HpuProgram {
     friend bool operator==(const AfterSplit&, const AfterSplit&) = default;
     std::size_t hash() const noexcept { return sac::hash_combine(c.hash(), sp.hash() + i); }
     void operator()(sac::Engine& e, SaDelaunay* dt, SaVertex* x, const SaDelaunay::Cavity& w) const {
-      SaDelaunay::fan(e, dt, x, w);
+      SaDelaunay::fan(e, dt, x, w, c.pc);
       split_next(e, birth(e, c, x), sp, i + 1);
     }
   };

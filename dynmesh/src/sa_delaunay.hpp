@@ -62,7 +62,13 @@
 // Every memo key holds x: a hit undoes all the trace between the caller and the entry it
 // reuses, so a key that could match a call of a later insertion (say `dead` keyed by the
 // triangle alone, when an earlier insertion now takes it) would silently discard every
-// insertion in between, and they would all be re-run from scratch.
+// insertion in between, and they would all be re-run from scratch. For the same reason the
+// fan's keys also hold the caller's `token`, the place of the insertion in the caller's
+// order (the refinement passes its pair): when an update makes an insertion happen earlier
+// than before (the refinement inserts an off-center in an earlier round), x alone would
+// match its old fan far ahead and discard everything in between (measured: about 3,000
+// pairs of one class re-run for a deletion on the data's hull at n = 20,000); with the
+// token it runs anew here, and its old trace is dropped when propagation reaches it.
 // A point on a box side: the flat boundary edge (the side's edge through x) is not fanned,
 // its halves become box edges of the neighbouring new triangles (Delaunay::insert's rule).
 //
@@ -560,7 +566,7 @@ struct SaDelaunay {
 
   /// Replaces the cavity by the fan of x: keyed allocations and memoized writes only (no
   /// read), in an order that is a function of the cavity.
-  static void fan(sac::Engine& e, SaDelaunay* dt, SaVertex* x, const Cavity& w) {
+  static void fan(sac::Engine& e, SaDelaunay* dt, SaVertex* x, const Cavity& w, const void* token = nullptr) {
     // The edges from x to the fan's corners, in order of first appearance.
     std::vector<std::pair<SaVertex*, SaEdge*>> spokes;
     const auto spoke = [&](SaVertex* c) {
@@ -584,20 +590,20 @@ struct SaDelaunay {
     if (made.t.empty()) throw InvariantError("dynmesh: SaDelaunay: an empty fan");
     // Memoized on what they write (a function of the triangle alone), with x in each key
     // (see the header).
-    for (SaTri* t : made.t) e.memo(sac::fn<&put_fan_triangle>(x, t));
-    for (SaTri* t : w.members) e.memo(sac::fn<&kill>(x, t));
+    for (SaTri* t : made.t) e.memo(sac::fn<&put_fan_triangle>(x, t, token));
+    for (SaTri* t : w.members) e.memo(sac::fn<&kill>(x, t, token));
     // x's triangle: the fan triangle of the (x, y)-smallest corner (a function of the
     // fan, not of where the search started).
     const auto a_of = [x](const SaTri* t) { return t->v[sa_index::at(sa_index::next(t->index_of(x)))]; };
     SaTri* low = made.t.front();
     for (SaTri* t : made.t)
       if (xy_less(a_of(t)->p, a_of(low)->p)) low = t;
-    e.memo(sac::fn<&put_vertex>(x, low));
+    e.memo(sac::fn<&put_vertex>(x, low, token));
   }
 
   /// The fan triangle t = (a, b, x) takes its sides, and gives a a live triangle; also b,
   /// when b-x is a half of a split box side (no fan triangle starts at b then).
-  static void put_fan_triangle(sac::Engine& e, SaVertex* x, SaTri* t) {
+  static void put_fan_triangle(sac::Engine& e, SaVertex* x, SaTri* t, const void*) {
     using sa_index::at;
     using sa_index::next;
     using sa_index::prev;
@@ -608,12 +614,12 @@ struct SaDelaunay {
     if (t->e[at(next(ix))]->box_side) e.write(t->v[at(prev(ix))]->tri, t);
   }
 
-  static void kill(sac::Engine& e, SaVertex* x, SaTri* t) {
+  static void kill(sac::Engine& e, SaVertex* x, SaTri* t, const void*) {
     (void)x;
     e.write(t->dead, true);
     e.make<SaTriEvent>(t->registry, t, -1);
   }
-  static void put_vertex(sac::Engine& e, SaVertex* v, SaTri* t) { e.write(v->tri, t); }
+  static void put_vertex(sac::Engine& e, SaVertex* v, SaTri* t, const void*) { e.write(v->tri, t); }
 
   // ------------------------------------------------------------------ stars
 

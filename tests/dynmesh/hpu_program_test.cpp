@@ -28,7 +28,9 @@
 #include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
+#include "dynmesh/edit.hpp"
 #include "hpu_geometry.hpp"
+#include "hpu_inputs.hpp"
 #include "sa_delaunay.hpp"
 #include "../sanitized.hpp"
 
@@ -57,63 +59,52 @@ testing::AssertionResult same_triangles(const std::vector<Triangle>& got, const 
   return r;
 }
 
-/// The program on a mutator-owned input list: the inputs and their side midpoints in
-/// (Morton, xy) order. set_points() diffs the list, relinks it with Engine::set,
-/// propagates, and frees the nodes of points that left.
+/// The program on the mutator's input list (HpuInputs: the inputs and their side
+/// midpoints in insertion order). set_points() turns the new point set into edits, relinks
+/// the list, propagates, and frees the nodes that left.
 class HpuHarness {
  public:
   HpuHarness(const Box<2>& box, const std::vector<Point<2>>& pts, double angle)
-      : box_(box), dt_{&registry_, box}, program_(&dt_, &head_, angle) {
-    relink(pts);
+      : box_(box), inputs_(box), dt_{&registry_, box}, program_(&dt_, &inputs_.head(), angle) {
+    set_list(pts);
     engine_.run([this](sac::Engine& e) { HpuProgram::main(e, &program_); });
+    registry_.clear_change();
   }
+  ~HpuHarness() { registry_.close(); }
 
   void set_points(const std::vector<Point<2>>& pts) {
-    const std::vector<SaInputNode*> gone = relink(pts);
+    set_list(pts);
     engine_.propagate();
-    for (SaInputNode* n : gone) {
-      ASSERT_TRUE(engine_.unused(n->next)) << "the trace still reads an erased node";
-      engine_.retire(n->next);
-      nodes_.erase(n->point);
-    }
+    inputs_.release(engine_);
   }
 
   std::vector<Triangle> triangles() const { return registry_.triangles(); }
+  MeshChange take_change() { return registry_.take_change(); }
   void check() const {
     engine_.check_invariants();
     registry_.check_invariants(box_);
+    const std::vector<Point<2>> now(points_.begin(), points_.end());
+    inputs_.check_invariants(now);
   }
   const sac::Stats& stats() const { return engine_.stats(); }
 
  private:
-  /// Makes the list the sorted inputs and midpoints; returns the unlinked nodes.
-  std::vector<SaInputNode*> relink(const std::vector<Point<2>>& pts) {
-    std::set<Point<2>> all(pts.begin(), pts.end());
-    for (const auto& m : detail::side_midpoints(box_, pts)) all.insert(m);
-    all.erase(box_.origin);  // an input at the near corner: the box's own vertex already
-    std::vector<Point<2>> order(all.begin(), all.end());
-    std::sort(order.begin(), order.end(),
-              [this](const Point<2>& a, const Point<2>& b) { return detail::morton_less(box_, a, b); });
-    std::vector<SaInputNode*> gone;
-    for (const auto& [p, n] : nodes_)
-      if (!all.count(p)) gone.push_back(n.get());
-    std::vector<SaInputNode*> list;
-    for (const auto& p : order) {
-      auto& slot = nodes_[p];
-      if (!slot) slot = std::make_unique<SaInputNode>(p);
-      list.push_back(slot.get());
-    }
-    for (std::size_t i = 0; i < list.size(); ++i)
-      engine_.set(list[i]->next, i + 1 < list.size() ? list[i + 1] : nullptr);
-    engine_.set(head_, list.empty() ? nullptr : list.front());
-    return gone;
+  void set_list(const std::vector<Point<2>>& pts) {
+    const std::set<Point<2>> next(pts.begin(), pts.end());
+    std::vector<Edit<2>> edits;
+    for (const Point<2>& p : points_)
+      if (!next.count(p)) edits.push_back({EditOp::Delete, p});
+    for (const Point<2>& p : next)
+      if (!points_.count(p)) edits.push_back({EditOp::Insert, p});
+    inputs_.commit(engine_, inputs_.plan(edits));
+    points_ = next;
   }
 
   // Declared before the engine, so destroyed after it.
   Box<2> box_;
   detail::SaTriRegistry registry_;
-  std::map<Point<2>, std::unique_ptr<SaInputNode>> nodes_;
-  sac::Mod<SaInputNode*> head_;
+  detail::HpuInputs inputs_;
+  std::set<Point<2>> points_;
   sac::Engine engine_;
   detail::SaDelaunay dt_;
   HpuProgram program_;
@@ -209,12 +200,16 @@ std::vector<std::uint64_t> run_updates(const Box<2>& box, std::vector<Point<2>> 
   HpuHarness h(box, pts, angle);
   EXPECT_TRUE(same_triangles(h.triangles(), HpuMesh(box, pts, angle).triangles()));
   scratch = h.stats().events_created;
+  std::vector<Triangle> mesh = h.triangles();
   for (int k = 0; k < updates; ++k) {
     SCOPED_TRACE("update " + std::to_string(k));
     if (!pts.empty() && rng() % 2 == 0) pts.erase(pts.begin() + static_cast<std::ptrdiff_t>(rng() % pts.size()));
     else pts.push_back(fresh());
     h.set_points(pts);
     distance.push_back(h.stats().last_trace_distance);
+    // The change feed replays: the last mesh, less what it removed, plus what it added.
+    EXPECT_TRUE(apply_change(mesh, h.take_change()));
+    EXPECT_EQ(mesh, h.triangles()) << "the feed does not replay to the new mesh";
     const bool same = same_triangles(h.triangles(), HpuMesh(box, pts, angle).triangles());
     EXPECT_TRUE(same);
     if (!same) break;
