@@ -72,6 +72,8 @@
 
 namespace dynmesh::detail {
 
+struct HpuPair;
+
 /// A queue entry (the twin's Entry), keyed by (vertex, class, birth).
 struct HpuEntry {
   HpuEntry(SaVertex* x, bool b) : v(x), birth(b) {}
@@ -80,6 +82,7 @@ struct HpuEntry {
   SaVertex* v;
   bool birth;
   sac::Mod<HpuEntry*> next;
+  sac::Mod<HpuPair*> pairs;  // the loose pairs its collect found, in order
 };
 
 /// A collected pair p→q, keyed by (its collector's entry, p, q).
@@ -119,7 +122,6 @@ struct HpuRound {
   HpuRound() = default;
   HpuRound(const HpuRound&) = delete;
   HpuRound& operator=(const HpuRound&) = delete;
-  sac::Mod<HpuPair*> pairs;                   // collected, in order
   sac::Mod<HpuEntry*> births;                 // the next round
   sac::Mod<sac::Mod<HpuEntry*>*> cont_tail;   // Q_{j+1}'s tail after this round's collect
 };
@@ -318,8 +320,8 @@ struct HpuProgram {
   static void round(sac::Engine& e, HpuProgram* pg, HpuClass* cs, HpuClass* csn, sac::Mod<HpuEntry*>* head,
                     sac::Mod<HpuEntry*>* cdest) {
     HpuRound* rs = e.alloc<HpuRound>(head);
-    e.memo_read(*head, sac::fn<&collect_step>(pg, cs, rs, &rs->pairs, cdest, nullptr, nullptr));
-    e.memo_read(rs->pairs, sac::fn<&process_step>(pg, cs, rs, &rs->births, nullptr, nullptr));
+    e.memo_read(*head, sac::fn<&collect_step>(pg, cs, rs, cdest, nullptr, nullptr));
+    e.memo_read(*head, sac::fn<&process_entry>(pg, cs, rs, &rs->births, nullptr, nullptr));
     e.memo(sac::fn<&round_end>(pg, cs, csn, rs));
   }
 
@@ -352,7 +354,6 @@ struct HpuProgram {
     HpuRound* rs;
     HpuEntry* ent;
     HpuEntry* before;  // the entry before ent (null: ent is first)
-    sac::Mod<HpuPair*>* pdest;
     sac::Mod<HpuEntry*>* cdest;
     void operator()(sac::Engine& e, const std::vector<SaVertex*>& star, const std::vector<SaTri*>&,
                     bool cycle) const {
@@ -379,19 +380,22 @@ struct HpuProgram {
         if (a.first->p != b.first->p) return xy_less(a.first->p, b.first->p);
         return xy_less(a.second->p, b.second->p);
       });
-      sac::Mod<HpuPair*>* pd = pdest;
+      // The entry's own list: no tail threads through the round, so a change in one
+      // entry's pairs does not change the keys of the (mostly pairless) entries after it.
+      sac::Mod<HpuPair*>* pd = &ent->pairs;
       for (const auto& [p, q] : local) {
         HpuPair* pc = e.alloc<HpuPair>(std::tuple{ent, p, q}, p, q);
         e.write(*pd, pc);
         pd = &pc->next;
       }
+      e.write(*pd, nullptr);
       sac::Mod<HpuEntry*>* cd = cdest;
       if (go_on) {
         HpuEntry* c = e.alloc<HpuEntry>(std::tuple{v, j + 1, false}, v, false);
         e.write(*cd, c);
         cd = &c->next;
       }
-      e.memo_read(ent->next, sac::fn<&collect_step>(pg, cs, rs, pd, cd, ent, before));
+      e.memo_read(ent->next, sac::fn<&collect_step>(pg, cs, rs, cd, ent, before));
     }
   };
 
@@ -401,15 +405,10 @@ struct HpuProgram {
   /// discard everything in between (measured: 144k events for a deletion at n = 50,000);
   /// with the predecessor it runs anew in place. process_step does the same.
   static void collect_step(sac::Engine& e, HpuEntry* ent, HpuProgram* pg, HpuClass* cs, HpuRound* rs,
-                           sac::Mod<HpuPair*>* pdest, sac::Mod<HpuEntry*>* cdest, HpuEntry* owner,
-                           HpuEntry* owner_pred) {
+                           sac::Mod<HpuEntry*>* cdest, HpuEntry* owner, HpuEntry* owner_pred) {
     (void)owner_pred;
-    if (!ent) {
-      e.write(*pdest, nullptr);
-      e.write(rs->cont_tail, cdest);
-      return;
-    }
-    read_fan(e, ent->v, CollectK{pg, cs, rs, ent, owner, pdest, cdest});
+    if (!ent) return e.write(rs->cont_tail, cdest);
+    read_fan(e, ent->v, CollectK{pg, cs, rs, ent, owner, cdest});
   }
 
   // ---------------------------------------------------------------- process
@@ -421,7 +420,9 @@ struct HpuProgram {
     HpuRound* rs;
     HpuPair* pc;
     sac::Mod<HpuEntry*>* bdest;
-    HpuPair* prev;  // the pair before pc (null: pc is first)
+    HpuPair* prev;        // the pair before pc in its entry's list (null: pc is first)
+    HpuEntry* ent;        // pc's entry
+    HpuEntry* ent_prev;   // the entry before it (null: ent is first)
     friend bool operator==(const Ctx&, const Ctx&) = default;
     std::size_t hash() const noexcept {
       std::uint64_t h = sac::Hash<HpuPair*>{}(pc);
@@ -431,18 +432,29 @@ struct HpuProgram {
     }
   };
 
-  /// pc was read from owner's `next` (owner null: the round's pairs); owner's predecessor
-  /// is in the key, as in collect_step.
-  static void process_step(sac::Engine& e, HpuPair* pc, HpuProgram* pg, HpuClass* cs, HpuRound* rs,
-                           sac::Mod<HpuEntry*>* bdest, HpuPair* owner, HpuPair* owner_pred) {
+  /// The process pass walks the round's entries and each entry's pairs. nent was read from
+  /// owner's `next` (owner null: the round's head); owner's predecessor is in the key, as
+  /// in collect_step.
+  static void process_entry(sac::Engine& e, HpuEntry* nent, HpuProgram* pg, HpuClass* cs, HpuRound* rs,
+                            sac::Mod<HpuEntry*>* bdest, HpuEntry* owner, HpuEntry* owner_pred) {
     (void)owner_pred;
-    if (!pc) return e.write(*bdest, nullptr);
-    try_pair(e, Ctx{pg, cs, rs, pc, bdest, owner});
+    if (!nent) return e.write(*bdest, nullptr);
+    e.memo_read(nent->pairs, sac::fn<&process_step>(pg, cs, rs, bdest, nent, owner, nullptr, nullptr));
+  }
+
+  /// pc was read from owner's `next` (owner null: ent's list head); owner's predecessor is
+  /// in the key, as in collect_step.
+  static void process_step(sac::Engine& e, HpuPair* pc, HpuProgram* pg, HpuClass* cs, HpuRound* rs,
+                           sac::Mod<HpuEntry*>* bdest, HpuEntry* ent, HpuEntry* ent_prev, HpuPair* owner,
+                           HpuPair* owner_pred) {
+    (void)owner_pred;
+    if (!pc) return e.memo_read(ent->next, sac::fn<&process_entry>(pg, cs, rs, bdest, ent, ent_prev));
+    try_pair(e, Ctx{pg, cs, rs, pc, bdest, owner, ent, ent_prev});
   }
 
   /// The pair is done: the next one.
   static void done(sac::Engine& e, const Ctx& c) {
-    e.memo_read(c.pc->next, sac::fn<&process_step>(c.pg, c.cs, c.rs, c.bdest, c.pc, c.prev));
+    e.memo_read(c.pc->next, sac::fn<&process_step>(c.pg, c.cs, c.rs, c.bdest, c.ent, c.ent_prev, c.pc, c.prev));
   }
 
   /// x was inserted: its birth entry joins the next round.
