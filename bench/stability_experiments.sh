@@ -11,12 +11,12 @@
 # gnuplot pictures. Everything lands in docs/data/ and docs/figures/; the tables are
 # printed as Markdown for docs/EXPERIMENTS.md.
 #
-# With `--postprocess quadtree` the same experiments measure the whole update of the 2D
-# quadtree mesh (DynamicMesh: tree and mesh in one trace), into docs/data/mesh_* and
-# docs/figures/mesh_*; the spread sweep stops at 2^36, the deepest a mesh of derived-box
-# coordinates resolves (mesh_resolution_level).
+# With `--postprocess quadtree` (or hpu) the same experiments measure the whole update of
+# the 2D quadtree mesh (or the hpu mesh; DynamicMesh: tree and mesh in one trace), into
+# docs/data/mesh_* and docs/figures/mesh_* (hpu: hpu_*); the spread sweep stops at 2^36,
+# the deepest a mesh of derived-box coordinates resolves (mesh_resolution_level).
 #
-# Usage: bash bench/stability_experiments.sh [--quick] [--postprocess quadtree]
+# Usage: bash bench/stability_experiments.sh [--quick] [--postprocess quadtree|hpu]
 #        (after `bash dev.sh run`, which builds)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -31,7 +31,7 @@ while (($#)); do
   case $1 in
     --quick) QUICK=1 ;;
     --postprocess) PP=${2:?--postprocess needs a value}; shift ;;
-    *) echo "usage: $0 [--quick] [--postprocess quadtree]" >&2; exit 2 ;;
+    *) echo "usage: $0 [--quick] [--postprocess quadtree|hpu]" >&2; exit 2 ;;
   esac
   shift
 done
@@ -39,8 +39,10 @@ U=400
 ((QUICK)) && U=60
 if [[ $PP == none ]]; then
   P=stability_ FP= DIMS="2 3" KMAX=40 PPARGS=() WHAT="the quadtree"
-else
+elif [[ $PP == quadtree ]]; then
   P=mesh_stability_ FP=mesh_ DIMS=2 KMAX=36 PPARGS=(--postprocess "$PP") WHAT="the $PP mesh"
+else
+  P=hpu_stability_ FP=hpu_ DIMS=2 KMAX=36 PPARGS=(--postprocess "$PP") WHAT="the $PP mesh"
 fi
 
 SPREAD_CSV=$DATA/${P}spread.csv

@@ -4,6 +4,7 @@
 #include "dynmesh/dynamic_mesh.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <iterator>
 #include <span>
 #include <string>
@@ -175,7 +176,11 @@ void check_hpu_structures(const MeshState& s) {
 /// propagate() has just run.
 std::vector<PointId> checked_update(const DynamicMesh& mesh, MeshState& s, std::span<const Edit<2>> edits,
                                     const HpuInputs::Plan& plan) {
+  // The update's time is the whole of it but the validation: relinking, the propagation
+  // and the change feed.
+  const auto t0 = std::chrono::steady_clock::now();
   std::vector<PointId> ids = s.update(edits, plan);
+  s.core.last.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 #ifdef SAC_DEBUG_CHECKS
   s.core.check_own_invariants();
   check_trees_of(mesh, s);

@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
 
   DemoOptions m;
   CLI::App* demo = app.add_subcommand(
-      "demo", "Build the quadtree on an embedded clustered point set, time single-point updates, verify, draw");
+      "demo", "Mesh an embedded clustered point set with DynHPU, time single-point updates, verify, draw the mesh");
   demo->add_option("--n", m.n, "number of points")->capture_default_str()->check(whole_number(2, kMaxCount));
   demo->add_option("--updates", m.updates, "updates (alternating deletions and insertions)")
       ->capture_default_str()
@@ -182,7 +182,7 @@ int main(int argc, char** argv) {
   demo->add_option("--seed", m.seed, "random seed of the point set and of the updates")
       ->capture_default_str()
       ->check(any_seed);
-  demo->add_option("--svg", m.svg, "picture of the final tree (empty: none)")->capture_default_str();
+  demo->add_option("--svg", m.svg, "picture of the final mesh (empty: none)")->capture_default_str();
 
   try {
     app.parse(argc, argv);

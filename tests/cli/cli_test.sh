@@ -174,10 +174,14 @@ case $case_name in
     run "$dynmesh" demo --n 1000 --updates 100 --svg demo.svg
     grep -q '^verified: yes' out.txt || { cat out.txt; fail "demo not verified"; }
     grep -q 'trace distance' out.txt || fail "demo lacks the trace distance figure"
-    # The first figure is the speedup of an update over a static rebuild.
-    sed -n 2p out.txt | grep -q '^  speedup  *[0-9]*x: an update vs a static rebuild' ||
-      fail "demo does not lead with the speedup over a static rebuild: $(sed -n 2p out.txt)"
+    # The first figure is the speedup of an update over re-meshing from scratch.
+    sed -n 2p out.txt | grep -q '^  speedup  *[0-9]*x: an update vs re-meshing from scratch' ||
+      fail "demo does not lead with the speedup over re-meshing: $(sed -n 2p out.txt)"
+    grep -q '^  mesh  *[0-9]* vertices, [0-9]* triangles, smallest angle 2[0-9.]* degrees' out.txt ||
+      fail "demo lacks the mesh figures (or its smallest angle is below 20): $(grep mesh out.txt)"
+    grep -q '^  triangles changed' out.txt || fail "demo lacks the triangles changed per update"
     head -c 5 demo.svg | grep -q '^<?xml\|^<svg' || fail "demo.svg is not SVG"
+    grep -q '<polygon\|<path\|<line' demo.svg || fail "demo.svg draws no mesh"
     ;;
 
   mesh_hpu) # the default postprocess: a quality Delaunay mesh, a function of the point set

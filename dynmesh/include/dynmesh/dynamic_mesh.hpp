@@ -99,6 +99,8 @@ class DynamicMesh {
   /// no tree).
   std::vector<Leaf<2>> refined_leaves() const;
 
+  /// The last update's trace distance and time (seconds: relinking, the propagation and
+  /// the change feed; not the input's validation).
   const UpdateStats& last_update() const noexcept;
   const sac::Stats& engine_stats() const noexcept;
   std::size_t trace_bytes() const;
