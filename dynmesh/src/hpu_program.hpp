@@ -55,6 +55,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -158,69 +159,10 @@ struct HpuProgram {
            p[1] == b.origin[1] + b.side;
   }
 
-  // ---------------------------------------------------------------- stars with triangles
-
-  /// v's neighbours counter-clockwise (SaDelaunay::read_star's order) and the triangles
-  /// between them: tris[i] = (v, ring[i], ring[i + 1 mod d]).
-  template <class K>
-  struct Fan {
-    SaVertex* v;
-    SaTri* first;
-    std::vector<SaVertex*> ccw, cw;
-    std::vector<SaTri*> tccw, tcw;
-    K k;
-  };
-
-  /// Reads v's star and calls k(Engine&, ring, tris, interior) in the last read's body.
+  /// v's star (SaDelaunay::read_star): k(Engine&, ring, tris, interior).
   template <class K>
   static void read_fan(sac::Engine& e, SaVertex* v, const K& k) {
-    e.read(v->tri, [v, k](sac::Engine& e2, SaTri* first) {
-      const int i = first->index_of(v);
-      if (i < 0) throw InvariantError("dynmesh: HpuProgram: a vertex's triangle lacks it");
-      fan_ccw(e2, Fan<K>{v, first, {first->v[sa_index::at(sa_index::next(i))]}, {}, {}, {}, k}, first);
-    });
-  }
-
-  template <class K>
-  static void fan_ccw(sac::Engine& e, Fan<K> w, SaTri* t) {
-    using sa_index::at;
-    using sa_index::next;
-    using sa_index::prev;
-    const int i = t->index_of(w.v);
-    w.ccw.push_back(t->v[at(prev(i))]);
-    w.tccw.push_back(t);
-    if (t->e[at(next(i))]->box_side) return fan_turn(e, std::move(w));
-    e.read(t->across(next(i)), [w](sac::Engine& e2, SaTri* u) {
-      Fan<K> c = w;
-      if (u != c.first) return fan_ccw(e2, std::move(c), u);
-      c.ccw.pop_back();  // all the way round: the last neighbour is the first
-      c.k(e2, std::as_const(c.ccw), std::as_const(c.tccw), true);
-    });
-  }
-
-  template <class K>
-  static void fan_turn(sac::Engine& e, Fan<K> w) {
-    const int i = w.first->index_of(w.v);
-    const int j = sa_index::prev(i);
-    if (w.first->e[sa_index::at(j)]->box_side) return w.k(e, std::as_const(w.ccw), std::as_const(w.tccw), false);
-    e.read(w.first->across(j), [w](sac::Engine& e2, SaTri* u) { fan_cw(e2, Fan<K>(w), u); });
-  }
-
-  template <class K>
-  static void fan_cw(sac::Engine& e, Fan<K> w, SaTri* t) {
-    using sa_index::at;
-    using sa_index::next;
-    using sa_index::prev;
-    const int i = t->index_of(w.v);
-    w.cw.push_back(t->v[at(next(i))]);
-    w.tcw.push_back(t);
-    if (!t->e[at(prev(i))]->box_side)
-      return e.read(t->across(prev(i)), [w](sac::Engine& e2, SaTri* u) { fan_cw(e2, Fan<K>(w), u); });
-    std::vector<SaVertex*> ring(w.cw.rbegin(), w.cw.rend());
-    ring.insert(ring.end(), w.ccw.begin(), w.ccw.end());
-    std::vector<SaTri*> tris(w.tcw.rbegin(), w.tcw.rend());
-    tris.insert(tris.end(), w.tccw.begin(), w.tccw.end());
-    w.k(e, std::as_const(ring), std::as_const(tris), false);
+    SaDelaunay::read_star(e, v, k);
   }
 
   // ---------------------------------------------------------------- 1. insertion
@@ -262,7 +204,7 @@ struct HpuProgram {
     HpuProgram* pg;
     HpuCell* cell;
     int mn;
-    void operator()(sac::Engine& e, const std::vector<SaVertex*>& ring, const std::vector<SaTri*>&, bool) const {
+    void operator()(sac::Engine& e, std::span<SaVertex* const> ring, std::span<SaTri* const>, bool) const {
       int c = INT_MAX;
       for (const SaVertex* q : ring) c = std::min(c, edge_class(cell->v->p, q->p));
       e.write(cell->cls, c);
@@ -355,7 +297,7 @@ struct HpuProgram {
     HpuEntry* ent;
     HpuEntry* before;  // the entry before ent (null: ent is first)
     sac::Mod<HpuEntry*>* cdest;
-    void operator()(sac::Engine& e, const std::vector<SaVertex*>& star, const std::vector<SaTri*>&,
+    void operator()(sac::Engine& e, std::span<SaVertex* const> star, std::span<SaTri* const>,
                     bool cycle) const {
       SaVertex* v = ent->v;
       const int j = cs->j;
@@ -470,7 +412,7 @@ struct HpuProgram {
 
   struct TryK {
     Ctx c;
-    void operator()(sac::Engine& e, const std::vector<SaVertex*>& ring, const std::vector<SaTri*>& tris,
+    void operator()(sac::Engine& e, std::span<SaVertex* const> ring, std::span<SaTri* const> tris,
                     bool cycle) const {
       HpuProgram* pg = c.pg;
       SaVertex* p = c.pc->p;
@@ -613,7 +555,7 @@ struct HpuProgram {
     int side;
     SaVertex* v;
     K k;
-    void operator()(sac::Engine& e, const std::vector<SaVertex*>& ring, const std::vector<SaTri*>&,
+    void operator()(sac::Engine& e, std::span<SaVertex* const> ring, std::span<SaTri* const>,
                     bool cycle) const {
       if (cycle || ring.empty()) throw InvariantError("dynmesh: HpuProgram: a side crossing at an inner vertex");
       const unsigned along = side % 2 == 0 ? 0 : 1;

@@ -65,9 +65,11 @@ inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};
 //   /usr/bin/time -v dynmesh mesh unif1e5.txt -o o --min-angle 30          101,860 KiB: 987 B/point
 //   /usr/bin/time -v dynmesh mesh unif1e5.txt -o o --min-angle 30 --check  147,524 KiB: +468 B/point
 inline constexpr MemoryCost kHpuMeshCost{1'300, 650};
-// The self-adjusting hpu mesh (DynamicMesh, Postprocess::Hpu: the tree and the hpu trace):
-//   (to be measured)
-inline constexpr MemoryCost kHpuDynamicCost{60'000, 12'000};
+// The self-adjusting hpu mesh (DynamicMesh, Postprocess::Hpu: the tree and the hpu trace;
+// --edits selects it), on unif1e5, at its largest, 30 degrees (20.7 degrees: 4,759,144 KiB,
+// 48,735 B/point; --check +5,875 B/point):
+//   /usr/bin/time -v dynmesh mesh unif1e5.txt --min-angle 30 --edits e10.txt -o o   6,981,172 KiB: 71,487 B/point
+inline constexpr MemoryCost kHpuDynamicCost{80'000, 8'000};
 // The program before any point: 7-8 MB resident, more address space (libraries, a thread stack).
 inline constexpr std::uint64_t kFixedBytes = std::uint64_t{32} << 20;
 

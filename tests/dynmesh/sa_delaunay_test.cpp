@@ -136,7 +136,7 @@ class PointSource {
 /// Sink of a star read: the ring's points, written to a modifiable the test reads.
 struct StarSink {
   sac::Mod<std::vector<Point<2>>>* out;
-  void operator()(sac::Engine& e, const std::vector<SaVertex*>& ring, bool) const {
+  void operator()(sac::Engine& e, std::span<SaVertex* const> ring, std::span<detail::SaTri* const>, bool) const {
     std::vector<Point<2>> pts;
     for (const SaVertex* v : ring) pts.push_back(v->p);
     e.write(*out, std::move(pts));
