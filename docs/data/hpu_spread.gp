@@ -1,0 +1,6 @@
+set terminal svg size 900,600 dynamic font 'sans,13'
+set output 'docs/figures/hpu_trace_distance_vs_spread.svg'
+set title 'Trace distance per update, the hpu mesh (mean of each run)'
+set xlabel 'log2(L/s)'; set ylabel 'trace events created + undone'
+set key right bottom; set grid; set yrange [0:*]
+plot '< grep "^clusters-2d " docs/data/hpu_spread_means.dat' using 2:3 with linespoints title 'clusters-2d', '< grep "^shrinking-2d " docs/data/hpu_spread_means.dat' using 2:3 with linespoints title 'shrinking-2d', '< grep "^spiral-2d " docs/data/hpu_spread_means.dat' using 2:3 with linespoints title 'spiral-2d', '< grep "^uniform-2d " docs/data/hpu_spread_means.dat' using 2:3 with linespoints title 'uniform-2d', '< grep "^shrinking-2d " docs/data/spread_means.dat' using 2:3 with linespoints dt 2 title 'shrinking-2d, tree alone'
