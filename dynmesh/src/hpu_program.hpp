@@ -13,8 +13,9 @@
 //   2. the class of each initial vertex (its shortest edge's), after all insertions;
 //   3. per class j, smallest first: Q_j = (initial entries of class j, in initial order)
 //      ++ (continuations made during class j − 1); rounds: collect every entry of the
-//      round (its loose pairs, and its continuation into Q_{j+1}), then process the pairs in
-//      collection order; births (off-centers and side midpoints) form the next round.
+//      round (its loose pairs, into the entry's own list, and its continuation into
+//      Q_{j+1}), then process the pairs in collection order (entry by entry); births
+//      (off-centers and side midpoints) form the next round.
 // Lists by destination passing (quadtree_refine.hpp's pattern): every list cell is a keyed
 // allocation (an entry by (vertex, class, birth), a pair by (its collector's entry, p, q),
 // a class by j, a round by the modifiable holding its first entry), so a re-executed step
@@ -26,7 +27,12 @@
 // phase needs from an earlier one travels in modifiables (a round's continuation tail, the
 // smallest initial class).
 // Memo keys never reach across insertions (sa_delaunay.hpp's warning): each holds the
-// cell, class or round it belongs to, so it can only match its own old call.
+// cell, class or round it belongs to, so it can only match its own old call; a list step's
+// key also holds its predecessor's predecessor, and the fan's the births' tail, so that an
+// entry, a pair or an off-center that an update moved earlier cannot match its old call
+// far ahead and discard everything in between (docs/EXPERIMENTS.md, "What made the trace
+// distance flat"). No destination is threaded through a sparse list: an entry owns its
+// pairs, so a change in one entry's pairs leaves the keys of the pairless entries after it.
 // Process, the twin's loop for one pair p→q: read p's star (its triangles too); p→q must be
 // an edge with a triangle t = (p, q, tv) on its left and still loose; r = the off-center;
 // r outside the box → split the box edge holding the first crossing X of m→r with the
@@ -140,8 +146,8 @@ struct HpuStart {
 /// The program. Preconditions (the mutator's): the list's points are distinct, in the box,
 /// none a box corner (an input at the near corner is the box's vertex already: leave it
 /// out). Run with e.run([&](sac::Engine& r) { HpuProgram::main(r, &program); });
-/// the mutator keeps `input` equal to the inputs and their side midpoints in (Morton, xy)
-/// order (relinking with Engine::set) and calls propagate().
+/// the mutator keeps `input` equal to the inputs and their side midpoints in
+/// insertion_less order (HpuInputs, relinking with Engine::set) and calls propagate().
 struct HpuProgram {
   SaDelaunay* dt;
   sac::Mod<SaInputNode*>* input;

@@ -24,7 +24,9 @@
 //      The outside of a box side is never a side of a pair.
 //   3. Classes: the class of pq is ⌊log2 |pq|⌋ (from the double exponent of |pq|²). Queue
 //      entries are vertices, Q_j a FIFO per class. A vertex enters at the class of its
-//      shortest edge; its entry in Q_j collects its loose pairs of class ≤ j (both sides,
+//      shortest edge (the first entries: the corners, then the other vertices in BRIO order,
+//      src/hpu_geometry.hpp's insertion_less, which keeps the self-adjusting version's
+//      updates local); its entry in Q_j collects its loose pairs of class ≤ j (both sides,
 //      in (x, y) order of their ends) and re-enters it in the queue of its next longer
 //      edge's class. A new vertex enters at max(current class, its shortest edge's class).
 //      Since edges between old vertices only vanish and every new edge has a new end, each
@@ -48,10 +50,11 @@
 // questions quickly (stars, neighbours, cavities): the self-adjusting version answers the
 // same questions from the quadtree's cells and must reach the same mesh.
 //
-// The self-adjusting version: src/hpu_program.hpp runs this algorithm on the runtime, on
-// the self-adjusting triangulation of src/sa_delaunay.hpp, and is bit-identical to this twin
-// after every update (tests/dynmesh/hpu_program_test.cpp). Not yet wired into DynamicMesh:
-// the feed comes from a registry scan, and inputs come from a Morton list the mutator keeps.
+// The self-adjusting version: DynamicMesh with Postprocess::Hpu (dynamic_mesh.hpp) runs
+// this algorithm on the runtime (src/hpu_program.hpp, on the self-adjusting triangulation of
+// src/sa_delaunay.hpp, reading the inputs and side midpoints from a list the mutator keeps,
+// src/hpu_inputs.hpp), and is bit-identical to this twin after every update
+// (tests/dynmesh/dynamic_mesh_test.cpp, hpu_program_test.cpp).
 //
 // Invariants: check_invariants(): the triangulation's own invariants (Delaunay, tiling) and
 // the mesh contract through check_mesh (every angle ≥ θ, every input a vertex).
