@@ -3,8 +3,10 @@
 // (hpu_geometry.hpp: BRIO rounds, then (Morton, xy)).
 //
 // Purpose: HpuProgram (hpu_program.hpp) reads one list, `head`, of the points it inserts
-// before refining: the inputs and side_midpoints(box, inputs) (hpu_geometry.hpp), the box's
-// near corner left out (it is the box's own vertex). HpuInputs keeps that list equal to its
+// before refining: the inputs and side_midpoints(box, inputs) (hpu_geometry.hpp), less the
+// box's corners (an input may lie on one, in the closed box: it is the box's own vertex;
+// fuzz_dynamic_mesh found the far corners inserted twice when only the near one was left
+// out). HpuInputs keeps that list equal to its
 // definition under insertions and deletions of inputs, relinking it with Engine::set, in
 // time proportional to the change rather than to n:
 //   * A midpoint belongs to exactly one side (it is never a corner). Per side, the side's
@@ -21,7 +23,7 @@
 // follows, release() retires the nodes that left the list.
 //
 // Invariants (check_invariants): walking the list from head gives exactly the inputs and
-// their side midpoints less the near corner, each once, strictly in insertion_less order;
+// their side midpoints less the box's corners, each once, strictly in insertion_less order;
 // the counts equal a from-scratch count; every node in the map is in the list.
 // Complexity: plan + commit O(k (lg n + path)) for k edits off the sides (a path has O(lg
 // L/s) midpoints); O(n) for a batch holding an input on a side.
@@ -154,7 +156,7 @@ class HpuInputs {
       auto it = list_.find(p);
       const auto in = input_after.find(p);
       const bool input = in != input_after.end() ? in->second : it != list_.end() && it->second.input;
-      const bool listed = (input || is_midpoint(p)) && p != box_.origin;
+      const bool listed = (input || is_midpoint(p)) && !is_corner(p);
       if (listed && it == list_.end()) link(e, p, input);
       else if (!listed && it != list_.end()) unlink(e, it);
       else if (it != list_.end()) it->second.input = input;
@@ -175,7 +177,7 @@ class HpuInputs {
     const auto fail = [](const std::string& what) { throw InvariantError("dynmesh: HpuInputs: " + what); };
     std::set<Point<2>> want(inputs.begin(), inputs.end());
     for (const Point<2>& m : side_midpoints(box_, inputs)) want.insert(m);
-    want.erase(box_.origin);
+    for (auto it = want.begin(); it != want.end();) it = is_corner(*it) ? want.erase(it) : std::next(it);
     std::vector<Point<2>> order(want.begin(), want.end());
     std::sort(order.begin(), order.end(), InsertionOrder{box_});
     std::size_t i = 0;
@@ -236,6 +238,11 @@ class HpuInputs {
     halving_path(a, b, p, f.u, out);
   }
 
+  /// A box corner (SaDelaunay::init_box's arithmetic): the box's own vertex already.
+  bool is_corner(const Point<2>& p) const noexcept {
+    const double x1 = box_.origin[0] + box_.side, y1 = box_.origin[1] + box_.side;
+    return (p[0] == box_.origin[0] || p[0] == x1) && (p[1] == box_.origin[1] || p[1] == y1);
+  }
   bool is_input(const Point<2>& p) const {
     const auto it = list_.find(p);
     return it != list_.end() && it->second.input;

@@ -144,8 +144,7 @@ struct HpuStart {
 };
 
 /// The program. Preconditions (the mutator's): the list's points are distinct, in the box,
-/// none a box corner (an input at the near corner is the box's vertex already: leave it
-/// out). Run with e.run([&](sac::Engine& r) { HpuProgram::main(r, &program); });
+/// none a box corner (an input at a corner is the box's vertex already: leave it out). Run with e.run([&](sac::Engine& r) { HpuProgram::main(r, &program); });
 /// the mutator keeps `input` equal to the inputs and their side midpoints in
 /// insertion_less order (HpuInputs, relinking with Engine::set) and calls propagate().
 struct HpuProgram {

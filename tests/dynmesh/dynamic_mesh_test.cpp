@@ -275,6 +275,34 @@ TEST(DynamicMeshHpu, DefaultIsHpuAtTheSeedsBound) {
   EXPECT_TRUE(agrees(dyn, {}));
 }
 
+TEST(DynamicMeshHpu, InputsAtTheBoxCornersAreItsOwnVertices) {
+  // Found by fuzz_dynamic_mesh: where fl(o + L) rounds below o + L, the box admits inputs
+  // on its far sides, corners included, which the input list must leave out like the near
+  // corner (they are the box's vertices already). Here x1 = fl(o1 + 3) < o1 + 3.
+  const Box<2> box{{1.2250000000000001, -0.44999999999999996}, 3.0};
+  const double x1 = box.origin[0] + box.side;
+  ASSERT_LT(x1 - box.origin[0], box.side);
+  const std::vector<Point<2>> corners = {{x1, box.origin[1]}, box.origin};
+  for (const double angle : {kHpuDefaultMinAngle, 30.0}) {
+    std::vector<Point<2>> pts = {{2.7250000000000001, 1.05}, {4.0374999999999996, 0.48750000000000004}};
+    DynamicMesh dyn(box, pts, hpu(angle));
+    ASSERT_TRUE(agrees(dyn, pts));
+    for (const Point<2>& c : corners) {
+      SCOPED_TRACE("corner " + to_string(c));
+      dyn.insert(c);
+      pts.push_back(c);
+      ASSERT_TRUE(agrees(dyn, pts));
+    }
+    for (const Point<2>& c : corners) {
+      dyn.erase(c);
+      pts.erase(std::find(pts.begin(), pts.end(), c));
+      ASSERT_TRUE(agrees(dyn, pts));
+    }
+    DynamicMesh both(box, corners, hpu(angle));
+    EXPECT_TRUE(agrees(both, corners));
+  }
+}
+
 constexpr double kAngles[] = {kHpuDefaultMinAngle, 25.0, 30.0};
 
 TEST(DynamicMeshHpuDifferential, Uniform) {
