@@ -6,7 +6,7 @@
 // classes, Morton codes, the leaf and apex heights) and the loose test live here once, as
 // functions of points only (no triangulation, no vertex ids).
 // Invariants: each function is one fixed sequence of double operations on its arguments;
-// where the result must not depend on the argument order (side_midpoint, circumradius2) it
+// where the result must not depend on the argument order (side_midpoint, circumradius_above) it
 // first puts the arguments in (x, y) order.
 // Complexity: O(1) each; side_midpoints O(n log n + n·halvings).
 // Paper: Üngör, "Off-centers" (2004); Acar & Hudson, Figure 5 (DynHPU); Ruppert (1995) and
@@ -82,8 +82,6 @@ inline int edge_class(const Point<2>& a, const Point<2>& b) noexcept {
   const double sx = std::ldexp(dx, -e), sy = std::ldexp(dy, -e);
   return e + (std::ilogb(sx * sx + sy * sy) >> 1);
 }
-/// 4^(j+1): the squared circumradius above which a vertex of class j stays queued.
-inline double continuation_radius2(int j) noexcept { return std::ldexp(1.0, 2 * (std::clamp(j, -1100, 1100) + 1)); }
 
 /// The Morton code of p on the box's 2^32 grid (clamped): the initial queue order.
 inline std::uint64_t morton_of(const Box<2>& box, const Point<2>& p) noexcept {
@@ -195,18 +193,27 @@ inline std::vector<Point<2>> side_midpoints(const Box<2>& box, std::span<const P
   return out;
 }
 
-/// The squared circumradius of a, b, c in one fixed sequence of double operations, from
-/// the corner that is smallest in (x, y) order, so that any reader of the same triangle
-/// gets the same bits.
-inline double circumradius2(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept {
+/// Is the circumradius of a, b, c above 2^(j+1) (the continuation rule of class j)? In one
+/// fixed sequence of double operations from the corner that is smallest in (x, y) order, so
+/// that any reader of the same triangle gets the same answer, and in a frame scaled by a
+/// power of two (exact) so that the squares neither overflow in a huge box nor underflow in
+/// a tiny one: the same decisions as the unscaled formula wherever that one is finite. A
+/// degenerate (flat) triangle counts as above.
+inline bool circumradius_above(const Point<2>& a, const Point<2>& b, const Point<2>& c, int j) noexcept {
   const Point<2>*P = &a, *Q = &b, *R = &c;
   if (xy_less(*Q, *P) && xy_less(*Q, *R)) std::tie(P, Q, R) = std::tuple{Q, R, P};
   else if (xy_less(*R, *P) && xy_less(*R, *Q)) std::tie(P, Q, R) = std::tuple{R, P, Q};
-  const double bx = (*Q)[0] - (*P)[0], by = (*Q)[1] - (*P)[1], cx = (*R)[0] - (*P)[0], cy = (*R)[1] - (*P)[1];
+  double bx = (*Q)[0] - (*P)[0], by = (*Q)[1] - (*P)[1], cx = (*R)[0] - (*P)[0], cy = (*R)[1] - (*P)[1];
+  const double m = std::max({std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)});
+  if (!(m > 0)) return true;
+  const int e = std::ilogb(m);
+  bx = std::ldexp(bx, -e), by = std::ldexp(by, -e), cx = std::ldexp(cx, -e), cy = std::ldexp(cy, -e);
   const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
   const double d = 2.0 * (bx * cy - by * cx);
   const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
-  return ux * ux + uy * uy;
+  // R² > 4^(j+1)  ⇔  (R·2^-e)² > 2^(2(j+1) − 2e); the exponent is clamped (ldexp saturates).
+  const long k = std::clamp(2L * (static_cast<long>(j) + 1 - e), -4000L, 4000L);
+  return ux * ux + uy * uy > std::ldexp(1.0, static_cast<int>(k));
 }
 
 /// p→q is ccw-loose: its ccw-leaf (height `leaf`) holds no vertex. t is the third corner of

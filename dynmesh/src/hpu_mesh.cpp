@@ -131,8 +131,8 @@ class Refiner {
     bool birth;
   };
 
-  double circumradius2(Vid a, Vid b, Vid c) const noexcept {
-    return detail::circumradius2(dt_.point(a), dt_.point(b), dt_.point(c));
+  bool circumradius_above(Vid a, Vid b, Vid c, int j) const noexcept {
+    return detail::circumradius_above(dt_.point(a), dt_.point(b), dt_.point(c), j);
   }
 
   /// p→q is ccw-loose: its ccw-leaf holds no vertex. t is the third corner of the triangle on
@@ -153,12 +153,11 @@ class Refiner {
     const bool cycle = !on_boundary(v);
     const std::size_t d = star_.size();
     bool go_on = false;
-    const double big = detail::continuation_radius2(j);
     local_.clear();
     for (std::size_t i = 0; i < d; ++i) {
       const Vid q = star_[i];
       const int c = edge_class(v, q);
-      if (i + 1 < d || cycle) go_on = go_on || circumradius2(v, q, star_[(i + 1) % d]) > big;
+      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(v, q, star_[(i + 1) % d], j);
       if (c > j) go_on = true;
       if (birth ? c > j : c != j) continue;
       const Vid left = i + 1 < d ? star_[i + 1] : cycle ? star_[0] : kNone;

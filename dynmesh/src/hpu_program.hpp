@@ -308,12 +308,11 @@ struct HpuProgram {
       const int j = cs->j;
       const std::size_t d = star.size();
       bool go_on = false;
-      const double big = continuation_radius2(j);
       std::vector<std::pair<SaVertex*, SaVertex*>> local;
       for (std::size_t i = 0; i < d; ++i) {
         SaVertex* q = star[i];
         const int c = edge_class(v->p, q->p);
-        if (i + 1 < d || cycle) go_on = go_on || circumradius2(v->p, q->p, star[(i + 1) % d]->p) > big;
+        if (i + 1 < d || cycle) go_on = go_on || circumradius_above(v->p, q->p, star[(i + 1) % d]->p, j);
         if (c > j) go_on = true;
         if (ent->birth ? c > j : c != j) continue;
         const SaVertex* left = i + 1 < d ? star[i + 1] : cycle ? star[0] : nullptr;

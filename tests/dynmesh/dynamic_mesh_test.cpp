@@ -215,10 +215,16 @@ TEST(DynamicMesh, ExtremeBoxSidesAreMeshed) {
     const double o0 = box.origin[0], o1 = box.origin[1], side = box.side;
     const std::vector<Point<2>> pts = {
         {o0 + side * 0.3, o1 + side * 0.45}, {o0 + side * 0.7, o1 + side * 0.6}, {o0 + side * 0.5, o1 + side * 0.5000001}};
-    DynamicMesh dyn(box, pts, kQuadtree);
-    EXPECT_TRUE(agrees(dyn, pts));
-    dyn.erase(pts[1]);
-    EXPECT_TRUE(agrees(dyn, std::vector<Point<2>>{pts[0], pts[2]}));
+    // The hpu mesh too: its edge classes and continuation rule are computed in a scaled
+    // frame, so that squared lengths neither overflow nor underflow.
+    for (const MeshOptions& o : {kQuadtree, hpu(kHpuDefaultMinAngle), hpu(30)}) {
+      DynamicMesh dyn(box, pts, o);
+      EXPECT_TRUE(agrees(dyn, pts));
+      dyn.erase(pts[1]);
+      EXPECT_TRUE(agrees(dyn, std::vector<Point<2>>{pts[0], pts[2]}));
+      dyn.insert(pts[1]);
+      EXPECT_TRUE(agrees(dyn, pts));
+    }
   }
 }
 

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -372,6 +373,29 @@ TEST(HpuProgram, SideEdgeAtFollowsTheTwinsUpperBoundRule) {
     auto got = outs[i].get();
     if (xy_less(got.second, got.first)) std::swap(got.first, got.second);
     EXPECT_EQ(got, queries[i].want) << "side " << queries[i].side << " at " << to_string(queries[i].x);
+  }
+}
+
+}  // namespace
+
+namespace {
+
+/// The continuation rule decides the same at every scale: its squares are computed in a
+/// frame scaled by a power of two, so they neither overflow (a box side of 2^600, where the
+/// unscaled squares were infinite and their difference NaN) nor underflow.
+TEST(HpuGeometry, CircumradiusRuleIsScaleFree) {
+  const Point<2> a{0.0, 0.0}, b{3.0, 0.25}, c{1.0, 2.5};
+  for (const int s : {0, 600, -600, 1000, -1000}) {
+    SCOPED_TRACE("scale 2^" + std::to_string(s));
+    const auto at = [s](const Point<2>& p) { return Point<2>{std::ldexp(p[0], s), std::ldexp(p[1], s)}; };
+    for (int j = -3; j <= 3; ++j)
+      EXPECT_EQ(detail::circumradius_above(at(a), at(b), at(c), j + s), detail::circumradius_above(a, b, c, j))
+          << "class " << j;
+    // The circumradius here is about 1.6: above 2^0 and below 2^1.
+    EXPECT_TRUE(detail::circumradius_above(at(a), at(b), at(c), s - 1));
+    EXPECT_FALSE(detail::circumradius_above(at(a), at(b), at(c), s));
+    // Flat triangles count as above.
+    EXPECT_TRUE(detail::circumradius_above(at(a), at(b), at(Point<2>{6.0, 0.5}), s + 5));
   }
 }
 
