@@ -48,7 +48,12 @@
 // never insertion order or addresses, so the mesh is a function of (box, point set, θ); the
 // tests shuffle and reverse the input and compare bits. The triangulation only answers the
 // questions quickly (stars, neighbours, cavities): the self-adjusting version answers the
-// same questions from the quadtree's cells and must reach the same mesh.
+// same questions from its own self-adjusting triangulation, not from the quadtree's cells
+// as the seed's Figure 5 does (line 12's cell for an off-center, "active" points), and must
+// reach the same mesh. That choice keeps one algorithm and one oracle; its cost is that the
+// work near an update is bounded by the triangulation's locality rather than by cells
+// (docs/EXPERIMENTS.md: flat in n on uniform, clustered and shrinking inputs, growing on a
+// spiral).
 //
 // The self-adjusting version: DynamicMesh with Postprocess::Hpu (dynamic_mesh.hpp) runs
 // this algorithm on the runtime (src/hpu_program.hpp, on the self-adjusting triangulation of
