@@ -254,6 +254,8 @@ class SaTriRegistry {
   void clear_change() noexcept { events_.clear(); }
   /// Call before the engine is destroyed: its records' destructors then log nothing.
   void close() noexcept { closing_ = true; }
+  /// For the checker's negative test only: one live triangle too many.
+  void corrupt_live_count_for_testing() noexcept { ++live_; }
 
   /// Throws InvariantError naming the first broken rule (see the header). Mutator only. O(t).
   void check_invariants(const Box<2>& box) const {

@@ -88,6 +88,8 @@ class HpuHarness {
     inputs_.check_invariants(now);
   }
   const sac::Stats& stats() const { return engine_.stats(); }
+  /// For the checker's negative test: the feed counts one live triangle too many.
+  void corrupt_live_count() { registry_.corrupt_live_count_for_testing(); }
 
  private:
   void set_list(const std::vector<Point<2>>& pts) {
@@ -397,6 +399,53 @@ TEST(HpuGeometry, CircumradiusRuleIsScaleFree) {
     // Flat triangles count as above.
     EXPECT_TRUE(detail::circumradius_above(at(a), at(b), at(Point<2>{6.0, 0.5}), s + 5));
   }
+}
+
+}  // namespace
+
+namespace {
+
+/// HpuInputs' checker fails on a list that lost a point, that holds one too many, or whose
+/// order is broken, and passes on the list it keeps (the negative test of its checker).
+TEST(HpuInputs, CheckerCatchesABrokenList) {
+  const Box<2> box{{0, 0}, 1};
+  // Points near the bottom side, so that the list holds side midpoints too.
+  const std::vector<Point<2>> pts = {{0.3, 0.01}, {0.7, 0.4}, {0.55, 0.8}, {0.2, 0.6}};
+  sac::Engine engine;
+  detail::HpuInputs inputs(box);
+  std::vector<Edit<2>> edits;
+  for (const Point<2>& p : pts) edits.push_back({EditOp::Insert, p});
+  inputs.commit(engine, inputs.plan(edits));
+  ASSERT_NO_THROW(inputs.check_invariants(pts));
+  EXPECT_GT(inputs.size(), pts.size()) << "the bottom side's midpoints are listed";
+  // A point the list does not hold, and one it holds that is not an input.
+  std::vector<Point<2>> more = pts;
+  more.push_back({0.9, 0.9});
+  EXPECT_THROW(inputs.check_invariants(more), InvariantError);
+  EXPECT_THROW(inputs.check_invariants(std::vector<Point<2>>(pts.begin(), pts.end() - 1)), InvariantError);
+  // The list cut after its first node, then two nodes swapped.
+  detail::SaInputNode* first = inputs.head().get();
+  detail::SaInputNode* second = first->next.get();
+  detail::SaInputNode* third = second->next.get();
+  engine.set(first->next, static_cast<detail::SaInputNode*>(nullptr));
+  EXPECT_THROW(inputs.check_invariants(pts), InvariantError);
+  engine.set(inputs.head(), second);
+  engine.set(second->next, first);
+  engine.set(first->next, third);
+  EXPECT_THROW(inputs.check_invariants(pts), InvariantError);
+  engine.set(inputs.head(), first);
+  engine.set(first->next, second);
+  engine.set(second->next, third);
+  EXPECT_NO_THROW(inputs.check_invariants(pts));
+}
+
+/// SaTriRegistry's checker catches a feed whose live count disagrees with the triangles.
+TEST(SaTriRegistry, CheckerCatchesAWrongLiveCount) {
+  const Box<2> box{{0, 0}, 1};
+  HpuHarness h(box, {{0.25, 0.5}, {0.75, 0.5}, {0.5, 0.25}}, kHpuDefaultMinAngle);
+  ASSERT_NO_THROW(h.check());
+  h.corrupt_live_count();
+  EXPECT_THROW(h.check(), InvariantError);
 }
 
 }  // namespace
