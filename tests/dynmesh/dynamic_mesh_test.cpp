@@ -359,3 +359,49 @@ TEST(DynamicMeshHpuDifferential, OnAndNearTheBoxSides) {
 }
 
 }  // namespace
+
+namespace {
+
+/// Mean trace distance of `updates` alternating deletions and insertions (fixed seeds) on
+/// n uniform points, hpu at 20.7 degrees. Deterministic: it counts trace events.
+double mean_hpu_distance(std::size_t n, std::size_t updates, std::uint64_t seed) {
+  const auto pool = generate<2>(Distribution::Uniform, n + updates, seed);
+  const std::vector<Point<2>> start(pool.begin(), pool.begin() + static_cast<std::ptrdiff_t>(n));
+  DynamicMesh dyn(derive_box<2>(start), start, hpu(kHpuDefaultMinAngle));
+  Rng rng(seed + 99);
+  std::vector<PointId> ids;
+  for (const auto& [id, p] : dyn.points()) ids.push_back(id);
+  double sum = 0;
+  std::size_t next = n, done = 0;
+  for (std::size_t u = 0; u < updates; ++u) {
+    if (u % 2 == 0) {
+      const std::size_t k = rng.below(ids.size());
+      dyn.erase(ids[k]);
+      ids[k] = ids.back();
+      ids.pop_back();
+    } else {
+      try {
+        ids.push_back(dyn.insert(pool[next++]));
+      } catch (const InputError&) {
+        continue;
+      }
+    }
+    sum += static_cast<double>(dyn.last_update().trace_distance);
+    ++done;
+  }
+  return sum / static_cast<double>(done);
+}
+
+/// What re-ran, not only the result: an update's trace distance does not grow with n (the
+/// issue's bound: at most 1.5 times between sizes, here 8x apart).
+TEST(DynamicMeshHpu, TraceDistanceDoesNotGrowWithN) {
+  const std::size_t small = kSlowBuild ? 150 : 500, large = kSlowBuild ? 1200 : 4000;
+  const std::size_t updates = kSlowBuild ? 20 : 80;
+  const double a = mean_hpu_distance(small, updates, 51), b = mean_hpu_distance(large, updates, 51);
+  std::printf("[ DynamicMeshHpu ] mean trace distance per update: %.0f at n = %zu, %.0f at n = %zu\n", a, small, b,
+              large);
+  EXPECT_LE(b, 1.5 * a);
+  EXPECT_GT(b, 0.0);
+}
+
+}  // namespace
