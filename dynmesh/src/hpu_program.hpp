@@ -138,14 +138,13 @@ struct HpuStart {
   HpuStart() = default;
   HpuStart(const HpuStart&) = delete;
   HpuStart& operator=(const HpuStart&) = delete;
-  std::array<SaVertex*, 4> corners{};  // in (Morton, xy) order
-  sac::Mod<HpuCell*> cells;            // the initial vertices, in order
-  sac::Mod<int> min_class;             // the smallest initial class
+  sac::Mod<HpuCell*> cells;  // the initial vertices, in order
+  sac::Mod<int> min_class;   // the smallest initial class
 };
 
 /// The program. Preconditions (the mutator's): the list's points are distinct, in the box,
-/// none a box corner (an input at a corner is the box's vertex already: leave it out). Run with e.run([&](sac::Engine& r) { HpuProgram::main(r, &program); });
-/// the mutator keeps `input` equal to the inputs and their side midpoints in
+/// none a box corner (an input at a corner is the box's vertex already: leave it out).
+/// Run with e.run([&](sac::Engine& r) { HpuProgram::main(r, &program); }); the mutator keeps `input` equal to the inputs and their side midpoints in
 /// insertion_less order (HpuInputs, relinking with Engine::set) and calls propagate().
 struct HpuProgram {
   SaDelaunay* dt;
@@ -158,17 +157,6 @@ struct HpuProgram {
       : dt(d), input(in), leaf(leaf_height(min_angle_deg)), apex(apex_height(min_angle_deg)) {}
 
   const Box<2>& box() const noexcept { return dt->box; }
-  bool on_boundary(const Point<2>& p) const noexcept {
-    const Box<2>& b = dt->box;
-    return p[0] == b.origin[0] || p[1] == b.origin[1] || p[0] == b.origin[0] + b.side ||
-           p[1] == b.origin[1] + b.side;
-  }
-
-  /// v's star (SaDelaunay::read_star): k(Engine&, ring, tris, interior).
-  template <class K>
-  static void read_fan(sac::Engine& e, SaVertex* v, const K& k) {
-    SaDelaunay::read_star(e, v, k);
-  }
 
   // ---------------------------------------------------------------- 1. insertion
 
@@ -178,7 +166,6 @@ struct HpuProgram {
     std::array<SaVertex*, 4> order = c;
     std::sort(order.begin(), order.end(),
               [pg](const SaVertex* a, const SaVertex* b) { return morton_less(pg->box(), a->p, b->p); });
-    pg->start->corners = order;  // main never re-runs: a plain field is enough
     // The initial vertices: the corners in (Morton, xy) order, then the list's.
     sac::Mod<HpuCell*>* dest = &pg->start->cells;
     for (SaVertex* v : order) dest = append_cell(e, v, dest);
@@ -219,7 +206,7 @@ struct HpuProgram {
 
   static void class_step(sac::Engine& e, HpuCell* cell, HpuProgram* pg, int mn) {
     if (!cell) return e.write(pg->start->min_class, mn);
-    read_fan(e, cell->v, ClassK{pg, cell, mn});
+    SaDelaunay::read_star(e, cell->v, ClassK{pg, cell, mn});
   }
 
   // ---------------------------------------------------------------- 3. classes and rounds
@@ -354,7 +341,7 @@ struct HpuProgram {
                            sac::Mod<HpuEntry*>* cdest, HpuEntry* owner, HpuEntry* owner_pred) {
     (void)owner_pred;
     if (!ent) return e.write(rs->cont_tail, cdest);
-    read_fan(e, ent->v, CollectK{pg, cs, rs, ent, owner, cdest});
+    SaDelaunay::read_star(e, ent->v, CollectK{pg, cs, rs, ent, owner, cdest});
   }
 
   // ---------------------------------------------------------------- process
@@ -412,7 +399,7 @@ struct HpuProgram {
   }
 
   /// One try of the twin's process(p, q, j) loop.
-  static void try_pair(sac::Engine& e, const Ctx& c) { read_fan(e, c.pc->p, TryK{c}); }
+  static void try_pair(sac::Engine& e, const Ctx& c) { SaDelaunay::read_star(e, c.pc->p, TryK{c}); }
 
   struct TryK {
     Ctx c;
@@ -546,7 +533,7 @@ struct HpuProgram {
         if (lo < x[along] && x[along] < hi) return k(e, ed->lo, ed->hi);
       }
       for (SaVertex* v : t->v)
-        if (v->p == x) return read_fan(e, v, PickK<K>{side, v, k});
+        if (v->p == x) return SaDelaunay::read_star(e, v, PickK<K>{side, v, k});
       throw InvariantError("dynmesh: HpuProgram: the side crossing is on no box edge of its triangle");
     }
   };

@@ -34,6 +34,7 @@
 #include "hpu_inputs.hpp"
 #include "sa_delaunay.hpp"
 #include "../sanitized.hpp"
+#include "same_triangles.hpp"
 
 namespace {
 
@@ -42,23 +43,7 @@ using detail::HpuProgram;
 using detail::SaInputNode;
 using test_support::kSanitized;
 
-std::string tri_string(const Triangle& t) {
-  return to_string(t.v[0]) + " " + to_string(t.v[1]) + " " + to_string(t.v[2]);
-}
-
-/// Equal triangle lists, or the counts and the first few differences.
-testing::AssertionResult same_triangles(const std::vector<Triangle>& got, const std::vector<Triangle>& want) {
-  if (got == want) return testing::AssertionSuccess();
-  std::vector<Triangle> extra, missing;
-  std::set_difference(got.begin(), got.end(), want.begin(), want.end(), std::back_inserter(extra));
-  std::set_difference(want.begin(), want.end(), got.begin(), got.end(), std::back_inserter(missing));
-  auto r = testing::AssertionFailure() << got.size() << " triangles, the static twin has " << want.size() << "; "
-                                       << extra.size() << " extra, " << missing.size() << " missing";
-  for (std::size_t i = 0; i < std::min<std::size_t>(3, extra.size()); ++i) r << "\n  extra   " << tri_string(extra[i]);
-  for (std::size_t i = 0; i < std::min<std::size_t>(3, missing.size()); ++i)
-    r << "\n  missing " << tri_string(missing[i]);
-  return r;
-}
+using dynmesh_test::same_triangles;
 
 /// The program on the mutator's input list (HpuInputs: the inputs and their side
 /// midpoints in insertion order). set_points() turns the new point set into edits, relinks

@@ -26,6 +26,7 @@
 
 #include "delaunay.hpp"
 #include "dynamic_test_support.hpp"
+#include "same_triangles.hpp"
 #include "dynmesh/box.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
@@ -54,23 +55,7 @@ std::vector<Triangle> static_triangles(const Box<2>& box, std::span<const Point<
   return dt.triangles();
 }
 
-std::string tri_string(const Triangle& t) {
-  return to_string(t.v[0]) + " " + to_string(t.v[1]) + " " + to_string(t.v[2]);
-}
-
-/// Equal triangle lists, or the counts and the first few differences.
-testing::AssertionResult same_triangles(const std::vector<Triangle>& got, const std::vector<Triangle>& want) {
-  if (got == want) return testing::AssertionSuccess();
-  std::vector<Triangle> extra, missing;
-  std::set_difference(got.begin(), got.end(), want.begin(), want.end(), std::back_inserter(extra));
-  std::set_difference(want.begin(), want.end(), got.begin(), got.end(), std::back_inserter(missing));
-  auto r = testing::AssertionFailure() << got.size() << " triangles, the static twin has " << want.size() << "; "
-                                       << extra.size() << " extra, " << missing.size() << " missing";
-  for (std::size_t i = 0; i < std::min<std::size_t>(3, extra.size()); ++i) r << "\n  extra   " << tri_string(extra[i]);
-  for (std::size_t i = 0; i < std::min<std::size_t>(3, missing.size()); ++i)
-    r << "\n  missing " << tri_string(missing[i]);
-  return r;
-}
+using dynmesh_test::same_triangles;
 
 /// The static twin's star of each centre, as points (Delaunay::star's order).
 std::vector<std::vector<Point<2>>> static_stars(const Box<2>& box, std::span<const Point<2>> pts,
