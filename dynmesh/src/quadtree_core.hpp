@@ -95,8 +95,10 @@ class Directory {
     if (!fresh) return **v;
     Slot<d>* s = pool_.create(c);
     *v = s;
-    rt.init(s->split, std::uint8_t{0});
-    rt.init(s->pts, static_cast<PNode<d>*>(nullptr));
+    // Defaults, not base versions: most slots are written before anything reads them
+    // (82% of the 2D defaults at n = 10^5 were never read).
+    rt.init_default(s->split);
+    rt.init_default(s->pts);
     return *s;
   }
   const Slot<d>* find(const CellId<d>& c) const {

@@ -153,9 +153,24 @@ void Engine::poison() noexcept {
 // ------------------------------------------------------------------ versions
 
 VersionBase* Engine::visible(const ModBase& m, const Stamp* t) const {
-  VersionBase* v = m.newest_;
+  VersionBase* v = m.newest();
   while (v && !(v->is_base() || order_.less(&v->stamp, t))) v = v->older();
   return v;
+}
+
+VersionBase* Engine::visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops) {
+  if (VersionBase* v = visible(m, t)) return v;
+  const VersionBase* newest = m.newest();
+  const bool defaulted = m.default_only() || (newest && (newest->oldest()->link & VersionBase::kDefaulted));
+  return default_base(const_cast<ModBase&>(m), defaulted, ops);
+}
+
+VersionBase* Engine::default_base(ModBase& m, bool defaulted, const detail::VersionOps* ops) {
+  if (!defaulted || !ops->make_default) return nullptr;
+  // What init(m, T{}) would have made before the first run.
+  VersionBase* base = ops->make_default(allocate(ops->size));
+  set_base(m, base, nullptr);
+  return base;
 }
 
 void Engine::link_write(ModBase& m, VersionBase* v) {
@@ -164,16 +179,16 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
   ++stats_.events_created;
   ++stats_.live_events;
   VersionBase* newer = nullptr;
-  VersionBase* older = m.newest_;
+  VersionBase* older = m.newest();
   while (older && !(older->is_base() || order_.less(&older->stamp, &v->stamp))) {
     newer = older;
     older = older->older();
   }
   if (older) v->set_older(older);
-  else v->set_oldest_of(&m);
+  else v->link = newer ? newer->link : end_link(m, m.default_only());  // v is the oldest now
   v->readers = nullptr;
   if (newer) newer->set_older(v);
-  else m.newest_ = v;
+  else m.set_newest(v);
   // Readers of the older version that come after v now see v. When v is the last stamp of
   // the whole trace (every from-scratch write) none can.
   if (older && older->readers && v->stamp.next() != nullptr) {
@@ -193,7 +208,7 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
 void Engine::set_base(ModBase& m, VersionBase* fresh,
                       bool (*assign_if_changed)(VersionBase*, VersionBase*)) {
   VersionBase* last = nullptr;
-  for (VersionBase* v = m.newest_; v; v = v->older()) last = v;
+  for (VersionBase* v = m.newest(); v; v = v->older()) last = v;
   if (VersionBase* base = last && last->is_base() ? last : nullptr) {
     const bool changed = assign_if_changed(base, fresh);
     destroy(fresh);
@@ -205,23 +220,26 @@ void Engine::set_base(ModBase& m, VersionBase* fresh,
   // (such a read would have failed), and no reader is affected.
   fresh->stamp.link = static_cast<std::uintptr_t>(StampKind::Sentinel);
   fresh->stamp.label = static_cast<std::uint32_t>(bases_.size());
-  fresh->set_oldest_of(&m);
+  fresh->link = last ? last->link : end_link(m, m.default_only());
   fresh->readers = nullptr;
   bases_.push_back(fresh);
   input_bytes_ += (fresh->ops->size + 7) & ~std::size_t{7};
   if (last) last->set_older(fresh);
-  else m.newest_ = fresh;
+  else m.set_newest(fresh);
 }
 
 bool Engine::unused(const ModBase& m) const noexcept {
-  const VersionBase* v = m.newest_;
+  const VersionBase* v = m.newest();
   return !v || (v->is_base() && !v->older() && !v->readers);
 }
 
 void Engine::retire(ModBase& m) {
   require_mutator("retire");
-  VersionBase* v = m.newest_;
-  if (!v) return;
+  VersionBase* v = m.newest();
+  if (!v) {
+    m.head_ = 0;  // no version; a default, if any, goes too
+    return;
+  }
   if (!v->is_base() || v->older())
     throw UsageError("sac::Engine::retire: the modifiable has versions written by the computation");
   if (v->readers) throw UsageError("sac::Engine::retire: the modifiable is still read");
@@ -229,7 +247,7 @@ void Engine::retire(ModBase& m) {
   bases_[i] = bases_.back();
   bases_[i]->stamp.label = i;
   bases_.pop_back();
-  m.newest_ = nullptr;
+  m.head_ = 0;
   input_bytes_ -= (v->ops->size + 7) & ~std::size_t{7};
   destroy(v);
 }
@@ -263,7 +281,7 @@ void Engine::exec_read(ReadNode* r) {
   now_ = &r->start;
   ++stats_.events_created;
   ++stats_.live_events;
-  VersionBase* v = visible(*r->mod, &r->start);
+  VersionBase* v = visible_or_default(*r->mod, &r->start, r->ops->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
   attach(r, v);
   push_close(&r->end, TaskKind::CloseRead, r);
@@ -356,7 +374,7 @@ void Engine::execute(const Task& t) {
       ++stats_.reads_reexecuted;
       ++stats_.last_reexecuted;
       detach(r);
-      VersionBase* v = visible(*r->mod, &r->start);
+      VersionBase* v = visible_or_default(*r->mod, &r->start, r->ops->value);
       if (!v)
         throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
       attach(r, v);
@@ -472,7 +490,7 @@ ReadNode* Engine::find_read_match(const ModBase& m, const detail::ReadOps* ops,
                                   const void* closure) const {
   return earliest_match<ReadNode>(
       [&](auto&& offer) {
-        for (VersionBase* v = m.newest_; v; v = v->older())
+        for (VersionBase* v = m.newest(); v; v = v->older())
           for (ReadNode* r = v->readers; r; r = r->rnext) offer(r);
       },
       [&](const ReadNode* r) { return r->ops == ops && ops->equal(r, closure); });
@@ -563,7 +581,12 @@ void Engine::undo(Stamp* s) {
       ++stats_.events_undone;
       --stats_.live_events;
       VersionBase* older = v->older();
+      ModBase* m = older ? nullptr : v->mod();
+      const bool defaulted = !older && (v->link & VersionBase::kDefaulted);
       unlink_version(v);
+      // Its readers see the default now: make it the base version, so that they attach to
+      // it and are cut off when v held the default value too.
+      if (v->readers && defaulted) older = default_base(*m, true, v->ops);
       if (v->readers) {
         const bool same = older && v->ops->equal(v, older);
         for (ReadNode* r = v->readers; r;) {
@@ -594,11 +617,12 @@ void Engine::undo(Stamp* s) {
 
 void Engine::unlink_version(VersionBase* v) {
   ModBase* m = v->mod();
-  if (m->newest_ == v) {
-    m->newest_ = v->older();
+  if (m->newest() == v) {
+    if (VersionBase* o = v->older()) m->set_newest(o);
+    else m->head_ = (v->link & VersionBase::kDefaulted) ? ModBase::kDefaultOnly : 0;  // it was the only one
     return;
   }
-  VersionBase* newer = m->newest_;
+  VersionBase* newer = m->newest();
   while (newer->older() != v) newer = newer->older();
   newer->link = v->link;
 }
@@ -738,7 +762,7 @@ void Engine::check_invariants() const {
         ++events;
         mods.insert(v->mod());
         bool found = false;
-        for (const VersionBase* x = v->mod()->newest_; x; x = x->older())
+        for (const VersionBase* x = v->mod()->newest(); x; x = x->older())
           if (x == v) found = true;
         if (!found) fail("write not in its modifiable's version list");
       } else if constexpr (K == StampKind::Alloc) {
@@ -774,7 +798,7 @@ void Engine::check_invariants() const {
   mods.for_each([&](const void* mod) {
     const auto* m = static_cast<const ModBase*>(mod);
     const VersionBase* newer = nullptr;
-    for (const VersionBase* v = m->newest_; v; v = v->older()) {
+    for (const VersionBase* v = m->newest(); v; v = v->older()) {
       if (v->mod() != m) fail("version chain does not end at its modifiable");
       if (v->is_base()) {
         if (v->older()) fail("base version is not the oldest");

@@ -1328,7 +1328,13 @@ DynamicQuadtree<d> checker_tree() {
 /// The newest `split` value of a cell's slot, writable: a change the engine never sees.
 template <std::size_t d>
 std::uint8_t& split_value(detail::DynamicState<d>& s, const CellId<d>& c) {
-  return const_cast<std::uint8_t&>(s.dir.get(s.rt, c).split.get());
+  sac::Mod<std::uint8_t>& split = s.dir.get(s.rt, c).split;
+  // A default that nothing read has no version to corrupt: give it one, equal to it.
+  if (s.rt.unused(split)) {
+    s.rt.retire(split);
+    s.rt.init(split, std::uint8_t{0});
+  }
+  return const_cast<std::uint8_t&>(split.get());
 }
 
 /// The message of the dynmesh::InvariantError that check() throws, or "" if none.

@@ -89,6 +89,15 @@ class Engine {
   template <class T, class U>
   void init(Mod<T>& m, U&& value);
 
+  /// Gives a never-written m the default T{}: what a read sees when no version of m
+  /// precedes it. Costs nothing until such a read runs, which makes the base version then
+  /// (as init(m, T{}) would have), so modifiables named by the thousands outside the trace
+  /// and mostly written before they are read (a directory's cells) hold no memory for
+  /// their defaults. May be called inside the computation, like init(). UsageError if m is
+  /// already written.
+  template <class T>
+  void init_default(Mod<T>& m);
+
   /// True when nothing in the trace refers to m: it has no version written by the
   /// computation and no reader (it may then be retired).
   bool unused(const ModBase& m) const noexcept;
@@ -249,6 +258,17 @@ class Engine {
   void destroy_all() noexcept;
 
   detail::VersionBase* visible(const ModBase& m, const Stamp* t) const;
+  /// What a read of m at t sees: the visible version, else m's default made into its base
+  /// version (init_default), else null. `ops`: m's version type.
+  detail::VersionBase* visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops);
+  /// m's default made into its base version, if m has a default (init_default) and no base
+  /// version yet; else null. `defaulted`: whether m has a default.
+  detail::VersionBase* default_base(ModBase& m, bool defaulted, const detail::VersionOps* ops);
+  /// The oldest version's link for m: the modifiable, its end mark and its default flag.
+  static std::uintptr_t end_link(const ModBase& m, bool defaulted) {
+    return reinterpret_cast<std::uintptr_t>(&m) | detail::VersionBase::kEnd |
+           (defaulted ? detail::VersionBase::kDefaulted : 0);
+  }
   bool in_window(const Stamp* start, const Stamp* end) const {
     return order_.less(now_, start) && order_.less(end, window_end_);
   }
@@ -327,6 +347,13 @@ void Engine::init(Mod<T>& m, U&& value) {
   V* v = construct<V>(std::forward<U>(value));
   v->ops = &detail::VersionOpsFor<T>::ops;
   set_base(m, v, nullptr);  // no base yet, so nothing to compare with
+}
+
+template <class T>
+void Engine::init_default(Mod<T>& m) {
+  static_assert(std::is_default_constructible_v<T>, "init_default needs a default-constructible T");
+  if (m.written()) throw UsageError("sac::Engine::init_default: the modifiable is already written");
+  m.head_ = ModBase::kDefaultOnly;
 }
 
 template <class F>

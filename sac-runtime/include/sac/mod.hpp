@@ -3,13 +3,19 @@
 // Purpose: a Mod<T> is a versioned, multi-write cell. Each write inside the computation adds
 // a version at the writer's timestamp; a read sees the latest version before its own time.
 // The mutator gives a modifiable its base value with Engine::set() (a version that precedes
-// all computation time). A Mod is 8 bytes and may live anywhere: in mutator-owned structures
-// (inputs) or in objects allocated by the computation (Engine::alloc).
+// all computation time), or a default with Engine::init_default() (T{}, made into a base
+// version only when a read first sees it). A Mod is 8 bytes and may live anywhere: in
+// mutator-owned structures (inputs) or in objects allocated by the computation
+// (Engine::alloc).
 // Invariants: versions are kept newest first, strictly decreasing in time; a base version,
-// if any, is last. Only the engine that wrote a Mod may touch it.
+// if any, is last; the oldest version's link names the modifiable and says whether it has
+// a default. Only the engine that wrote a Mod may touch it.
 // Complexity: get() O(1); reads and writes at time t are O(number of versions after t).
 // Follows Acar, Ahmed, Blume, "Imperative self-adjusting computation" (POPL'08).
 #pragma once
+
+#include <cstdint>
+#include <type_traits>
 
 #include "sac/detail/trace_nodes.hpp"
 #include "sac/errors.hpp"
@@ -22,12 +28,21 @@ class ModBase {
   ModBase(const ModBase&) = delete;
   ModBase& operator=(const ModBase&) = delete;
 
-  /// True once the mutator or the computation has written it.
-  bool written() const { return newest_ != nullptr; }
+  /// True once the mutator or the computation has written it, or it has a default.
+  bool written() const { return head_ != 0; }
 
  protected:
   friend class Engine;
-  detail::VersionBase* newest_ = nullptr;
+  /// head_ when init_default() gave m a default and no version exists yet.
+  static constexpr std::uintptr_t kDefaultOnly = 2;
+  /// True when head_ is kDefaultOnly (the default is a version's flag once one exists).
+  bool default_only() const { return head_ == kDefaultOnly; }
+  /// The newest version, or null.
+  detail::VersionBase* newest() const {
+    return head_ == kDefaultOnly ? nullptr : reinterpret_cast<detail::VersionBase*>(head_);
+  }
+  void set_newest(detail::VersionBase* v) { head_ = reinterpret_cast<std::uintptr_t>(v); }
+  std::uintptr_t head_ = 0;  // the newest version, 0 or kDefaultOnly
 };
 
 template <class T>
@@ -38,8 +53,12 @@ class Mod : public ModBase {
   /// The newest value: the output after run()/propagate(). For the mutator only — inside
   /// the computation, read() it so the dependency is recorded.
   const T& get() const {
-    if (!newest_) throw UsageError("sac::Mod::get: the modifiable was never written");
-    return static_cast<const detail::Version<T>*>(newest_)->value;
+    if constexpr (std::is_default_constructible_v<T>) {
+      static const T kDefault{};
+      if (default_only()) return kDefault;
+    }
+    if (!head_) throw UsageError("sac::Mod::get: the modifiable was never written");
+    return static_cast<const detail::Version<T>*>(newest())->value;
   }
 };
 

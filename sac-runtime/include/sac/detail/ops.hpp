@@ -13,6 +13,7 @@
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
+#include <new>
 #include <type_traits>
 
 #include "sac/detail/order_list.hpp"
@@ -48,8 +49,22 @@ struct VersionOpsFor {
     else
       return false;  // no cut-off without operator==
   }
-  static constexpr VersionOps ops{&destroy, &equal, sizeof(Version<T>)};
+  static VersionBase* make_default(void* mem);
+  static constexpr VersionOps ops{&destroy, &equal,
+                                  std::is_default_constructible_v<T> ? &make_default : nullptr,
+                                  sizeof(Version<T>)};
 };
+
+template <class T>
+VersionBase* VersionOpsFor<T>::make_default(void* mem) {
+  if constexpr (std::is_default_constructible_v<T>) {
+    auto* v = new (mem) Version<T>();
+    v->ops = &ops;
+    return v;
+  } else {
+    return nullptr;
+  }
+}
 
 template <class T, class F>
 struct ReadOpsFor {
@@ -65,7 +80,7 @@ struct ReadOpsFor {
   }
   static constexpr ReadOps ops{&invoke, &destroy,
                                std::equality_comparable<F> ? &equal : nullptr,
-                               sizeof(ReadNodeT<F>)};
+                               &VersionOpsFor<T>::ops, sizeof(ReadNodeT<F>)};
 };
 
 /// A keyed allocation's ops table with the bytes of its key (and the padding before the

@@ -30,6 +30,10 @@ struct MemoNode;
 struct VersionOps {
   void (*destroy)(VersionBase*) noexcept;
   bool (*equal)(const VersionBase*, const VersionBase*);
+  /// Builds a Version<T> holding T{} (ops set) in `mem` of `size` bytes: the base version
+  /// of a modifiable with a default (Engine::init_default), made when a read first sees the
+  /// default. Null when T has no default constructor.
+  VersionBase* (*make_default)(void* mem);
   std::uint32_t size;
 };
 
@@ -39,22 +43,28 @@ struct VersionOps {
 struct VersionBase {
   Stamp stamp;
   const VersionOps* ops;
-  std::uintptr_t link;   // next older version, or (the modifiable | 1) after the oldest
+  // The next older version; after the oldest, the modifiable | kEnd (| kDefaulted when
+  // Engine::init_default() gave it a default).
+  std::uintptr_t link;
   ReadNode* readers;     // the reads that see this version
+
+  static constexpr std::uintptr_t kEnd = 1;
+  static constexpr std::uintptr_t kDefaulted = 2;
 
   bool is_base() const { return stamp.kind() == StampKind::Sentinel; }
   VersionBase* older() const {
-    return (link & 1) ? nullptr : reinterpret_cast<VersionBase*>(link);
+    return (link & kEnd) ? nullptr : reinterpret_cast<VersionBase*>(link);
   }
-  /// The owning modifiable, found at the end of the (short) chain of older versions; this
-  /// saves a pointer in every version.
-  ModBase* mod() const {
+  /// The oldest version of the chain this one is in (short: versions are few).
+  const VersionBase* oldest() const {
     const VersionBase* v = this;
-    while (!(v->link & 1)) v = reinterpret_cast<const VersionBase*>(v->link);
-    return reinterpret_cast<ModBase*>(v->link & ~std::uintptr_t{1});
+    while (!(v->link & kEnd)) v = reinterpret_cast<const VersionBase*>(v->link);
+    return v;
   }
+  /// The owning modifiable, found at the end of the chain of older versions; this saves a
+  /// pointer in every version.
+  ModBase* mod() const { return reinterpret_cast<ModBase*>(oldest()->link & ~(kEnd | kDefaulted)); }
   void set_older(VersionBase* o) { link = reinterpret_cast<std::uintptr_t>(o); }
-  void set_oldest_of(ModBase* m) { link = reinterpret_cast<std::uintptr_t>(m) | 1; }
 };
 
 template <class T>
@@ -68,6 +78,7 @@ struct ReadOps {
   void (*invoke)(Engine&, ReadNode*, const VersionBase*);
   void (*destroy)(ReadNode*) noexcept;
   bool (*equal)(const ReadNode*, const void* closure);  // null: not memoizable
+  const VersionOps* value;  // the ops of the versions it reads
   std::uint32_t size;
 };
 
