@@ -40,6 +40,7 @@
 #include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/edit.hpp"
 #include "dynmesh/errors.hpp"
+#include "cell_index.hpp"
 #include "quadtree_refine.hpp"
 
 namespace dynmesh::detail {
@@ -91,26 +92,20 @@ template <std::size_t d>
 class Directory {
  public:
   Slot<d>& get(sac::Engine& rt, const CellId<d>& c) {
-    auto [v, fresh] = table_.try_emplace(c, nullptr);
-    if (!fresh) return **v;
+    if (Slot<d>* s = table_.find(c)) return *s;
     Slot<d>* s = pool_.create(c);
-    *v = s;
+    table_.insert(s);
     // Defaults, not base versions: most slots are written before anything reads them
     // (82% of the 2D defaults at n = 10^5 were never read).
     rt.init_default(s->split);
     rt.init_default(s->pts);
     return *s;
   }
-  const Slot<d>* find(const CellId<d>& c) const {
-    Slot<d>* const* v = table_.find(c);
-    return v ? *v : nullptr;
-  }
+  const Slot<d>* find(const CellId<d>& c) const { return table_.find(c); }
   std::size_t size() const noexcept { return table_.size(); }
   std::size_t bytes() const noexcept { return pool_.bytes() + copies_.bytes() + table_bytes(); }
-  /// The hash table counted at its least capacity, two slots (8·d bytes of key and a
-  /// pointer) per entry; the true capacity is the power of two reached at the directory's
-  /// largest size, up to twice that.
-  std::size_t table_bytes() const noexcept { return table_.size() * 2 * (8 * d + sizeof(void*)); }
+  /// The index's slot array at its capacity (a pointer per slot).
+  std::size_t table_bytes() const noexcept { return table_.bytes(); }
   const StablePool<Slot<d>>& slot_pool() const noexcept { return pool_; }
   /// The points' list nodes below level 0 (see below()).
   const StablePool<PNode<d>>& node_pool() const noexcept { return copies_; }
@@ -144,26 +139,31 @@ class Directory {
   /// Releases every slot the trace no longer refers to. O(size).
   void sweep(sac::Engine& rt) {
     std::vector<Slot<d>*> dead;
-    table_.for_each([&](const CellId<d>&, Slot<d>* s) {
+    table_.for_each([&](Slot<d>* s) {
       if (rt.unused(s->split) && rt.unused(s->pts)) dead.push_back(s);
     });
     for (Slot<d>* s : dead) {
       rt.retire(s->split);
       rt.retire(s->pts);
-      table_.erase(s->id);
+      table_.erase(s->id());
       pool_.destroy(s);
     }
   }
   template <class F>
   void for_each(F&& f) const {
-    table_.for_each([&](const CellId<d>&, Slot<d>* s) { f(*s); });
+    table_.for_each([&](const Slot<d>* s) { f(*s); });
   }
 
   /// Throws InvariantError unless each slot is filed under its own cell and every child of
   /// a split cell has a slot with a written point list. O(size).
   void check_invariants(const sac::Engine& rt) const {
-    table_.for_each([&](const CellId<d>& c, const Slot<d>* s) {
-      if (!(s->id == c)) throw InvariantError("dynmesh: directory slot filed under another cell");
+    try {
+      table_.check_invariants();
+    } catch (const InvariantError& e) {
+      throw InvariantError(std::string(e.what()) + " (directory slot filed under another cell)");
+    }
+    table_.for_each([&](const Slot<d>* s) {
+      const CellId<d> c = s->id();
       if (!s->split.written() || !s->pts.written())
         throw InvariantError("dynmesh: directory slot " + to_string(c) + " without its default state");
       if (!tree_split(s->split.get())) return;
@@ -178,7 +178,7 @@ class Directory {
   }
 
  private:
-  CellTable<d, Slot<d>*> table_;
+  CellIndex<d, Slot<d>> table_;
   StablePool<Slot<d>> pool_;
   StablePool<PNode<d>> copies_;
 };

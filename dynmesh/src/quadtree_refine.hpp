@@ -68,6 +68,7 @@
 #include <sac/fn.hpp>
 
 #include "dynmesh/cell.hpp"
+#include "dynmesh/detail/cell_table.hpp"
 #include "dynmesh/point.hpp"
 
 namespace dynmesh::detail {
@@ -99,8 +100,9 @@ constexpr bool any_split(std::uint8_t v) noexcept { return (v & 3u) != 0; }
 /// CellId, so identities never depend on when or where a run first named the cell.
 template <std::size_t d>
 struct Slot {
-  explicit Slot(const CellId<d>& c) : id(c) {}
-  CellId<d> id;
+  explicit Slot(const CellId<d>& c) : key(pack_cell<d>(c)) {}
+  CellId<d> id() const noexcept { return unpack_cell<d>(key); }
+  PackedCell<d> key;  // its cell, packed (the directory's index reads it)
   sac::Mod<std::uint8_t> split;  // kTreeSplit once SPLIT ran on the cell (see above)
   sac::Mod<PNode<d>*> pts;       // the cell's points (written by its parent's SPLIT)
 };

@@ -1358,11 +1358,11 @@ TYPED_TEST(DynamicQuadtreeCheckers, DirectorySlotFiledUnderAnotherCell) {
   const CellId<d> leaf = tree.leaves().front().cell;  // a child of a split cell: it has a slot
   ASSERT_NE(s.dir.find(leaf), nullptr);
   detail::Slot<d>& slot = s.dir.get(s.rt, leaf);
-  slot.id = parent(leaf);
+  slot.key = detail::pack_cell<d>(parent(leaf));
   EXPECT_THROW(s.dir.check_invariants(s.rt), InvariantError);
   EXPECT_THAT(invariant_message([&] { s.dir.check_invariants(s.rt); }), HasSubstr("filed under another cell"));
   EXPECT_THROW(tree.check_invariants(), InvariantError);
-  slot.id = leaf;
+  slot.key = detail::pack_cell<d>(leaf);
   EXPECT_TRUE(invariants_hold(tree));
 }
 

@@ -3,9 +3,8 @@
 // Purpose: the per-level occupied-cell and split-cell tables of the static quadtree and of the
 // invariant checker. One flat array of slots, linear probing, power-of-two capacity, load
 // factor ≤ 1/2, backward-shift deletion (no tombstones), locality-preserving home slots (see
-// home()). Keys are stored packed: the d index
-// words with the level in the top byte of the first word (indices are < 2^52), so a set slot
-// is 8·d bytes. Not a public API: it is installed only because public class templates hold
+// cell_home()). Keys are stored packed (PackedCell: the d index words with the level in the
+// top byte of the first word), so a set slot is 8·d bytes. Not a public API: it is installed only because public class templates hold
 // one.
 // Invariants: an empty slot has first word ~0 (level 255 does not exist); every stored key is
 // found by probing from its home slot without crossing an empty slot; size() == number of
@@ -27,6 +26,55 @@
 namespace dynmesh::detail {
 
 struct NoValue {};
+
+/// A CellId packed in d words: the indices, with the level in the top byte of the first
+/// word (indices are < 2^52). ~0 in the first word is no cell (level 255 does not exist).
+template <std::size_t d>
+using PackedCell = std::array<std::uint64_t, d>;
+
+inline constexpr std::uint64_t kNoCell = ~std::uint64_t{0};
+inline constexpr int kPackedLevelShift = 56;
+
+template <std::size_t d>
+constexpr PackedCell<d> pack_cell(const CellId<d>& c) noexcept {
+  PackedCell<d> k = c.index;
+  k[0] |= static_cast<std::uint64_t>(c.level) << kPackedLevelShift;
+  return k;
+}
+
+template <std::size_t d>
+constexpr CellId<d> unpack_cell(const PackedCell<d>& k) noexcept {
+  CellId<d> c;
+  c.level = static_cast<int>(k[0] >> kPackedLevelShift);
+  c.index = k;
+  c.index[0] &= (std::uint64_t{1} << kPackedLevelShift) - 1;
+  return c;
+}
+
+template <std::size_t d>
+constexpr bool same_cell(const PackedCell<d>& a, const PackedCell<d>& b) noexcept {
+  bool eq = a[0] == b[0];
+  for (std::size_t k = 1; k < d; ++k) eq &= a[k] == b[k];
+  return eq;
+}
+
+/// Locality-preserving home slot in a table of mask + 1 slots: the cells of one aligned
+/// block of 4^d cells of a level share a scattered base (a hash of the level and the block)
+/// and occupy consecutive slots after it, so spatially coherent sequences of operations
+/// touch few cache lines. The callers process cells in Morton or (level, i, j, k) order
+/// where it matters.
+template <std::size_t d>
+std::size_t cell_home(const PackedCell<d>& k, std::size_t mask) noexcept {
+  constexpr int kBlockBits = 2;  // blocks of 4 cells per axis
+  constexpr std::uint64_t kBlockMask = (std::uint64_t{1} << kBlockBits) - 1;
+  std::uint64_t h = k[d - 1] >> kBlockBits;
+  std::uint64_t low = k[d - 1] & kBlockMask;
+  for (std::size_t a = d - 1; a-- > 0;) {
+    h = CellHash::mix(h) ^ (k[a] >> kBlockBits);  // k[0]'s level bits stay in the block key
+    low = (low << kBlockBits) | (k[a] & kBlockMask);
+  }
+  return static_cast<std::size_t>((CellHash::mix(h) << (kBlockBits * d)) | low) & mask;
+}
 
 template <std::size_t d, class V = NoValue>
 class CellTable {
@@ -115,49 +163,18 @@ class CellTable {
   }
 
  private:
-  using Key = std::array<std::uint64_t, d>;
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
-  static constexpr int kLevelShift = 56;
-  static constexpr int kBlockBits = 2;  // blocks of 4 cells per axis
-  static constexpr std::uint64_t kBlockMask = (std::uint64_t{1} << kBlockBits) - 1;
+  using Key = PackedCell<d>;
+  static constexpr std::uint64_t kEmpty = kNoCell;
 
   struct Slot {
     Key key{kEmpty};
     [[no_unique_address]] V value{};
   };
 
-  static bool same(const Key& a, const Key& b) noexcept {
-    bool eq = a[0] == b[0];
-    for (std::size_t k = 1; k < d; ++k) eq &= a[k] == b[k];
-    return eq;
-  }
-
-  static Key pack(const CellId<d>& c) noexcept {
-    Key k = c.index;
-    k[0] |= static_cast<std::uint64_t>(c.level) << kLevelShift;
-    return k;
-  }
-  static CellId<d> unpack(const Key& k) noexcept {
-    CellId<d> c;
-    c.level = static_cast<int>(k[0] >> kLevelShift);
-    c.index = k;
-    c.index[0] &= (std::uint64_t{1} << kLevelShift) - 1;
-    return c;
-  }
-
-  /// Locality-preserving home slot: the cells of one aligned block of 4^d cells of a level
-  /// share a scattered base (a hash of the level and the block) and occupy consecutive slots
-  /// after it, so spatially coherent sequences of operations touch few cache lines. The
-  /// callers process cells in Morton or (level, i, j, k) order where it matters.
-  std::size_t home(const Key& k) const noexcept {
-    std::uint64_t h = k[d - 1] >> kBlockBits;
-    std::uint64_t low = k[d - 1] & kBlockMask;
-    for (std::size_t a = d - 1; a-- > 0;) {
-      h = CellHash::mix(h) ^ (k[a] >> kBlockBits);  // k[0]'s level bits stay in the block key
-      low = (low << kBlockBits) | (k[a] & kBlockMask);
-    }
-    return static_cast<std::size_t>((CellHash::mix(h) << (kBlockBits * d)) | low) & mask_;
-  }
+  static bool same(const Key& a, const Key& b) noexcept { return same_cell<d>(a, b); }
+  static Key pack(const CellId<d>& c) noexcept { return pack_cell<d>(c); }
+  static CellId<d> unpack(const Key& k) noexcept { return unpack_cell<d>(k); }
+  std::size_t home(const Key& k) const noexcept { return cell_home<d>(k, mask_); }
 
   void rehash(std::size_t cap) {
     std::vector<Slot> old = std::move(slots_);
