@@ -189,11 +189,15 @@ struct Refine {
   /// already split is skipped.
   static void regrade(sac::Engine& r, Refine* cx, const CellId<d>& c) {
     if (c.level == 0) return;
+    // The closure holds the cells packed (2·8·d bytes, not 2·(8·d + 8)): there are about
+    // 15 of these reads per point.
+    const PackedCell<d> pc = pack_cell<d>(c);
     for (const CellId<d>& u : coarser_touching(c))
-      r.read(cx->slot(r, u).split, [cx, u, c](sac::Engine& x, std::uint8_t s) {
+      r.read(cx->slot(r, u).split, [cx, pu = pack_cell<d>(u), pc](sac::Engine& x, std::uint8_t s) {
         if (s) return;
-        split(x, cx, u, c);
-        regrade(x, cx, u);
+        const CellId<d> uc = unpack_cell<d>(pu);
+        split(x, cx, uc, unpack_cell<d>(pc));
+        regrade(x, cx, uc);
       });
   }
 
@@ -208,10 +212,12 @@ struct Refine {
     for (unsigned w = 0; w < static_cast<unsigned>(kChildren<d>); ++w)
       to.to[w] = &cx->slot(r, child(c, w)).pts;
     List& points = c.level == 0 ? *cx->input : cell.pts;
-    r.memo_read(points, sac::fn<&partition>(cx, witness, c.level + 1, to));
+    r.memo_read(points, sac::fn<&partition>(cx, pack_cell<d>(witness), c.level + 1, to));
   }
 
-  static void partition(sac::Engine& r, Node* p, Refine* cx, CellId<d> witness, int child_level,
+  /// One step of the partition; `witness` (packed: one record per point per level) is only
+  /// part of the memo key.
+  static void partition(sac::Engine& r, Node* p, Refine* cx, PackedCell<d> witness, int child_level,
                         Dests to) {
     if (!p) {
       for (List* m : to.to) r.write(*m, nullptr);
