@@ -198,7 +198,7 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
       if (order_.less(&v->stamp, &r->start)) {
         detach(r);
         attach(r, v);
-        if (!same) enqueue(r);
+        if (!same) enqueue(r, m);
       }
       r = nx;
     }
@@ -213,7 +213,7 @@ void Engine::set_base(ModBase& m, VersionBase* fresh,
     const bool changed = assign_if_changed(base, fresh);
     destroy(fresh);
     if (changed)
-      for (ReadNode* r = base->readers; r; r = r->rnext) enqueue(r);
+      for (ReadNode* r = base->readers; r; r = r->rnext) enqueue(r, m);
     return;
   }
   // A new base version: it precedes every computation write, so nobody saw "nothing" here
@@ -281,7 +281,8 @@ void Engine::exec_read(ReadNode* r) {
   now_ = &r->start;
   ++stats_.events_created;
   ++stats_.live_events;
-  VersionBase* v = visible_or_default(*r->mod, &r->start, r->ops->value);
+  const ModBase& m = *r->issued_mod;
+  VersionBase* v = visible_or_default(m, &r->start, r->ops->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
   attach(r, v);
   push_close(&r->end, TaskKind::CloseRead, r);
@@ -335,7 +336,7 @@ void Engine::execute(const Task& t) {
     case TaskKind::ExecMemoRead: {
       auto* r = static_cast<ReadNode*>(t.node);
       if (window_end_) {
-        if (ReadNode* hit = find_read_match(*r->mod, r->ops, closure_of(r))) {
+        if (ReadNode* hit = find_read_match(*r->issued_mod, r->ops, closure_of(r))) {
           destroy(r);
           memo_hit(&hit->start, &hit->end);
           break;
@@ -365,22 +366,6 @@ void Engine::execute(const Task& t) {
     case TaskKind::CloseMemo:
       close_chain(t.kind, t.node);
       break;
-    case TaskKind::Rerun: {
-      auto* r = static_cast<ReadNode*>(t.node);
-      reruns_.push_back(RerunContext{now_, window_end_});
-      tasks_.push_back(Task{TaskKind::FinishRerun, r});
-      now_ = &r->start;
-      window_end_ = &r->end;
-      ++stats_.reads_reexecuted;
-      ++stats_.last_reexecuted;
-      detach(r);
-      VersionBase* v = visible_or_default(*r->mod, &r->start, r->ops->value);
-      if (!v)
-        throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
-      attach(r, v);
-      exec_body([&] { r->ops->invoke(*this, r, v); });
-      break;
-    }
     case TaskKind::FinishRerun: {
       auto* r = static_cast<ReadNode*>(t.node);
       undo_between(now_, &r->end);  // what the old execution did and this one did not redo
@@ -394,10 +379,11 @@ void Engine::execute(const Task& t) {
       // execution continues after it.
       auto* end = static_cast<Stamp*>(t.node);
       if (!queue_.empty() && order_.less(&queue_.top()->start, end)) {
-        ReadNode* r = queue_.pop();
+        const ModBase* m = nullptr;
+        ReadNode* r = queue_.pop(&m);
         ++stats_.queue_pops;
-        tasks_.push_back(t);
-        tasks_.push_back(Task{TaskKind::Rerun, r});
+        tasks_.push_back(t);  // drain on after this re-execution
+        rerun(r, *m);
       } else {
         now_ = end;
       }
@@ -427,10 +413,24 @@ void Engine::discard_pending() noexcept {
   pending_.clear();  // the allocations are in the trace; destroy_all frees them there
 }
 
-void Engine::enqueue(ReadNode* r) {
+void Engine::enqueue(ReadNode* r, const ModBase& m) {
   if (r->qpos != kNotQueued) return;
-  queue_.push(r);
+  queue_.push(r, &m);
   ++stats_.queue_pushes;
+}
+
+void Engine::rerun(ReadNode* r, const ModBase& m) {
+  reruns_.push_back(RerunContext{now_, window_end_});
+  tasks_.push_back(Task{TaskKind::FinishRerun, r});
+  now_ = &r->start;
+  window_end_ = &r->end;
+  ++stats_.reads_reexecuted;
+  ++stats_.last_reexecuted;
+  detach(r);
+  VersionBase* v = visible_or_default(m, &r->start, r->ops->value);
+  if (!v) throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
+  attach(r, v);
+  exec_body([&] { r->ops->invoke(*this, r, v); });
 }
 
 void Engine::propagate() {
@@ -442,9 +442,10 @@ void Engine::propagate() {
   stats_.last_reexecuted = 0;
   try {
     while (!queue_.empty()) {
-      ReadNode* r = queue_.pop();
+      const ModBase* m = nullptr;
+      ReadNode* r = queue_.pop(&m);
       ++stats_.queue_pops;
-      tasks_.push_back(Task{TaskKind::Rerun, r});
+      rerun(r, *m);
       drain(0);
     }
   } catch (...) {
@@ -581,7 +582,7 @@ void Engine::undo(Stamp* s) {
       ++stats_.events_undone;
       --stats_.live_events;
       VersionBase* older = v->older();
-      ModBase* m = older ? nullptr : v->mod();
+      ModBase* m = v->mod();
       const bool defaulted = !older && (v->link & VersionBase::kDefaulted);
       unlink_version(v);
       // Its readers see the default now: make it the base version, so that they attach to
@@ -594,7 +595,7 @@ void Engine::undo(Stamp* s) {
           r->rpprev = nullptr;
           r->rnext = nullptr;
           if (older) attach(r, older);
-          if (!same) enqueue(r);
+          if (!same) enqueue(r, *m);
           r = nx;
         }
       }
@@ -735,7 +736,7 @@ void Engine::check_invariants() const {
   std::vector<Open> stack;
   std::uint64_t events = 0;
   std::size_t nkeyed = 0, nmemo = 0;
-  AddressSet mods(stats_.live_events / 2);  // the modifiables read or written
+  AddressSet mods(stats_.live_events / 2);  // the modifiables written (then: or read)
   AddressSet reads(stats_.live_events / 2);
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
@@ -746,11 +747,9 @@ void Engine::check_invariants() const {
         if (!(r->flags & detail::kReadEndLinked)) fail("read without end stamp");
         if (!r->end.linked() || !order_.less(&r->start, &r->end)) fail("read end not after start");
         // Attachment to the version visible at its start is checked below, from the
-        // version side: scanning the visible version's readers here would be quadratic in
-        // a modifiable's fan-out (a coarse cell is read by every point's descent).
-        if (!visible(*r->mod, &r->start)) fail("read of a modifiable with no visible version");
+        // version side (a read record does not name its modifiable; scanning the visible
+        // version's readers here would also be quadratic in a modifiable's fan-out).
         reads.insert(r);
-        mods.insert(r->mod);
         if (r->qpos != kNotQueued) fail("read still queued");
         stack.push_back({&r->end, false});
       } else if constexpr (K == StampKind::ReadEnd) {
@@ -794,6 +793,9 @@ void Engine::check_invariants() const {
   // Versions of every written or read modifiable: strictly decreasing time, base last,
   // readers between this version and the next newer one (so each reader hangs on the version
   // visible at its time), and every reader a live read of the trace, each exactly once.
+  // A live read hangs on a computation's version or a base version; so the modifiables of
+  // both cover every read.
+  for (const VersionBase* b : bases_) mods.insert(b->mod());
   std::size_t attached = 0;
   mods.for_each([&](const void* mod) {
     const auto* m = static_cast<const ModBase*>(mod);
@@ -807,7 +809,6 @@ void Engine::check_invariants() const {
         if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("versions out of order");
       }
       for (const ReadNode* r = v->readers; r; r = r->rnext) {
-        if (r->mod != m) fail("reader of another modifiable");
         if (!v->is_base() && !order_.less(&v->stamp, &r->start)) fail("reader before its version");
         if (newer && !order_.less(&r->start, &newer->stamp)) fail("reader after the next version");
         if (!reads.contains(r)) fail("a version's reader is not a live read of the trace");
@@ -840,14 +841,23 @@ void Engine::dump_dot(std::ostream& os) const {
     os << "  " << n << " [shape=box, label=\"" << n << "\"];\n";
     return n;
   };
+  // A read does not name its modifiable: find it from the versions' reader lists.
+  std::unordered_map<const ReadNode*, const ModBase*> read_mod;
+  const auto note_readers = [&](const VersionBase* v) {
+    for (const ReadNode* r = v->readers; r; r = r->rnext) read_mod[r] = v->mod();
+  };
+  for (const VersionBase* b : bases_) note_readers(b);
+  for (const Stamp* s = order_.base()->next(); s; s = s->next())
+    if (s->kind() == StampKind::Write) note_readers(detail::version_of(const_cast<Stamp*>(s)));
   std::size_t id = 0;
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     std::string name = "e" + std::to_string(id++);
     const std::string& parent = stack.back().first;
     visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
       if constexpr (K == StampKind::ReadStart) {
-        os << "  " << name << " [label=\"read\"];\n  " << parent << " -> " << name << ";\n  "
-           << mod_name(rec->mod) << " -> " << name << " [style=dashed];\n";
+        os << "  " << name << " [label=\"read\"];\n  " << parent << " -> " << name << ";\n";
+        if (const auto it = read_mod.find(rec); it != read_mod.end())
+          os << "  " << mod_name(it->second) << " -> " << name << " [style=dashed];\n";
         stack.push_back({name, &rec->end});
       } else if constexpr (K == StampKind::Write) {
         os << "  " << name << " [shape=diamond, label=\"write\"];\n  " << parent << " -> " << name

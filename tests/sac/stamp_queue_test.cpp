@@ -222,6 +222,28 @@ TEST(StampQueue, RemoveTheOnlyAndTheLastElement) {
   EXPECT_NO_THROW(q.check_invariants());
 }
 
+// An element's Aux value travels with it through sifts and removals of others.
+TEST(StampQueue, AuxValuesStayWithTheirElements) {
+  World w;
+  std::mt19937_64 rng(11);
+  std::vector<int> ids;
+  for (int i = 0; i < 300; ++i) ids.push_back(w.add_after(ids.empty() ? -1 : ids[rng() % ids.size()]));
+  const std::vector<int> rank = w.ranks();
+  sac::StampQueue<Elem, ElemTraits, long> q(w.ol);
+  std::shuffle(ids.begin(), ids.end(), rng);
+  for (int id : ids) q.push(w.elem(id), 1000L + id);
+  for (std::size_t i = 0; i < ids.size(); i += 3) q.remove(w.elem(ids[i]));
+  ASSERT_NO_THROW(q.check_invariants());
+  int prev = -1;
+  while (!q.empty()) {
+    long aux = 0;
+    Elem* e = q.pop(&aux);
+    ASSERT_EQ(aux, 1000L + e->id);
+    ASSERT_GT(rank[static_cast<std::size_t>(e->id)], prev);
+    prev = rank[static_cast<std::size_t>(e->id)];
+  }
+}
+
 TEST(StampQueue, CheckInvariantsDetectsCorruption) {
   World w;
   int last = -1;

@@ -179,7 +179,8 @@ class Engine {
   // and see check_invariants() fail. Nothing else may define it.
   friend struct EngineTestAccess;
 
-  using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits>;
+  // A queued read waits with the modifiable it reads (ReadNode does not keep it).
+  using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits, const ModBase*>;
 
   // Work of the trampoline (sac/detail/trampoline.hpp).
   using TaskKind = detail::TaskKind;
@@ -252,7 +253,10 @@ class Engine {
   static void* closure_of(detail::ReadNode* r) { return static_cast<detail::ReadNode*>(r) + 1; }
   void undo_between(Stamp* a, Stamp* b);
   void undo(Stamp* s);
-  void enqueue(detail::ReadNode* r);
+  /// Queues r, a read of m, for re-execution (no-op if queued).
+  void enqueue(detail::ReadNode* r, const ModBase& m);
+  /// Re-executes r, a read of m, inside its own interval (an affected read just popped).
+  void rerun(detail::ReadNode* r, const ModBase& m);
   void free_deferred() noexcept;
   void index_pending_allocs();
   void destroy_all() noexcept;
@@ -382,7 +386,7 @@ void Engine::read(const Mod<T>& m, F&& body) {
   using N = detail::ReadNodeT<Fn>;
   require_computation("read");
   N* r = construct<N>(std::forward<F>(body));
-  r->mod = &m;
+  r->issued_mod = &m;
   r->ops = &detail::ReadOpsFor<T, Fn>::ops;
   r->qpos = kNotQueued;
   issue(TaskKind::ExecRead, r);

@@ -3,6 +3,8 @@
 // Purpose: affected reads wait here until change propagation re-executes them in time order.
 // A binary min-heap of T* ordered by the OrderList position of Traits::stamp(t); each element
 // stores its heap index (Traits::pos(t)) so that undone reads leave the queue in O(log n).
+// An element may carry an Aux value while queued (the engine: the modifiable the read reads,
+// which the read record itself does not keep); Aux = std::nullptr_t costs nothing.
 // Relabelling the order list never changes relative order, so the heap stays valid.
 //
 // Invariants (check_invariants()): heap order under OrderList::less; Traits::pos(heap_[i]) == i
@@ -11,6 +13,7 @@
 // Follows the priority-queue propagation of Acar, "Self-Adjusting Computation" (2005), ch. 6.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -22,89 +25,96 @@ namespace sac {
 
 inline constexpr std::uint32_t kNotQueued = 0xffffffffu;
 
-template <class T, class Traits>
+template <class T, class Traits, class Aux = std::nullptr_t>
 class StampQueue {
  public:
   explicit StampQueue(const OrderList& order) : order_(&order) {}
 
   bool empty() const { return heap_.empty(); }
   std::size_t size() const { return heap_.size(); }
-  T* top() const { return heap_.front(); }
+  T* top() const { return heap_.front().t; }
   bool contains(const T* t) const { return Traits::pos(t) != kNotQueued; }
 
-  void push(T* t) {
+  void push(T* t, Aux aux = Aux{}) {
     Traits::pos(t) = static_cast<std::uint32_t>(heap_.size());
-    heap_.push_back(t);
+    heap_.push_back(Entry{t, aux});
     sift_up(heap_.size() - 1);
   }
 
-  T* pop() {
-    T* t = heap_.front();
+  /// Removes and returns the earliest element; its Aux goes to *aux when given.
+  T* pop(Aux* aux = nullptr) {
+    const Entry e = heap_.front();
     remove_at(0);
-    return t;
+    if (aux) *aux = e.aux;
+    return e.t;
   }
 
   void remove(T* t) { remove_at(Traits::pos(t)); }
 
-  std::size_t memory_bytes() const { return heap_.capacity() * sizeof(T*); }
+  std::size_t memory_bytes() const { return heap_.capacity() * sizeof(Entry); }
 
   void check_invariants() const {
     for (std::size_t i = 0; i < heap_.size(); ++i) {
-      if (Traits::pos(heap_[i]) != i)
+      if (Traits::pos(heap_[i].t) != i)
         throw InvariantError("StampQueue: stored index mismatch at " + std::to_string(i));
-      if (!Traits::stamp(heap_[i])->linked())
+      if (!Traits::stamp(heap_[i].t)->linked())
         throw InvariantError("StampQueue: element with an unlinked stamp");
-      if (i > 0 && before(heap_[i], heap_[(i - 1) / 2]))
+      if (i > 0 && before(heap_[i].t, heap_[(i - 1) / 2].t))
         throw InvariantError("StampQueue: heap order broken at " + std::to_string(i));
     }
   }
 
  private:
+  struct Entry {
+    T* t;
+    [[no_unique_address]] Aux aux;
+  };
+
   bool before(const T* a, const T* b) const { return order_->less(Traits::stamp(a), Traits::stamp(b)); }
 
   void remove_at(std::size_t i) {
-    T* gone = heap_[i];
-    T* last = heap_.back();
+    const Entry gone = heap_[i];
+    const Entry last = heap_.back();
     heap_.pop_back();
-    Traits::pos(gone) = kNotQueued;
-    if (gone == last) return;
+    Traits::pos(gone.t) = kNotQueued;
+    if (gone.t == last.t) return;
     heap_[i] = last;
-    Traits::pos(last) = static_cast<std::uint32_t>(i);
-    if (i > 0 && before(last, heap_[(i - 1) / 2])) sift_up(i);
+    Traits::pos(last.t) = static_cast<std::uint32_t>(i);
+    if (i > 0 && before(last.t, heap_[(i - 1) / 2].t)) sift_up(i);
     else sift_down(i);
   }
 
   void sift_up(std::size_t i) {
-    T* t = heap_[i];
+    const Entry e = heap_[i];
     while (i > 0) {
       std::size_t p = (i - 1) / 2;
-      if (!before(t, heap_[p])) break;
+      if (!before(e.t, heap_[p].t)) break;
       heap_[i] = heap_[p];
-      Traits::pos(heap_[i]) = static_cast<std::uint32_t>(i);
+      Traits::pos(heap_[i].t) = static_cast<std::uint32_t>(i);
       i = p;
     }
-    heap_[i] = t;
-    Traits::pos(t) = static_cast<std::uint32_t>(i);
+    heap_[i] = e;
+    Traits::pos(e.t) = static_cast<std::uint32_t>(i);
   }
 
   void sift_down(std::size_t i) {
-    T* t = heap_[i];
+    const Entry e = heap_[i];
     const std::size_t n = heap_.size();
     for (;;) {
       std::size_t c = 2 * i + 1;
       if (c >= n) break;
-      if (c + 1 < n && before(heap_[c + 1], heap_[c])) ++c;
-      if (!before(heap_[c], t)) break;
+      if (c + 1 < n && before(heap_[c + 1].t, heap_[c].t)) ++c;
+      if (!before(heap_[c].t, e.t)) break;
       heap_[i] = heap_[c];
-      Traits::pos(heap_[i]) = static_cast<std::uint32_t>(i);
+      Traits::pos(heap_[i].t) = static_cast<std::uint32_t>(i);
       i = c;
     }
-    heap_[i] = t;
-    Traits::pos(t) = static_cast<std::uint32_t>(i);
+    heap_[i] = e;
+    Traits::pos(e.t) = static_cast<std::uint32_t>(i);
   }
 
   const OrderList* order_;
-  std::vector<T*> heap_;
+  std::vector<Entry> heap_;
 };
 
 }  // namespace sac

@@ -5,7 +5,7 @@
 // Pool; their type-specific behaviour (destroy, compare, hash, invoke) sits in a static ops
 // table per instantiated type, so a record costs one pointer for it and no vtable.
 //
-// Layout (bytes, 64-bit): VersionBase 40 + value; ReadNode 72 + closure; AllocNode 32 +
+// Layout (bytes, 64-bit): VersionBase 40 + value; ReadNode 64 + closure; AllocNode 32 +
 // key + object; MemoNode 64 + closure.
 // Invariants: see Engine::check_invariants().
 #pragma once
@@ -85,17 +85,23 @@ struct ReadOps {
 inline constexpr std::uint32_t kReadDead = 1;       // start stamp undone
 inline constexpr std::uint32_t kReadEndLinked = 2;  // end stamp in the order list
 
+/// A read. It does not name its modifiable: a live read hangs on a version of it (whose
+/// chain ends at the modifiable), a queued read's modifiable waits with it in the queue, and
+/// an issued read keeps it in `issued_mod` until it runs (the union's other member). This
+/// keeps the record at 64 bytes.
 struct ReadNode {
   Stamp start;
   Stamp end;
-  const ModBase* mod;
-  ReadNode* rnext;
+  union {
+    ReadNode* rnext;             // attached: the next reader of the same version
+    const ModBase* issued_mod;   // issued, not yet run: the modifiable it will read
+  };
   ReadNode** rpprev;     // null when attached to no version
   const ReadOps* ops;
   std::uint32_t qpos;
   std::uint32_t flags;
 };
-static_assert(sizeof(ReadNode) == 72);
+static_assert(sizeof(ReadNode) == 64);
 
 template <class F>
 struct ReadNodeT : ReadNode {

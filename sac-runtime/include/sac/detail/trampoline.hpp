@@ -23,7 +23,6 @@ enum class TaskKind : std::uint8_t {
   ExecMemo,      // link a new memo entry and run it, unless an equal one is reused
   CloseRead,     // link the end stamp of a read (and of the closes chained onto it)
   CloseMemo,     // the same for a memo entry
-  Rerun,         // re-execute an affected read inside its own interval
   FinishRerun,   // undo what the re-execution did not redo; restore the saved context
   DrainUntil     // re-execute the affected reads before a stamp, then continue after it
 };
