@@ -79,12 +79,13 @@ std::string breakdown_text(const QuadtreeMemory& m, std::size_t trace_bytes, std
   row("input list nodes", m.input_nodes, m.input_node_bytes);
   std::snprintf(line, sizeof line,
                 "# total %zu B = trace_bytes() %zu B: %s (unaccounted records %lld B)\n"
-                "# base versions: %llu (2 per directory slot + 1 per input node + the list head = %zu)\n"
+                "# base versions: %llu (1 per input node + the list head = %zu; the directory's defaults"
+                " (Engine::init_default) make one only when a read sees them)\n"
                 "# outside trace_bytes(): engine vectors %zu B, pool reserved %zu B (unused %zu B, %.1f B/point),"
                 " large blocks %zu B, size-class rounding %zu B\n",
                 m.total(), trace_bytes, m.total() == trace_bytes ? "equal" : "DIFFERENT",
                 static_cast<long long>(m.engine.unaccounted), static_cast<unsigned long long>(m.engine.inputs.count),
-                2 * m.slots + m.input_nodes + 1, m.engine.engine_vectors, m.engine.pool_reserved, m.engine.pool_unused(),
+                m.input_nodes + 1, m.engine.engine_vectors, m.engine.pool_reserved, m.engine.pool_unused(),
                 static_cast<double>(m.engine.pool_unused()) / static_cast<double>(n), m.engine.pool_large,
                 m.engine.size_class_rounding);
   out += line;
@@ -94,14 +95,6 @@ std::string breakdown_text(const QuadtreeMemory& m, std::size_t trace_bytes, std
     std::snprintf(name, sizeof name, "reads of %zu B", bytes);
     row(name, count, bytes * count);
   }
-  // trace_bytes() counts the directory's table at two slots per entry; after a build (no
-  // erase yet) its capacity is the least power of two, from 16, of at least that.
-  std::size_t capacity = 16;
-  while (capacity < 2 * m.slots) capacity *= 2;
-  const std::size_t table = capacity * (8 * static_cast<std::size_t>(dim) + sizeof(void*));
-  std::snprintf(line, sizeof line, "# directory table at its capacity: %zu B (%.1f B/point, %zu B more than counted)\n",
-                table, static_cast<double>(table) / static_cast<double>(n), table - m.table_bytes);
-  out += line;
   return out;
 }
 
