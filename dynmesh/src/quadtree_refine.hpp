@@ -27,9 +27,9 @@
 // How it is made stable (DESIGN.md, "Writing it on the runtime so that it is stable"):
 //   * cells are named by CellId and found in a directory of slots outside the trace; a slot
 //     holds two versioned modifiables, `split` (0 until SPLIT writes 1) and `pts` (the head
-//     of the cell's point list), both defaulting to "nothing" (Engine::init), so a test of
-//     a cell that does not exist yet reads the default and is re-run if it comes to exist
-//     earlier in the trace;
+//     of the cell's point list), both defaulting to "nothing" (Engine::init_default), so a
+//     test of a cell that does not exist yet reads the default and is re-run if it comes to
+//     exist earlier in the trace;
 //   * SPLIT's partition is a memoized, order-preserving, destination-passing walk over the
 //     cell's point list (one memo_read and one write per point; the point's node at the
 //     child level is its own, PNode::down, so it needs no keyed allocation), so a new point

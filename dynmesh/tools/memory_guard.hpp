@@ -44,19 +44,19 @@ struct MemoryCost {
   std::uint64_t check_bytes_per_point;  // the from-scratch rebuild of --check (and stability)
 };
 
-// Measured on x86-64 (RelWithDebInfo -O2, glibc malloc) with uniform points written by
-// python3 (random.random(), %.17g): peak RSS ("Maximum resident set size" of /usr/bin/time -v)
-// at n = 10^5, less that of a 10-point run (7 MB, the program itself), over n; then about 30%
-// added, because the cost per point grows slowly with n (2D, 10^6 points: 15,248,256 KiB,
-// 15,607 B/point) and clustered points cost about 5% more than uniform ones (`stability
-// --dim 2 --n 100000 --updates 100`: 1,899,680 KiB for clusters, 1,803,396 KiB for uniform).
-// Under `ulimit -v` set to the estimate, the 10^5-point runs below complete.
-//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells          1,467,272 KiB: 14,954 B/point
-//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells --check  1,798,376 KiB: +3,390 B/point
-inline constexpr MemoryCost kQuadtree2dCost{20'000, 4'500};
-//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells          3,353,968 KiB: 34,271 B/point
-//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells --check  4,024,876 KiB: +6,869 B/point
-inline constexpr MemoryCost kOctree3dCost{44'000, 9'000};
+// Measured on x86-64 (-O2, glibc malloc) with uniform points written by python3
+// (random.random(), repr): peak RSS ("Maximum resident set size" of /usr/bin/time -v) at
+// n = 10^5, less that of a 10-point run (7 MB, the program itself), over n; then about 30%
+// added, because the cost per point grows slowly with n (2D, 10^6 points: 11,521,524 KiB,
+// 11,798 B/point) and clustered points cost about 5% more than uniform ones. Under
+// `ulimit -v` set to the estimate, the 10^5-point runs below complete. (Before issue 9's
+// first levers: 14,954 and 34,271 B/point, and 20,000 and 44,000 here.)
+//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells          1,136,000 KiB: 11,561 B/point
+//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells --check  1,446,204 KiB: +3,176 B/point
+inline constexpr MemoryCost kQuadtree2dCost{15'500, 4'500};
+//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells          2,339,688 KiB: 23,887 B/point
+//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells --check  3,019,148 KiB: +6,958 B/point
+inline constexpr MemoryCost kOctree3dCost{31'000, 9'000};
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o          7,050,276 KiB: 72,112 B/point
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o --check  8,130,208 KiB: +11,057 B/point
 inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};
