@@ -630,9 +630,8 @@ struct SaDelaunay {
   template <class K>
   struct Star {
     SaVertex* v;
-    SaTri* first;                 // v.tri, where the turn starts
-    InlineVec<SaTri*, 8> ccw;     // triangles from first on, counter-clockwise
-    InlineVec<SaTri*, 2> cw;      // triangles before first, clockwise (a boundary vertex)
+    InlineVec<SaTri*, 8> ccw;     // from v.tri (ccw[0], where the turn starts), counter-clockwise
+    InlineVec<SaTri*, 2> cw;      // before ccw[0], clockwise (a boundary vertex)
     K k;
   };
 
@@ -649,7 +648,7 @@ struct SaDelaunay {
   static void read_star(sac::Engine& e, SaVertex* v, const K& k) {
     e.read(v->tri, [v, k](sac::Engine& e2, SaTri* first) {
       if (first->index_of(v) < 0) throw InvariantError("dynmesh: SaDelaunay: a vertex's triangle lacks it");
-      star_ccw(e2, Star<K>{v, first, {}, {}, k}, first);
+      star_ccw(e2, Star<K>{v, {}, {}, k}, first);
     });
   }
 
@@ -662,7 +661,7 @@ struct SaDelaunay {
     w.ccw.push_back(t);
     if (t->e[at(next(i))]->box_side) return star_turn(e, std::move(w));
     e.read(t->across(next(i)), [w](sac::Engine& e2, SaTri* u) {
-      if (u != w.first) return star_ccw(e2, Star<K>(w), u);
+      if (u != w.ccw[0]) return star_ccw(e2, Star<K>(w), u);
       star_done(e2, w, true);  // all the way round
     });
   }
@@ -671,9 +670,10 @@ struct SaDelaunay {
   /// across v-a, unless that is a box side too.
   template <class K>
   static void star_turn(sac::Engine& e, Star<K> w) {
-    const int j = sa_index::prev(w.first->index_of(w.v));
-    if (w.first->e[sa_index::at(j)]->box_side) return star_done(e, w, false);
-    e.read(w.first->across(j), [w](sac::Engine& e2, SaTri* u) { star_cw(e2, Star<K>(w), u); });
+    SaTri* first = w.ccw[0];
+    const int j = sa_index::prev(first->index_of(w.v));
+    if (first->e[sa_index::at(j)]->box_side) return star_done(e, w, false);
+    e.read(first->across(j), [w](sac::Engine& e2, SaTri* u) { star_cw(e2, Star<K>(w), u); });
   }
 
   /// At t = (v, a, b) going clockwise: cross v-a.
