@@ -584,7 +584,7 @@ void Engine::undo(Stamp* s) {
       VersionBase* older = v->older();
       ModBase* m = v->mod();
       const bool defaulted = !older && (v->link & VersionBase::kDefaulted);
-      unlink_version(v);
+      unlink_version(m, v);
       // Its readers see the default now: make it the base version, so that they attach to
       // it and are cut off when v held the default value too.
       if (v->readers && defaulted) older = default_base(*m, true, v->ops);
@@ -616,8 +616,7 @@ void Engine::undo(Stamp* s) {
   });
 }
 
-void Engine::unlink_version(VersionBase* v) {
-  ModBase* m = v->mod();
+void Engine::unlink_version(ModBase* m, VersionBase* v) {
   if (m->newest() == v) {
     if (VersionBase* o = v->older()) m->set_newest(o);
     else m->head_ = (v->link & VersionBase::kDefaulted) ? ModBase::kDefaultOnly : 0;  // it was the only one

@@ -233,7 +233,7 @@ class Engine {
   void close_chain(TaskKind kind, void* node);
   void discard_pending() noexcept;
   void link_write(ModBase& m, detail::VersionBase* v);
-  void unlink_version(detail::VersionBase* v);
+  void unlink_version(ModBase* m, detail::VersionBase* v);  // v a version of m
   void link_alloc(detail::AllocNode* n, std::size_t h);
   void link_memo(detail::MemoNode* n, std::size_t h);
   void set_base(ModBase& m, detail::VersionBase* fresh,
