@@ -316,9 +316,9 @@ class QuadtreeCore {
     by_pos.reserve(points.size());
     by_id.reserve(points.size());
     for (const Point<d>& p : points) link_new(*try_locate(box, p), p);
-    Program* refine = &program;
-    rt.run([refine, &post](sac::Engine& e) {
-      Program::main(e, refine);
+    rt.set_context(&program);
+    rt.run([&post](sac::Engine& e) {
+      Program::main(e);
       post(e);
     });
     compact_mark = dir.size();

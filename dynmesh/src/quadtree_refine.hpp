@@ -149,7 +149,12 @@ struct Refine {
 
   // ------------------------------------------------------------------ the program
 
-  static void main(sac::Engine& r, Refine* cx) {
+  /// The program's context (Engine::set_context, which the owner calls before run()):
+  /// closures do not carry it.
+  static Refine* ctx(sac::Engine& r) { return r.context<Refine>(); }
+
+  static void main(sac::Engine& r) {
+    Refine* cx = ctx(r);
     // The root is crowded when it holds two points (its neighbourhood is itself).
     Crowded* c0 = r.alloc<Crowded>(0);
     r.read(*cx->input, [c0](sac::Engine& x, Node* a) {
@@ -161,27 +166,28 @@ struct Refine {
         y.write(*c0, root);
       });
     });
-    r.memo(sac::fn<&refine>(cx, 0, c0));
+    r.memo(sac::fn<&refine>(0, c0));
   }
 
   /// The crowded round of class l (with the grading splits it causes), then class l+1.
-  static void refine(sac::Engine& r, Refine* cx, int l, Crowded* cl) {
-    r.read(*cl, [cx, l, cl](sac::Engine& x, QNode<d>* head) {
+  static void refine(sac::Engine& r, int l, Crowded* cl) {
+    r.read(*cl, [l, cl](sac::Engine& x, QNode<d>* head) {
       if (!head) return;  // no crowded cell left: the tree is done
       Crowded* next = x.alloc<Crowded>(l + 1);
-      x.memo_read(*cl, sac::fn<&split_crowded>(cx));
-      x.memo_read(*cl, sac::fn<&classify>(cx, next));
-      x.memo(sac::fn<&refine>(cx, l + 1, next));
+      x.memo_read(*cl, sac::fn<&split_crowded>());
+      x.memo_read(*cl, sac::fn<&classify>(next));
+      x.memo(sac::fn<&refine>(l + 1, next));
     });
   }
 
   /// Step of the first walk over C_l: SPLIT the entry's cell, then the grading splits that
   /// it forces.
-  static void split_crowded(sac::Engine& r, QNode<d>* e, Refine* cx) {
+  static void split_crowded(sac::Engine& r, QNode<d>* e) {
     if (!e) return;
+    Refine* cx = ctx(r);
     split(r, cx, e->cell, e->cell);
     regrade(r, cx, e->cell);
-    r.memo_read(e->next, sac::fn<&split_crowded>(cx));
+    r.memo_read(e->next, sac::fn<&split_crowded>());
   }
 
   /// After c split, every leaf one class larger that touches c is ill-graded: split it (c
@@ -193,11 +199,11 @@ struct Refine {
     // 15 of these reads per point.
     const PackedCell<d> pc = pack_cell<d>(c);
     for (const CellId<d>& u : coarser_touching(c))
-      r.read(cx->slot(r, u).split, [cx, pu = pack_cell<d>(u), pc](sac::Engine& x, std::uint8_t s) {
+      r.read(cx->slot(r, u).split, [pu = pack_cell<d>(u), pc](sac::Engine& x, std::uint8_t s) {
         if (s) return;
         const CellId<d> uc = unpack_cell<d>(pu);
-        split(x, cx, uc, unpack_cell<d>(pc));
-        regrade(x, cx, uc);
+        split(x, ctx(x), uc, unpack_cell<d>(pc));
+        regrade(x, ctx(x), uc);
       });
   }
 
@@ -212,31 +218,30 @@ struct Refine {
     for (unsigned w = 0; w < static_cast<unsigned>(kChildren<d>); ++w)
       to.to[w] = &cx->slot(r, child(c, w)).pts;
     List& points = c.level == 0 ? *cx->input : cell.pts;
-    r.memo_read(points, sac::fn<&partition>(cx, pack_cell<d>(witness), c.level + 1, to));
+    r.memo_read(points, sac::fn<&partition>(pack_cell<d>(witness), c.level + 1, to));
   }
 
   /// One step of the partition; `witness` (packed: one record per point per level) is only
   /// part of the memo key.
-  static void partition(sac::Engine& r, Node* p, Refine* cx, PackedCell<d> witness, int child_level,
-                        Dests to) {
+  static void partition(sac::Engine& r, Node* p, PackedCell<d> witness, int child_level, Dests to) {
     if (!p) {
       for (List* m : to.to) r.write(*m, nullptr);
       return;
     }
     const unsigned w = child_code(p->q, child_level);
-    Node* copy = cx->dir->below(p);
+    Node* copy = ctx(r)->dir->below(p);
     r.write(*to.to[w], copy);
     to.to[w] = &copy->next;
-    r.memo_read(p->next, sac::fn<&partition>(cx, witness, child_level, to));
+    r.memo_read(p->next, sac::fn<&partition>(witness, child_level, to));
   }
 
   /// Step of the second walk over C_l, after all its splits: queue the crowded children of
   /// the entry's cell. A change that one child's test read re-runs the tests from that child
   /// on; the walk re-joins its old trace at the next entry with a crowded child (the memo
   /// key holds the queue's tail).
-  static void classify(sac::Engine& r, QNode<d>* e, Refine* cx, Crowded* out) {
+  static void classify(sac::Engine& r, QNode<d>* e, Crowded* out) {
     if (!e) return r.write(*out, nullptr);
-    test_child(r, cx, e, 0, out);
+    test_child(r, ctx(r), e, 0, out);
   }
 
   /// Child w of e's cell, k, is crowded when it holds two points, or one while a cell of
@@ -244,12 +249,12 @@ struct Refine {
   /// with the queue's new tail), then the walk moves on.
   static void test_child(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, Crowded* out) {
     if (w == static_cast<unsigned>(kChildren<d>))
-      return r.memo_read(e->next, sac::fn<&classify>(cx, out));
-    r.read(cx->slot(r, child(e->cell, w)).pts, [cx, e, w, out](sac::Engine& x, Node* a) {
-      if (!a) return test_child(x, cx, e, w + 1, out);  // empty: not crowded
-      x.read(a->next, [cx, e, w, out](sac::Engine& y, Node* b) {
-        if (b) return queue_crowded(y, cx, e, w, out);  // two points: self-crowded
-        scan_neighbourhood(y, cx, e, w, 0, out);          // one point: look around
+      return r.memo_read(e->next, sac::fn<&classify>(out));
+    r.read(cx->slot(r, child(e->cell, w)).pts, [e, w, out](sac::Engine& x, Node* a) {
+      if (!a) return test_child(x, ctx(x), e, w + 1, out);  // empty: not crowded
+      x.read(a->next, [e, w, out](sac::Engine& y, Node* b) {
+        if (b) return queue_crowded(y, ctx(y), e, w, out);  // two points: self-crowded
+        scan_neighbourhood(y, ctx(y), e, w, 0, out);          // one point: look around
       });
     });
   }
@@ -302,9 +307,9 @@ struct Refine {
     CellId<d> nb;
     while (i < kAround && !offset_cell(k, kScanOrder[w][static_cast<std::size_t>(i)], nb)) ++i;
     if (i >= kAround) return test_child(r, cx, e, w + 1, out);
-    r.read(cx->slot(r, nb).pts, [cx, e, w, i, out](sac::Engine& x, Node* p) {
-      if (p) return queue_crowded(x, cx, e, w, out);
-      scan_neighbourhood(x, cx, e, w, i + 1, out);
+    r.read(cx->slot(r, nb).pts, [e, w, i, out](sac::Engine& x, Node* p) {
+      if (p) return queue_crowded(x, ctx(x), e, w, out);
+      scan_neighbourhood(x, ctx(x), e, w, i + 1, out);
     });
   }
 

@@ -142,6 +142,10 @@ void Engine::fail_not_in_computation(const char* what) const {
                    ": only allowed inside run() or propagate() (the computation)");
 }
 
+void Engine::throw_bad_context() {
+  throw UsageError("sac::Engine::context: no context of that type was set (set_context)");
+}
+
 void Engine::poison() noexcept {
   discard_pending();
   poisoned_ = true;

@@ -1295,6 +1295,31 @@ TEST(EngineInitDefault, DifferentialAgainstFromScratch) {
   }
 }
 
+// ---- set_context(): what the bodies reach through the Engine instead of their closures
+
+struct Scale {
+  int factor;
+};
+
+TEST(EngineContext, BodiesReachTheContextAndTheTypeIsChecked) {
+  Engine e;
+  EXPECT_THROW(e.context<Scale>(), sac::UsageError) << "none set";
+  Scale s{3};
+  e.set_context(&s);
+  EXPECT_EQ(e.context<Scale>(), &s);
+  EXPECT_THROW(e.context<int>(), sac::UsageError) << "another type";
+  Mod<int> in, out;
+  e.set(in, 2);
+  e.run([&](Engine& en) {
+    en.read(in, body([po = &out](Engine& x, int v) { x.write(*po, v * x.context<Scale>()->factor); }));
+  });
+  EXPECT_EQ(out.get(), 6);
+  e.set(in, 5);
+  e.propagate();
+  EXPECT_EQ(out.get(), 15) << "a re-executed body reaches it too";
+  expect_healthy(e);
+}
+
 void maybe_throw(Engine& e, Mod<int>* src, int bad) {
   e.make<std::string>(std::string(100, 'm'));
   e.read(*src, body([bad, s = std::string(64, 'q')](Engine& x, int v) {

@@ -150,6 +150,23 @@ class Engine {
   template <class F>
   void memo(F&& f);
 
+  // ---------------------------------------------------------------- context
+  /// Gives the computation a context: a pointer its bodies reach through the Engine
+  /// (context<T>()) instead of carrying it in every closure, for what is the same for the
+  /// whole computation (a program object and its tables). One per engine; the mutator sets
+  /// it, before run(), and it must not change while the trace depends on it.
+  template <class T>
+  void set_context(T* c) noexcept {
+    context_ = c;
+    context_type_ = &detail::kTypeTag<T>;
+  }
+  /// The pointer set_context<T>() gave. UsageError if none was given, or one of another type.
+  template <class T>
+  T* context() const {
+    if (context_type_ != &detail::kTypeTag<T>) throw_bad_context();
+    return static_cast<T*>(context_);
+  }
+
   // ---------------------------------------------------------------- introspection
   const Stats& stats() const { return stats_; }
   /// Bytes held by the trace: records, closures, versions, tables, order-list groups, queue.
@@ -307,6 +324,9 @@ class Engine {
   detail::SegmentArray<PendingAlloc> pending_;
   std::vector<detail::VersionBase*> bases_;    // base versions; index kept in stamp.label
   std::vector<Task> tasks_;                    // the trampoline's stack
+  void* context_ = nullptr;             // set_context()
+  const void* context_type_ = nullptr;  // its type's tag
+  [[noreturn]] static void throw_bad_context();
   std::vector<RerunContext> reruns_;           // contexts saved by the running re-executions
   std::vector<Task> issued_;                   // calls issued by the running bodies
   std::size_t body_mark_ = 0;                  // issued_ entries below this belong to callers

@@ -22,6 +22,10 @@
 
 namespace sac::detail {
 
+/// A per-type object whose address names the type (Engine::context's check).
+template <class T>
+inline char kTypeTag = 0;  // not const: distinct objects, never merged
+
 struct ReadQueueTraits {
   static const Stamp* stamp(const ReadNode* r) { return &r->start; }
   static std::uint32_t& pos(ReadNode* r) { return r->qpos; }
