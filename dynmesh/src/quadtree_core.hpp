@@ -110,9 +110,13 @@ class Directory {
   /// The points' list nodes below level 0 (see below()).
   const StablePool<PNode<d>>& node_pool() const noexcept { return copies_; }
 
-  /// The node of p's point one level below p's, created on first use.
-  PNode<d>* below(PNode<d>* p) {
-    if (!p->down) p->down = copies_.create(p->q);
+  /// The node of p's point one level below p's, created on first use. Its `next` defaults
+  /// to null: the partition does not write a list's end (quadtree_refine.hpp).
+  PNode<d>* below(sac::Engine& rt, PNode<d>* p) {
+    if (!p->down) {
+      p->down = copies_.create(p->q);
+      rt.init_default(p->down->next);
+    }
     return p->down;
   }
   /// Frees the nodes below p that the trace no longer refers to (the deepest levels a point
@@ -120,16 +124,21 @@ class Directory {
   /// had to go is still referred to.
   bool release_below(sac::Engine& rt, PNode<d>* p, bool all) {
     // The levels a point is partitioned at are contiguous from the top, so the unused ones
-    // form a suffix of the chain.
+    // form a suffix of the chain. A list's end is not written, so a listed node's own `next`
+    // is used only if something reads it (today the crowding tests and partitions read every
+    // list end, but this does not rely on it): a node is kept while the node above it is
+    // used, since partitioning the cell above reads that node's `next`.
     PNode<d>* keep = p;
     if (!all)
-      for (PNode<d>* c = p->down; c && !rt.unused(c->next); c = c->down) keep = c;
+      for (PNode<d>* c = p->down; c && !rt.unused(keep->next); c = c->down) keep = c;
     PNode<d>* c = keep->down;
     keep->down = nullptr;
     bool ok = true;
     while (c) {
       PNode<d>* nx = c->down;
-      ok = ok && rt.unused(c->next);
+      // A default that a read once saw has a base version in the engine: retire it.
+      if (rt.unused(c->next)) rt.retire(c->next);
+      else ok = false;
       copies_.destroy(c);
       c = nx;
     }
@@ -140,7 +149,7 @@ class Directory {
   void sweep(sac::Engine& rt) {
     std::vector<Slot<d>*> dead;
     table_.for_each([&](Slot<d>* s) {
-      if (rt.unused(s->split) && rt.unused(s->pts)) dead.push_back(s);
+      if (rt.unused(s->split) && rt.unused(s->pts) && !parent_used(rt, s->id())) dead.push_back(s);
     });
     for (Slot<d>* s : dead) {
       rt.retire(s->split);
@@ -155,8 +164,8 @@ class Directory {
   }
 
   /// Throws InvariantError unless each slot is filed under its own cell and every child of
-  /// a split cell has a slot with a written point list. O(size).
-  void check_invariants(const sac::Engine& rt) const {
+  /// a split cell has a slot. O(size).
+  void check_invariants() const {
     try {
       table_.check_invariants();
     } catch (const InvariantError& e) {
@@ -170,14 +179,23 @@ class Directory {
       if (c.level >= kMaxLevel) throw InvariantError("dynmesh: a level-52 cell is split");
       for (const CellId<d>& k : children(c)) {
         const Slot<d>* ks = find(k);
-        if (!ks || rt.unused(ks->pts))
+        if (!ks)
           throw InvariantError("dynmesh: child " + to_string(k) + " of split cell " + to_string(c) +
-                               " has no point list");
+                               " has no slot");
       }
     });
   }
 
  private:
+  /// Whether c's parent may have been split in the trace: then c's slot stays, even unused,
+  /// because the parent's partition steps hold a pointer to its `pts` (an empty child's
+  /// `pts` is never written, and may never be read).
+  bool parent_used(const sac::Engine& rt, const CellId<d>& c) const {
+    if (c.level == 0) return false;
+    const Slot<d>* p = find(parent(c));
+    return p && !rt.unused(p->split);
+  }
+
   CellIndex<d, Slot<d>> table_;
   StablePool<Slot<d>> pool_;
   StablePool<PNode<d>> copies_;
@@ -410,7 +428,33 @@ class QuadtreeCore {
     if (head.get() != first) throw InvariantError("dynmesh: list head differs from its mirror");
     if (k != by_pos.size() || k != by_id.size())
       throw InvariantError("dynmesh: point indexes hold points not in the input list");
-    dir.check_invariants(rt);
+    dir.check_invariants();
+    check_cell_lists();
+  }
+  /// Every node on a cell's point list is a live node of one of its points, at the cell's
+  /// level and inside the cell: compaction freed nothing that a list still holds. (A list
+  /// ends at a null default, so its last node's `next` may be unused while it is listed.)
+  /// A cell whose list is an input node (level 0) below the root is a postprocess's own
+  /// write (the quadtree mesh's warped leaves), not a partition list.
+  void check_cell_lists() const {
+    std::unordered_map<const PNode<d>*, int> level_of;
+    for (const Node* n = first; n; n = n->succ) {
+      int l = 0;
+      for (const PNode<d>* c = n->down; c; c = c->down) level_of.emplace(c, ++l);
+    }
+    dir.for_each([&](const Slot<d>& s) {
+      const CellId<d> cell = s.id();
+      const PNode<d>* p = s.pts.get();
+      if (!p) return;
+      if (auto in = by_pos.find(p->q); in != by_pos.end() && static_cast<const PNode<d>*>(in->second) == p) return;
+      for (; p; p = p->next.get()) {
+        auto it = level_of.find(p);
+        if (it == level_of.end())
+          throw InvariantError("dynmesh: the point list of " + to_string(cell) + " holds a freed node");
+        if (it->second != cell.level || !contains(cell, p->q))
+          throw InvariantError("dynmesh: the point list of " + to_string(cell) + " holds another cell's node");
+      }
+    });
   }
 
   // ------------------------------------------------------------------ reading the tree
