@@ -286,11 +286,11 @@ void Engine::exec_read(ReadNode* r) {
   ++stats_.events_created;
   ++stats_.live_events;
   const ModBase& m = *r->issued_mod;
-  VersionBase* v = visible_or_default(m, &r->start, r->ops->value);
+  VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
   attach(r, v);
   push_close(&r->end, TaskKind::CloseRead, r);
-  exec_body([&] { r->ops->invoke(*this, r, v); });
+  exec_body([&] { r->ops()->invoke(*this, r, v); });
 }
 
 void Engine::push_close(Stamp* end, TaskKind kind, void* node) {
@@ -311,22 +311,11 @@ void Engine::push_close(Stamp* end, TaskKind kind, void* node) {
 
 void Engine::close_chain(TaskKind kind, void* node) {
   while (node) {
-    Stamp* end;
-    std::uint64_t* flags;
-    if (kind == TaskKind::CloseRead) {
-      auto* r = static_cast<ReadNode*>(node);
-      end = &r->end;
-      flags = nullptr;
-      r->flags |= detail::kReadEndLinked;
-    } else {
-      auto* n = static_cast<MemoNode*>(node);
-      end = &n->end;
-      flags = &n->flags;
-    }
+    Stamp* end = kind == TaskKind::CloseRead ? &static_cast<ReadNode*>(node)->end
+                                             : &static_cast<MemoNode*>(node)->end;
     const std::uintptr_t next = end->link;
     order_.insert_after(now_, end, kind == TaskKind::CloseRead ? StampKind::ReadEnd : StampKind::MemoEnd);
     now_ = end;
-    if (flags) *flags |= detail::kReadEndLinked;
     kind = (next & 1) ? TaskKind::CloseMemo : TaskKind::CloseRead;
     node = reinterpret_cast<void*>(next & ~std::uintptr_t{1});
   }
@@ -340,7 +329,7 @@ void Engine::execute(const Task& t) {
     case TaskKind::ExecMemoRead: {
       auto* r = static_cast<ReadNode*>(t.node);
       if (window_end_) {
-        if (ReadNode* hit = find_read_match(*r->issued_mod, r->ops, closure_of(r))) {
+        if (ReadNode* hit = find_read_match(*r->issued_mod, r->ops_id, closure_of(r))) {
           destroy(r);
           memo_hit(&hit->start, &hit->end);
           break;
@@ -363,7 +352,7 @@ void Engine::execute(const Task& t) {
       }
       link_memo(n, h);
       push_close(&n->end, TaskKind::CloseMemo, n);
-      exec_body([&] { n->invoke(*this, n); });
+      exec_body([&] { n->ops->invoke(*this, n); });
       break;
     }
     case TaskKind::CloseRead:
@@ -431,10 +420,10 @@ void Engine::rerun(ReadNode* r, const ModBase& m) {
   ++stats_.reads_reexecuted;
   ++stats_.last_reexecuted;
   detach(r);
-  VersionBase* v = visible_or_default(m, &r->start, r->ops->value);
+  VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
   attach(r, v);
-  exec_body([&] { r->ops->invoke(*this, r, v); });
+  exec_body([&] { r->ops()->invoke(*this, r, v); });
 }
 
 void Engine::propagate() {
@@ -491,14 +480,15 @@ N* Engine::earliest_match(Candidates&& candidates, Matches&& matches) const {
   return best;
 }
 
-ReadNode* Engine::find_read_match(const ModBase& m, const detail::ReadOps* ops,
+ReadNode* Engine::find_read_match(const ModBase& m, std::uint32_t ops_id,
                                   const void* closure) const {
+  const detail::ReadOps* ops = detail::read_ops_table[ops_id];
   return earliest_match<ReadNode>(
       [&](auto&& offer) {
         for (VersionBase* v = m.newest(); v; v = v->older())
           for (ReadNode* r = v->readers; r; r = r->rnext) offer(r);
       },
-      [&](const ReadNode* r) { return r->ops == ops && ops->equal(r, closure); });
+      [&](const ReadNode* r) { return r->ops_id == ops_id && ops->equal(r, closure); });
 }
 
 AllocNode* Engine::find_alloc_match(const detail::AllocOps* ops, std::size_t h,
@@ -578,7 +568,6 @@ void Engine::undo(Stamp* s) {
         queue_.remove(r);
         ++stats_.queue_removes;
       }
-      r->flags |= detail::kReadDead;
     } else if constexpr (K == StampKind::ReadEnd || K == StampKind::MemoEnd) {
       destroy(rec);
     } else if constexpr (K == StampKind::Write) {
@@ -615,7 +604,6 @@ void Engine::undo(Stamp* s) {
       ++stats_.events_undone;
       --stats_.live_events;
       memos_.erase(n, n->ops->hash(n));
-      n->flags |= detail::kReadDead;
     }
   });
 }
@@ -645,7 +633,7 @@ void Engine::destroy_all() noexcept {
     Stamp* nx = s->next();
     visit_record(s, [this]<StampKind K>(Kind<K>, auto* rec) {
       if constexpr (K == StampKind::ReadStart || K == StampKind::MemoStart) {
-        if (!(rec->flags & detail::kReadEndLinked)) destroy(rec);  // its body threw: no end stamp
+        if (!rec->end.linked()) destroy(rec);  // its body threw: no end stamp
       } else if constexpr (K != StampKind::Sentinel && K != StampKind::User) {
         destroy(rec);
       }
@@ -692,8 +680,8 @@ MemoryBreakdown Engine::memory_breakdown() const {
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
       if constexpr (K == StampKind::ReadStart) {
-        add(b.reads, rec->ops->size, sizeof(ReadNode), 0);
-        ++read_sizes[block_of(rec->ops->size)];
+        add(b.reads, rec->ops()->size, sizeof(ReadNode), 0);
+        ++read_sizes[block_of(rec->ops()->size)];
       } else if constexpr (K == StampKind::Write) {
         add(b.versions, rec->ops->size, sizeof(VersionBase), 0);
       } else if constexpr (K == StampKind::Alloc) {
@@ -746,8 +734,7 @@ void Engine::check_invariants() const {
       if constexpr (K == StampKind::ReadStart) {
         const ReadNode* r = rec;
         ++events;
-        if (r->flags & detail::kReadDead) fail("dead read in the trace");
-        if (!(r->flags & detail::kReadEndLinked)) fail("read without end stamp");
+        if (!r->end.linked()) fail("read without end stamp");
         if (!r->end.linked() || !order_.less(&r->start, &r->end)) fail("read end not after start");
         // Attachment to the version visible at its start is checked below, from the
         // version side (a read record does not name its modifiable; scanning the visible
@@ -774,8 +761,7 @@ void Engine::check_invariants() const {
         const MemoNode* n = rec;
         ++events;
         ++nmemo;
-        if (n->flags & detail::kReadDead) fail("dead memo entry in the trace");
-        if (!(n->flags & detail::kReadEndLinked) || !n->end.linked() ||
+        if (!n->end.linked() ||
             !order_.less(&n->start, &n->end))
           fail("memo entry without a proper end stamp");
         stack.push_back({&n->end, true});

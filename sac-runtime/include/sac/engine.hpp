@@ -229,7 +229,10 @@ class Engine {
   /// Destroys a record through its ops table and returns its memory.
   template <class Rec>
   void destroy(Rec* r) noexcept {
-    const auto* ops = r->ops;
+    const auto* ops = [r] {
+      if constexpr (std::is_base_of_v<detail::ReadNode, Rec>) return r->ops();
+      else return r->ops;
+    }();
     ops->destroy(r);
     deallocate(r, ops->size);
   }
@@ -255,7 +258,7 @@ class Engine {
   void link_memo(detail::MemoNode* n, std::size_t h);
   void set_base(ModBase& m, detail::VersionBase* fresh,
                 bool (*assign_if_changed)(detail::VersionBase*, detail::VersionBase*));
-  detail::ReadNode* find_read_match(const ModBase& m, const detail::ReadOps* ops,
+  detail::ReadNode* find_read_match(const ModBase& m, std::uint32_t ops_id,
                                     const void* closure) const;
   detail::AllocNode* find_alloc_match(const detail::AllocOps* ops, std::size_t h,
                                       const void* key) const;
@@ -407,7 +410,7 @@ void Engine::read(const Mod<T>& m, F&& body) {
   require_computation("read");
   N* r = construct<N>(std::forward<F>(body));
   r->issued_mod = &m;
-  r->ops = &detail::ReadOpsFor<T, Fn>::ops;
+  r->ops_id = detail::ReadOpsFor<T, Fn>::id();
   r->qpos = kNotQueued;
   issue(TaskKind::ExecRead, r);
 }
@@ -472,7 +475,6 @@ void Engine::memo(F&& f) {
   require_computation("memo");
   N* n = construct<N>(std::forward<F>(f));
   n->ops = &detail::MemoOpsFor<Fn>::ops;
-  n->invoke = [](Engine& e, detail::MemoNode* x) { detail::call_thunk(static_cast<N*>(x)->fn, e); };
   issue(TaskKind::ExecMemo, n);
 }
 

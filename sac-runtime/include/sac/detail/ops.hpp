@@ -1,7 +1,7 @@
 // sac/detail/ops.hpp — the static ops tables of the trace records, one per instantiated type.
 //
 // Purpose: a record stores one pointer to its type's ops (destroy, compare, hash, invoke, size;
-// see trace_nodes.hpp) instead of a vtable; the Engine's templates fill it from the tables
+// see trace_nodes.hpp), or for a read its number, instead of a vtable; the Engine's templates fill it from the tables
 // here. Also the StampQueue traits of a read and the calls of a body with or without the
 // Engine.
 // Invariants: ops.size == sizeof(the record type); a table's equal/key_equal/hash are only
@@ -85,6 +85,12 @@ struct ReadOpsFor {
   static constexpr ReadOps ops{&invoke, &destroy,
                                std::equality_comparable<F> ? &equal : nullptr,
                                &VersionOpsFor<T>::ops, sizeof(ReadNodeT<F>)};
+  /// ops' number in read_ops_table (numbered on first use: a function-local static, so no
+  /// read made during static initialisation can see it unnumbered).
+  static std::uint32_t id() {
+    static const std::uint32_t i = register_read_ops(&ops);
+    return i;
+  }
 };
 
 /// A keyed allocation's ops table with the bytes of its key (and the padding before the
@@ -126,8 +132,9 @@ struct MemoOpsFor {
   static bool equal(const MemoNode* n, const void* c) {
     return static_cast<const N*>(n)->fn == *static_cast<const F*>(c);
   }
+  static void invoke(Engine& e, MemoNode* n) { call_thunk(static_cast<N*>(n)->fn, e); }
   static std::size_t hash(const MemoNode* n) { return Hash<F>{}(static_cast<const N*>(n)->fn); }
-  static constexpr MemoOps ops{&destroy, &equal, &hash, sizeof(N)};
+  static constexpr MemoOps ops{&invoke, &destroy, &equal, &hash, sizeof(N)};
 };
 
 }  // namespace sac::detail

@@ -3,10 +3,12 @@
 // Every record embeds its Stamp(s) at a fixed offset so that a stamp met while walking the
 // order list leads back to its record (container_of by kind). Records come from the engine's
 // Pool; their type-specific behaviour (destroy, compare, hash, invoke) sits in a static ops
-// table per instantiated type, so a record costs one pointer for it and no vtable.
+// table per instantiated type, so a record costs one pointer for it and no vtable — a read,
+// the commonest record, only a 32-bit number (read_ops_table).
 //
-// Layout (bytes, 64-bit): VersionBase 40 + value; ReadNode 64 + closure; AllocNode 32 +
-// key + object; MemoNode 64 + closure.
+// Layout (bytes, 64-bit): VersionBase 40 + value; ReadNode 56 + closure; AllocNode 32 +
+// key + object; MemoNode 48 + closure. A read or memo entry keeps no flags: it is dead once
+// its start stamp is unlinked, and closed once its end stamp is linked.
 // Invariants: see Engine::check_invariants().
 #pragma once
 
@@ -82,13 +84,18 @@ struct ReadOps {
   std::uint32_t size;
 };
 
-inline constexpr std::uint32_t kReadDead = 1;       // start stamp undone
-inline constexpr std::uint32_t kReadEndLinked = 2;  // end stamp in the order list
+/// The read ops tables by number, so that a read stores 4 bytes for its ops instead of 8.
+/// A table is numbered the first time a read of its type is made (ReadOpsFor::id()) and
+/// keeps its number for the life of the process. Entry 0 is never used.
+inline constexpr std::uint32_t kMaxReadTypes = std::uint32_t{1} << 16;
+extern const ReadOps* read_ops_table[kMaxReadTypes];
+/// Gives `ops` the next free number. Throws sac::UsageError beyond kMaxReadTypes − 1 types.
+std::uint32_t register_read_ops(const ReadOps* ops);
 
 /// A read. It does not name its modifiable: a live read hangs on a version of it (whose
 /// chain ends at the modifiable), a queued read's modifiable waits with it in the queue, and
-/// an issued read keeps it in `issued_mod` until it runs (the union's other member). This
-/// keeps the record at 64 bytes.
+/// an issued read keeps it in `issued_mod` until it runs (the union's other member). Its ops
+/// table is a number, and its state is its stamps'. This keeps the record at 56 bytes.
 struct ReadNode {
   Stamp start;
   Stamp end;
@@ -97,11 +104,12 @@ struct ReadNode {
     const ModBase* issued_mod;   // issued, not yet run: the modifiable it will read
   };
   ReadNode** rpprev;     // null when attached to no version
-  const ReadOps* ops;
+  std::uint32_t ops_id;  // read_ops_table's index of its ops
   std::uint32_t qpos;
-  std::uint32_t flags;
+
+  const ReadOps* ops() const { return read_ops_table[ops_id]; }
 };
-static_assert(sizeof(ReadNode) == 64);
+static_assert(sizeof(ReadNode) == 56);
 
 template <class F>
 struct ReadNodeT : ReadNode {
@@ -139,6 +147,7 @@ struct PlainAllocNodeT : AllocNode {
 };
 
 struct MemoOps {
+  void (*invoke)(Engine&, MemoNode*);
   void (*destroy)(MemoNode*) noexcept;
   bool (*equal)(const MemoNode*, const void* closure);
   std::size_t (*hash)(const MemoNode*);
@@ -150,9 +159,8 @@ struct MemoNode {
   Stamp end;
   MemoNode* hnext;
   const MemoOps* ops;
-  void (*invoke)(Engine&, MemoNode*);
-  std::uint64_t flags;   // kReadDead / kReadEndLinked, as for reads
 };
+static_assert(sizeof(MemoNode) == 48);
 
 template <class F>
 struct MemoNodeT : MemoNode {
