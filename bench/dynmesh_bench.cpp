@@ -79,8 +79,8 @@ std::string breakdown_text(const QuadtreeMemory& m, std::size_t trace_bytes, std
   row("input list nodes", m.input_nodes, m.input_node_bytes);
   std::snprintf(line, sizeof line,
                 "# total %zu B = trace_bytes() %zu B: %s (unaccounted records %lld B)\n"
-                "# base versions: %llu (1 per input node + the list head = %zu; the directory's defaults"
-                " (Engine::init_default) make one only when a read sees them)\n"
+                "# base versions: %llu (1 per input node + the list head = %zu; a default (Engine::init_default)"
+                " makes one only when it is both read and written)\n"
                 "# outside trace_bytes(): engine vectors %zu B, pool reserved %zu B (unused %zu B, %.1f B/point),"
                 " large blocks %zu B, size-class rounding %zu B\n",
                 m.total(), trace_bytes, m.total() == trace_bytes ? "equal" : "DIFFERENT",

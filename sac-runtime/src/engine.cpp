@@ -162,22 +162,33 @@ VersionBase* Engine::visible(const ModBase& m, const Stamp* t) const {
   return v;
 }
 
-VersionBase* Engine::visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops) {
+const VersionBase* Engine::visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops) {
   if (VersionBase* v = visible(m, t)) return v;
+  // No version at all: the read will hang on m itself, and sees the type's shared T{}.
+  // Most defaults read are never written (a list's end), so they never cost a version.
+  if (m.default_only()) return ops->shared_default ? ops->shared_default() : nullptr;
   const VersionBase* newest = m.newest();
-  const bool defaulted = m.default_only() || (newest && (newest->oldest()->link & VersionBase::kDefaulted));
+  const bool defaulted = newest && (newest->oldest()->link & VersionBase::kDefaulted);
   return default_base(const_cast<ModBase&>(m), defaulted, ops);
 }
 
 VersionBase* Engine::default_base(ModBase& m, bool defaulted, const detail::VersionOps* ops) {
   if (!defaulted || !ops->make_default) return nullptr;
-  // What init(m, T{}) would have made before the first run.
+  // What init(m, T{}) would have made before the first run; the reads that hung on m's
+  // default hang on it now.
+  ReadNode* readers = m.default_readers();
   VersionBase* base = ops->make_default(allocate(ops->size));
   set_base(m, base, nullptr);
+  if (readers) {
+    base->readers = readers;
+    readers->rpprev = &base->readers;
+  }
   return base;
 }
 
 void Engine::link_write(ModBase& m, VersionBase* v) {
+  // Readers of the default and a version: the default needs its own version now.
+  if (m.default_readers()) default_base(m, true, v->ops);
   order_.insert_after(now_, &v->stamp, StampKind::Write);
   now_ = &v->stamp;
   ++stats_.events_created;
@@ -211,6 +222,8 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
 
 void Engine::set_base(ModBase& m, VersionBase* fresh,
                       bool (*assign_if_changed)(VersionBase*, VersionBase*)) {
+  // set() on a default that reads saw: make it a base version, then assign to it.
+  if (assign_if_changed && m.default_readers()) default_base(m, true, fresh->ops);
   VersionBase* last = nullptr;
   for (VersionBase* v = m.newest(); v; v = v->older()) last = v;
   if (VersionBase* base = last && last->is_base() ? last : nullptr) {
@@ -233,6 +246,7 @@ void Engine::set_base(ModBase& m, VersionBase* fresh,
 }
 
 bool Engine::unused(const ModBase& m) const noexcept {
+  if (m.default_only()) return !m.default_readers();
   const VersionBase* v = m.newest();
   return !v || (v->is_base() && !v->older() && !v->readers);
 }
@@ -241,6 +255,7 @@ void Engine::retire(ModBase& m) {
   require_mutator("retire");
   VersionBase* v = m.newest();
   if (!v) {
+    if (m.default_readers()) throw UsageError("sac::Engine::retire: the modifiable is still read");
     m.head_ = 0;  // no version; a default, if any, goes too
     return;
   }
@@ -286,9 +301,9 @@ void Engine::exec_read(ReadNode* r) {
   ++stats_.events_created;
   ++stats_.live_events;
   const ModBase& m = *r->issued_mod;
-  VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
+  const VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
-  attach(r, v);
+  attach_seen(r, m, v);
   push_close(&r->end, TaskKind::CloseRead, r);
   exec_body([&] { r->ops()->invoke(*this, r, v); });
 }
@@ -420,9 +435,9 @@ void Engine::rerun(ReadNode* r, const ModBase& m) {
   ++stats_.reads_reexecuted;
   ++stats_.last_reexecuted;
   detach(r);
-  VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
+  const VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
-  attach(r, v);
+  attach_seen(r, m, v);
   exec_body([&] { r->ops()->invoke(*this, r, v); });
 }
 
@@ -487,6 +502,7 @@ ReadNode* Engine::find_read_match(const ModBase& m, std::uint32_t ops_id,
       [&](auto&& offer) {
         for (VersionBase* v = m.newest(); v; v = v->older())
           for (ReadNode* r = v->readers; r; r = r->rnext) offer(r);
+        for (ReadNode* r = m.default_readers(); r; r = r->rnext) offer(r);
       },
       [&](const ReadNode* r) { return r->ops_id == ops_id && ops->equal(r, closure); });
 }
@@ -578,16 +594,20 @@ void Engine::undo(Stamp* s) {
       ModBase* m = v->mod();
       const bool defaulted = !older && (v->link & VersionBase::kDefaulted);
       unlink_version(m, v);
-      // Its readers see the default now: make it the base version, so that they attach to
-      // it and are cut off when v held the default value too.
-      if (v->readers && defaulted) older = default_base(*m, true, v->ops);
       if (v->readers) {
-        const bool same = older && v->ops->equal(v, older);
+        // Its readers see the default now when v was the oldest: on m itself if m has no
+        // version left, else on the default made a base version. Either way they are cut
+        // off when v held the default value too.
+        const VersionBase* seen = older;
+        if (defaulted)
+          seen = m->default_only() ? v->ops->shared_default() : (older = default_base(*m, true, v->ops));
+        const bool same = seen && v->ops->equal(v, seen);
         for (ReadNode* r = v->readers; r;) {
           ReadNode* nx = r->rnext;
           r->rpprev = nullptr;
           r->rnext = nullptr;
           if (older) attach(r, older);
+          else if (defaulted) attach_default(r, *m);
           if (!same) enqueue(r, *m);
           r = nx;
         }
@@ -729,6 +749,7 @@ void Engine::check_invariants() const {
   std::size_t nkeyed = 0, nmemo = 0;
   AddressSet mods(stats_.live_events / 2);  // the modifiables written (then: or read)
   AddressSet reads(stats_.live_events / 2);
+  std::vector<const ModBase*> default_mods;  // one per modifiable whose default reads hang on it
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
       if constexpr (K == StampKind::ReadStart) {
@@ -740,6 +761,7 @@ void Engine::check_invariants() const {
         // version side (a read record does not name its modifiable; scanning the visible
         // version's readers here would also be quadratic in a modifiable's fan-out).
         reads.insert(r);
+        if (const ModBase* m = default_head(r)) default_mods.push_back(m);
         if (r->qpos != kNotQueued) fail("read still queued");
         stack.push_back({&r->end, false});
       } else if constexpr (K == StampKind::ReadEnd) {
@@ -782,8 +804,8 @@ void Engine::check_invariants() const {
   // Versions of every written or read modifiable: strictly decreasing time, base last,
   // readers between this version and the next newer one (so each reader hangs on the version
   // visible at its time), and every reader a live read of the trace, each exactly once.
-  // A live read hangs on a computation's version or a base version; so the modifiables of
-  // both cover every read.
+  // A live read hangs on a computation's version, a base version or (below) a default with
+  // no version; so these cover every read.
   for (const VersionBase* b : bases_) mods.insert(b->mod());
   std::size_t attached = 0;
   mods.for_each([&](const void* mod) {
@@ -797,7 +819,9 @@ void Engine::check_invariants() const {
         if (!v->stamp.linked()) fail("version with unlinked stamp");
         if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("versions out of order");
       }
-      for (const ReadNode* r = v->readers; r; r = r->rnext) {
+      const ReadNode* const* back = &v->readers;
+      for (const ReadNode* r = v->readers; r; back = &r->rnext, r = r->rnext) {
+        if (r->rpprev != back) fail("a version's reader list has a broken back link");
         if (!v->is_base() && !order_.less(&v->stamp, &r->start)) fail("reader before its version");
         if (newer && !order_.less(&r->start, &newer->stamp)) fail("reader after the next version");
         if (!reads.contains(r)) fail("a version's reader is not a live read of the trace");
@@ -806,6 +830,18 @@ void Engine::check_invariants() const {
       newer = v;
     }
   });
+  // Reads of a default with no version hang on the modifiable; it has no version then.
+  for (const ModBase* m : default_mods) {
+    if (!m->default_only()) fail("a read hangs on the default of a modifiable that has versions");
+    const ReadNode* first = m->default_readers();
+    if (!first || default_head(first) != m) fail("a modifiable's default readers do not start at its head");
+    for (const ReadNode* r = first; r; r = r->rnext) {
+      if (r != first && r->rpprev == nullptr) fail("a default reader has no back link");
+      if (r->rnext && r->rnext->rpprev != &r->rnext) fail("a default reader list has a broken back link");
+      if (!reads.contains(r)) fail("a default reader is not a live read of the trace");
+      ++attached;
+    }
+  }
   if (attached != reads.size()) fail("read not attached to the version visible at its time");
   allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops->hash(n); },
                            [&](const AllocNode* n) {
@@ -836,8 +872,12 @@ void Engine::dump_dot(std::ostream& os) const {
     for (const ReadNode* r = v->readers; r; r = r->rnext) read_mod[r] = v->mod();
   };
   for (const VersionBase* b : bases_) note_readers(b);
-  for (const Stamp* s = order_.base()->next(); s; s = s->next())
+  for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     if (s->kind() == StampKind::Write) note_readers(detail::version_of(const_cast<Stamp*>(s)));
+    if (s->kind() == StampKind::ReadStart)
+      if (const ModBase* m = default_head(detail::read_of_start(const_cast<Stamp*>(s))))
+        for (const ReadNode* r = m->default_readers(); r; r = r->rnext) read_mod[r] = m;
+  }
   std::size_t id = 0;
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     std::string name = "e" + std::to_string(id++);

@@ -44,6 +44,7 @@ struct EngineTestAccess {
   static auto& memos(Engine& e) { return e.memos_; }
   static void attach(detail::ReadNode* r, detail::VersionBase* v) { Engine::attach(r, v); }
   static void detach(detail::ReadNode* r) { Engine::detach(r); }
+  static void attach_default(detail::ReadNode* r, const ModBase& m) { Engine::attach_default(r, m); }
 };
 
 }  // namespace sac
@@ -1223,12 +1224,101 @@ TEST(EngineInitDefault, ReadsTheDefaultAndBehavesAsAWrittenModifiable) {
   EXPECT_THROW(e.init(d, 1), sac::UsageError) << "already has a value";
   e.run([&](Engine& en) { en.read(d, body([po = &out](Engine& x, int v) { x.write(*po, v + 1); })); });
   EXPECT_EQ(out.get(), 1);
-  EXPECT_EQ(e.input_bytes(), 48u) << "the read made the default its base version";
+  EXPECT_EQ(e.input_bytes(), 0u) << "the read hangs on the modifiable: no version is made";
   EXPECT_FALSE(e.unused(d));
+  EXPECT_THROW(e.retire(d), sac::UsageError) << "still read";
   EXPECT_TRUE(e.unused(p));
   e.retire(p);
   EXPECT_FALSE(p.written());
   expect_healthy(e);
+  // set() on a default that a read saw: the default becomes a base version, then changes.
+  e.set(d, 4);
+  EXPECT_EQ(e.input_bytes(), 48u);
+  e.propagate();
+  EXPECT_EQ(out.get(), 5);
+  expect_healthy(e);
+}
+
+// Reads of a default with no version hang on the modifiable (no version is made); a write
+// earlier in time makes the default a base version and moves them onto it; undoing it gives
+// them the default back, cut off when the value is the same; a memo_read of such a default
+// is found and reused by a re-execution.
+TEST(EngineInitDefault, ReadsOfADefaultHangOnTheModifiableUntilItHasAVersion) {
+  Engine e;
+  Mod<int> sel, d, out1, out2, out3;
+  int runs = 0;
+  e.init_default(d);
+  e.set(sel, 0);
+  e.run([&](Engine& en) {
+    en.read(sel, body([pd = &d, po = &out3, pr = &runs](Engine& x, int s) {
+      if (s == 1) x.write(*pd, 7);
+      if (s == 2) x.write(*pd, 0);  // the default's value: its readers are cut off
+      x.write(*po, s);
+      if (s != 3) x.memo_read(*pd, sac::fn<reader_of>(pr, po));
+    }));
+    en.read(d, body([po = &out1](Engine& x, int v) { x.write(*po, v + 1); }));
+    en.read(d, body([po = &out2](Engine& x, int v) { x.write(*po, v + 2); }));
+  });
+  EXPECT_EQ(out1.get(), 1);
+  EXPECT_EQ(out2.get(), 2);
+  EXPECT_EQ(out3.get(), 0);
+  EXPECT_EQ(runs, 1);
+  EXPECT_EQ(e.input_bytes(), 48u) << "sel's base version only: the three reads of d hang on d";
+  EXPECT_FALSE(e.unused(d));
+  expect_healthy(e);
+
+  e.set(sel, 3);  // the memo_read goes: one default reader fewer
+  e.propagate();
+  expect_healthy(e);
+  e.set(sel, 0);  // and comes back, run again
+  e.propagate();
+  expect_healthy(e);
+  EXPECT_EQ(runs, 2);
+  EXPECT_EQ(e.input_bytes(), 48u);
+
+  e.set(sel, 1);  // a version before the reads: the default becomes a base version
+  e.propagate();
+  expect_healthy(e);
+  EXPECT_EQ(out1.get(), 8);
+  EXPECT_EQ(out2.get(), 9);
+  EXPECT_EQ(out3.get(), 7) << "the memo_read saw the write";
+  EXPECT_EQ(e.input_bytes(), 96u);
+
+  e.set(sel, 0);  // undone: the readers see the default again
+  e.propagate();
+  expect_healthy(e);
+  EXPECT_EQ(out1.get(), 1);
+  EXPECT_EQ(out2.get(), 2);
+  EXPECT_EQ(out3.get(), 0);
+
+  e.set(sel, 2);  // a write equal to the default: only sel's reader runs again
+  e.propagate();
+  expect_healthy(e);
+  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  EXPECT_EQ(out3.get(), 0);
+}
+
+TEST(EngineInitDefault, MemoReadOfADefaultWithoutVersionIsReused) {
+  Engine e;
+  Mod<int> in, d, out, dst;
+  int runs = 0;
+  e.init_default(d);
+  e.set(in, 1);
+  e.run([&](Engine& en) {
+    en.read(in, body([pd = &d, po = &out, pr = &runs, pt = &dst](Engine& x, int v) {
+      x.write(*po, v);
+      x.memo_read(*pd, sac::fn<reader_of>(pr, pt));
+    }));
+  });
+  EXPECT_EQ(runs, 1);
+  const Stats s0 = e.stats();
+  e.set(in, 2);
+  e.propagate();
+  expect_healthy(e);
+  EXPECT_EQ(out.get(), 2);
+  EXPECT_EQ(runs, 1) << "the old read of the default was found on d and reused";
+  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 1u);
+  EXPECT_EQ(e.input_bytes(), 48u);
 }
 
 /// The program of the differential test below: for each input a[i] (in order), a value
@@ -1255,7 +1345,8 @@ struct DefaultCells {
 
 // Every output equals a from-scratch run's after every update, on random inputs with a
 // fixed, printed seed; and a from-scratch run makes base versions exactly for the cells
-// whose first event is a read.
+// whose first event is a read and that are written later (a default only read hangs its
+// reads on the modifiable).
 TEST(EngineInitDefault, DifferentialAgainstFromScratch) {
   constexpr std::size_t n = 60, k = 12;
   for (std::uint64_t seed : {1u, 2u, 3u}) {
@@ -1278,18 +1369,20 @@ TEST(EngineInitDefault, DifferentialAgainstFromScratch) {
       DefaultCells fresh(n, k);
       for (std::size_t j = 0; j < n; ++j) f.set(fresh.a[j], in[j]);
       fresh.run(f);
-      std::vector<bool> written(k), named(k);
-      std::size_t read_first = 0;
+      std::vector<bool> written(k), named(k), read_first(k);
       for (std::size_t j = 0; j < n; ++j) {
         const std::size_t v = static_cast<std::size_t>(in[j]), c = v % k;
         if (v < k) written[c] = true;
-        else if (!written[c] && !named[c]) ++read_first;
+        else if (!written[c] && !named[c]) read_first[c] = true;
         named[c] = true;
         if (v >= k) {
           ASSERT_EQ(dyn.out[j].get(), fresh.out[j].get()) << "step " << step << ", out " << j;
         }
       }
-      ASSERT_EQ(f.input_bytes(), (n + read_first) * 48) << "base versions: the inputs and the defaults read first";
+      std::size_t read_then_written = 0;
+      for (std::size_t c = 0; c < k; ++c) read_then_written += read_first[c] && written[c];
+      ASSERT_EQ(f.input_bytes(), (n + read_then_written) * 48)
+          << "base versions: the inputs and the defaults read first and written later";
     }
     expect_healthy(e);
   }
@@ -1714,6 +1807,53 @@ TEST(EngineChecker, ReadDetachedFromItsVersion) {
   EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
   EXPECT_THAT(invariant_message(t.e), HasSubstr("not attached"));
   EngineTestAccess::attach(r, v);
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+TEST(EngineChecker, ReaderListWithABrokenBackLink) {
+  SmallTrace t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  ReadNode* r = t.inner_read();
+  ReadNode** saved = r->rpprev;
+  r->rpprev = &r->rnext;
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("broken back link"));
+  r->rpprev = saved;
+  EXPECT_NO_THROW(t.e.check_invariants());
+}
+
+/// Two reads of a default that has no version: they hang on the modifiable.
+struct DefaultReads {
+  Mod<int> d, out1, out2;
+  Engine e;
+  DefaultReads() {
+    e.init_default(d);
+    e.run([this](Engine& en) {
+      en.read(d, [this](Engine& x, int v) { x.write(out1, v); });
+      en.read(d, [this](Engine& x, int v) { x.write(out2, v); });
+    });
+  }
+  ReadNode* read(int i) {
+    int k = 0;
+    for (Stamp* s = EngineTestAccess::order(e).base()->next(); s; s = s->next())
+      if (s->kind() == StampKind::ReadStart && k++ == i) return sac::detail::read_of_start(s);
+    return nullptr;
+  }
+};
+
+TEST(EngineChecker, DefaultReaderDetachedOrWithABrokenBackLink) {
+  DefaultReads t;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  ReadNode* first = t.read(1);  // the later read was attached last: it heads the list
+  ReadNode* second = t.read(0);
+  ASSERT_EQ(first->rnext, second);
+  ReadNode** saved = second->rpprev;
+  second->rpprev = &second->rnext;
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("default reader list has a broken back link"));
+  second->rpprev = saved;
+  ASSERT_NO_THROW(t.e.check_invariants());
+  EngineTestAccess::detach(second);
+  EXPECT_THAT(invariant_message(t.e), HasSubstr("not attached"));
+  EngineTestAccess::attach_default(second, t.d);
   EXPECT_NO_THROW(t.e.check_invariants());
 }
 

@@ -282,11 +282,19 @@ class Engine {
   void destroy_all() noexcept;
 
   detail::VersionBase* visible(const ModBase& m, const Stamp* t) const;
-  /// What a read of m at t sees: the visible version, else m's default made into its base
-  /// version (init_default), else null. `ops`: m's version type.
-  detail::VersionBase* visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops);
+  /// What a read of m at t sees: the visible version; else, when m has a default
+  /// (init_default), the type's shared default if m has no version (the read then hangs on
+  /// m: attach_default), or m's default made into its base version; else null. `ops`: m's
+  /// version type.
+  const detail::VersionBase* visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops);
+  /// Hangs r on what it sees, v (from visible_or_default).
+  static void attach_seen(detail::ReadNode* r, const ModBase& m, const detail::VersionBase* v) {
+    if (m.default_only()) attach_default(r, m);
+    else attach(r, const_cast<detail::VersionBase*>(v));
+  }
   /// m's default made into its base version, if m has a default (init_default) and no base
-  /// version yet; else null. `defaulted`: whether m has a default.
+  /// version yet (m's default readers move onto it); else null. `defaulted`: whether m has
+  /// a default.
   detail::VersionBase* default_base(ModBase& m, bool defaulted, const detail::VersionOps* ops);
   /// The oldest version's link for m: the modifiable, its end mark and its default flag.
   static std::uintptr_t end_link(const ModBase& m, bool defaulted) {
@@ -302,9 +310,31 @@ class Engine {
     v->readers = r;
     r->rpprev = &v->readers;
   }
+  /// The first of a modifiable's default readers has this bit in its rpprev, which then
+  /// points at the modifiable's head_ (whose kDefaultOnly mark a plain store would lose).
+  static constexpr std::uintptr_t kHeadLink = 1;
+  /// Hangs r on m's default (m has a default and no version).
+  static void attach_default(detail::ReadNode* r, const ModBase& m) {
+    ModBase& w = const_cast<ModBase&>(m);
+    detail::ReadNode* first = w.default_readers();
+    r->rnext = first;
+    if (first) first->rpprev = &r->rnext;
+    w.head_ = reinterpret_cast<std::uintptr_t>(r) | ModBase::kDefaultOnly;
+    r->rpprev = reinterpret_cast<detail::ReadNode**>(reinterpret_cast<std::uintptr_t>(&w.head_) | kHeadLink);
+  }
+  /// The modifiable whose default r hangs on, if r is the first of its default readers.
+  static const ModBase* default_head(const detail::ReadNode* r) {
+    const auto pp = reinterpret_cast<std::uintptr_t>(r->rpprev);
+    return (pp & kHeadLink) ? reinterpret_cast<const ModBase*>(pp & ~kHeadLink) : nullptr;
+  }
   static void detach(detail::ReadNode* r) {
     if (!r->rpprev) return;
-    *r->rpprev = r->rnext;
+    const auto pp = reinterpret_cast<std::uintptr_t>(r->rpprev);
+    if (pp & kHeadLink)
+      *reinterpret_cast<std::uintptr_t*>(pp & ~kHeadLink) =
+          reinterpret_cast<std::uintptr_t>(r->rnext) | ModBase::kDefaultOnly;
+    else
+      *r->rpprev = r->rnext;
     if (r->rnext) r->rnext->rpprev = r->rpprev;
     r->rpprev = nullptr;
     r->rnext = nullptr;

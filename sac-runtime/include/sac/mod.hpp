@@ -3,13 +3,15 @@
 // Purpose: a Mod<T> is a versioned, multi-write cell. Each write inside the computation adds
 // a version at the writer's timestamp; a read sees the latest version before its own time.
 // The mutator gives a modifiable its base value with Engine::set() (a version that precedes
-// all computation time), or a default with Engine::init_default() (T{}, made into a base
-// version only when a read first sees it). A Mod is 8 bytes and may live anywhere: in
+// all computation time), or a default with Engine::init_default() (T{}: while the
+// modifiable has no version, the reads that see the default hang on the modifiable itself;
+// it becomes a base version only when a version is written too). A Mod is 8 bytes and may live anywhere: in
 // mutator-owned structures (inputs) or in objects allocated by the computation
 // (Engine::alloc).
 // Invariants: versions are kept newest first, strictly decreasing in time; a base version,
 // if any, is last; the oldest version's link names the modifiable and says whether it has
-// a default. Only the engine that wrote a Mod may touch it.
+// a default; a modifiable has default readers only while it has no version. Only the
+// engine that wrote a Mod may touch it.
 // Complexity: get() O(1); reads and writes at time t are O(number of versions after t).
 // Follows Acar, Ahmed, Blume, "Imperative self-adjusting computation" (POPL'08).
 #pragma once
@@ -33,17 +35,25 @@ class ModBase {
 
  protected:
   friend class Engine;
-  /// head_ when init_default() gave m a default and no version exists yet.
+  /// Marks head_ when init_default() gave m a default and no version exists yet; the rest
+  /// of head_ is then the first of the reads that see the default (or null).
   static constexpr std::uintptr_t kDefaultOnly = 2;
-  /// True when head_ is kDefaultOnly (the default is a version's flag once one exists).
-  bool default_only() const { return head_ == kDefaultOnly; }
+  /// True when m has a default and no version (the default is a version's flag once one
+  /// exists).
+  bool default_only() const { return (head_ & kDefaultOnly) != 0; }
   /// The newest version, or null.
   detail::VersionBase* newest() const {
-    return head_ == kDefaultOnly ? nullptr : reinterpret_cast<detail::VersionBase*>(head_);
+    return default_only() ? nullptr : reinterpret_cast<detail::VersionBase*>(head_);
+  }
+  /// The reads that see the default while m has no version, linked as a version's readers.
+  detail::ReadNode* default_readers() const {
+    return default_only() ? reinterpret_cast<detail::ReadNode*>(head_ & ~std::uintptr_t{7}) : nullptr;
   }
   void set_newest(detail::VersionBase* v) { head_ = reinterpret_cast<std::uintptr_t>(v); }
-  std::uintptr_t head_ = 0;  // the newest version, 0 or kDefaultOnly
+  // The newest version; or kDefaultOnly | the first default reader; or 0 (never written).
+  std::uintptr_t head_ = 0;
 };
+static_assert(sizeof(ModBase) == sizeof(std::uintptr_t));
 
 template <class T>
 class Mod : public ModBase {

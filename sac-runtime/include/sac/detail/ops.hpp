@@ -54,8 +54,10 @@ struct VersionOpsFor {
       return false;  // no cut-off without operator==
   }
   static VersionBase* make_default(void* mem);
+  static const VersionBase* shared_default();
   static constexpr VersionOps ops{&destroy, &equal,
                                   std::is_default_constructible_v<T> ? &make_default : nullptr,
+                                  std::is_default_constructible_v<T> ? &shared_default : nullptr,
                                   sizeof(Version<T>)};
 };
 
@@ -65,6 +67,20 @@ VersionBase* VersionOpsFor<T>::make_default(void* mem) {
     auto* v = new (mem) Version<T>();
     v->ops = &ops;
     return v;
+  } else {
+    return nullptr;
+  }
+}
+
+template <class T>
+const VersionBase* VersionOpsFor<T>::shared_default() {
+  if constexpr (std::is_default_constructible_v<T>) {
+    struct Holder {
+      Version<T> v;
+      Holder() { v.ops = &ops; }
+    };
+    static const Holder h;
+    return &h.v;
   } else {
     return nullptr;
   }

@@ -33,9 +33,12 @@ struct VersionOps {
   void (*destroy)(VersionBase*) noexcept;
   bool (*equal)(const VersionBase*, const VersionBase*);
   /// Builds a Version<T> holding T{} (ops set) in `mem` of `size` bytes: the base version
-  /// of a modifiable with a default (Engine::init_default), made when a read first sees the
-  /// default. Null when T has no default constructor.
+  /// of a modifiable with a default (Engine::init_default), made once the modifiable has
+  /// both a reader of the default and a version. Null when T has no default constructor.
   VersionBase* (*make_default)(void* mem);
+  /// One process-wide Version<T> holding T{}, in no modifiable: what a read of a default
+  /// that has no base version is handed (its body sees the value only). Null as above.
+  const VersionBase* (*shared_default)();
   std::uint32_t size;
 };
 
