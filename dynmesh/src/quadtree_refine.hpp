@@ -35,8 +35,11 @@
 //     child level is its own, PNode::down, so it needs no keyed allocation), so a new point
 //     changes O(1) expected trace per level; a list ends where nothing more is written (its
 //     last `next`, or an empty child's `pts`, keeps its null default);
-//   * the crowding test of a child k reads only k's first two list cells and, when k holds
-//     exactly one point, the list heads of N(k) until it finds a point;
+//   * a crowded entry says whether its cell holds two points or one (QNode::two), which
+//     decides its children's tests without looking around (classify): when it holds two,
+//     a child's test reads the child's first two list cells; when it holds one, the test
+//     reads the cell's list head, and then the list heads of the rest of N(k) for the one
+//     child holding the point, until it finds a point;
 //   * C_{l+1} is a modifiable list built by destination passing; each walk step is a
 //     memo_read keyed by (list cell, tail), so after a change the walk re-joins the old
 //     trace at the next cell with a crowded child;
@@ -108,11 +111,12 @@ struct Slot {
   sac::Mod<PNode<d>*> pts;       // the cell's points (written by its parent's SPLIT)
 };
 
-/// A crowded-queue entry (C_l), keyed by its cell.
+/// A crowded-queue entry (C_l), keyed by its cell and `two`.
 template <std::size_t d>
 struct QNode {
-  explicit QNode(const CellId<d>& c) : cell(c) {}
+  QNode(const CellId<d>& c, bool t) : cell(c), two(t) {}
   CellId<d> cell;
+  bool two;  // the cell holds two or more points; else one, and N(cell) holds another
   sac::Mod<QNode*> next;
 };
 
@@ -162,7 +166,7 @@ struct Refine {
       if (!a) return x.write(*c0, nullptr);
       x.read(a->next, [c0](sac::Engine& y, Node* b) {
         if (!b) return y.write(*c0, nullptr);
-        QNode<d>* root = y.alloc<QNode<d>>(CellId<d>::root(), CellId<d>::root());
+        QNode<d>* root = y.alloc<QNode<d>>(std::pair{CellId<d>::root(), true}, CellId<d>::root(), true);
         y.write(root->next, nullptr);
         y.write(*c0, root);
       });
@@ -243,31 +247,50 @@ struct Refine {
   /// the entry's cell. A change that one child's test read re-runs the tests from that child
   /// on; the walk re-joins its old trace at the next entry with a crowded child (the memo
   /// key holds the queue's tail).
+  ///
+  /// Child k of e's cell c is crowded when it holds two points, or one while a cell of N(k)
+  /// holds another; the entry says which of its own cases c is in (QNode::two):
+  ///   * c holds two or more points: every nonempty child is crowded, since a child holding
+  ///     one has another point in a sibling, and siblings lie in N(k). Its second list cell
+  ///     only tells which case the child's own entry is in.
+  ///   * c holds one point: only the child holding it can be crowded, and its siblings are
+  ///     empty, so only the rest of N(k) is scanned.
+  /// So no test scans a neighbourhood to learn what its parent's entry already says.
   static void classify(sac::Engine& r, QNode<d>* e, Crowded* out) {
     if (!e) return r.write(*out, nullptr);
-    test_child(r, ctx(r), e, 0, out);
+    if (e->two) test_child(r, ctx(r), e, 0, out);
+    else test_lone(r, ctx(r), e, out);
+  }
+  /// The walk's next step, once e's children are tested.
+  static void next_entry(sac::Engine& r, QNode<d>* e, Crowded* out) {
+    r.memo_read(e->next, sac::fn<&classify>(out));
   }
 
-  /// Child w of e's cell, k, is crowded when it holds two points, or one while a cell of
-  /// N(k) holds another. The tests of e's children run one after another (each continues
-  /// with the queue's new tail), then the walk moves on.
+  /// The tests of e's children (e->two), one after another: each continues with the
+  /// queue's new tail.
   static void test_child(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, Crowded* out) {
-    if (w == static_cast<unsigned>(kChildren<d>))
-      return r.memo_read(e->next, sac::fn<&classify>(out));
+    if (w == static_cast<unsigned>(kChildren<d>)) return next_entry(r, e, out);
     r.read(cx->slot(r, child(e->cell, w)).pts, [e, w, out](sac::Engine& x, Node* a) {
       if (!a) return test_child(x, ctx(x), e, w + 1, out);  // empty: not crowded
-      x.read(a->next, [e, w, out](sac::Engine& y, Node* b) {
-        if (b) return queue_crowded(y, ctx(y), e, w, out);  // two points: self-crowded
-        scan_neighbourhood(y, ctx(y), e, w, 0, out);          // one point: look around
-      });
+      x.read(a->next, [e, w, out](sac::Engine& y, Node* b) { queue_crowded(y, ctx(y), e, w, b != nullptr, out); });
+    });
+  }
+
+  /// e's cell holds one point (!e->two; never the root): the child holding it is crowded
+  /// when a cell of its neighbourhood outside the parent holds a point.
+  static void test_lone(sac::Engine& r, Refine* cx, QNode<d>* e, Crowded* out) {
+    r.read(cx->slot(r, e->cell).pts, [e, out](sac::Engine& x, Node* p) {
+      // Null only while an update is half propagated: the entry's own test re-runs first.
+      if (!p) return next_entry(x, e, out);
+      const unsigned w = child_code(p->q, e->cell.level + 1);
+      scan_neighbourhood(x, ctx(x), e, w, kChildren<d> - 1, out);  // siblings are empty
     });
   }
 
   /// The order in which a child with child number w scans N(k) without k, as offset codes
   /// (digit a, base 3, is the offset on axis a plus one, as in for_each_neighbour): its
-  /// siblings first, by child number, then the rest in code order. When k's parent holds two
-  /// or more points, one besides k's is in a sibling, so the scan usually stops within
-  /// 2^d − 1 reads. A table, so that a scan step computes one cell, not the whole list.
+  /// 2^d − 1 siblings first, by child number, then the rest in code order; test_lone starts
+  /// after the siblings. A table, so that a scan step computes one cell, not the whole list.
   static constexpr int kAround = kNeighbourhood<d> - 1;
   static constexpr auto kScanOrder = [] {
     std::array<std::array<int, kAround>, kChildren<d>> order{};
@@ -310,17 +333,21 @@ struct Refine {
     const CellId<d> k = child(e->cell, w);
     CellId<d> nb;
     while (i < kAround && !offset_cell(k, kScanOrder[w][static_cast<std::size_t>(i)], nb)) ++i;
-    if (i >= kAround) return test_child(r, cx, e, w + 1, out);
+    if (i >= kAround) return next_entry(r, e, out);
     r.read(cx->slot(r, nb).pts, [e, w, i, out](sac::Engine& x, Node* p) {
-      if (p) return queue_crowded(x, ctx(x), e, w, out);
+      if (p) return queue_crowded(x, ctx(x), e, w, false, out);
       scan_neighbourhood(x, ctx(x), e, w, i + 1, out);
     });
   }
 
-  static void queue_crowded(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, Crowded* out) {
-    QNode<d>* k = r.alloc<QNode<d>>(child(e->cell, w), child(e->cell, w));
-    r.write(*out, k);
-    test_child(r, cx, e, w + 1, &k->next);
+  /// Queues child w of e's cell, holding two or more points (`two`) or one; then the rest
+  /// of e's children (none after a lone point's child).
+  static void queue_crowded(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, bool two, Crowded* out) {
+    const CellId<d> k = child(e->cell, w);
+    QNode<d>* q = r.alloc<QNode<d>>(std::pair{k, two}, k, two);
+    r.write(*out, q);
+    if (e->two) test_child(r, cx, e, w + 1, &q->next);
+    else next_entry(r, e, &q->next);
   }
 };
 
