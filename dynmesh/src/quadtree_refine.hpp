@@ -197,19 +197,24 @@ struct Refine {
 
   /// After c split, every leaf one class larger that touches c is ill-graded: split it (c
   /// witnesses it) and, in turn, what that split forces. A leaf that an earlier witness
-  /// already split is skipped.
+  /// already split is skipped. c's parent, the first cell touching c, is split (c is a
+  /// cell of the tree), so it is not read.
   static void regrade(sac::Engine& r, Refine* cx, const CellId<d>& c) {
     if (c.level == 0) return;
-    // The closure holds the cells packed (2·8·d bytes, not 2·(8·d + 8)): there are about
-    // 15 of these reads per point.
+    // The closure holds c packed and the mask that names u from c (8·d + 8 bytes, not
+    // 2·8·d): there are 11 (2D) to 31 (3D) of these reads per point.
     const PackedCell<d> pc = pack_cell<d>(c);
-    for (const CellId<d>& u : coarser_touching(c))
-      r.read(cx->slot(r, u).split, [pu = pack_cell<d>(u), pc](sac::Engine& x, std::uint8_t s) {
-        if (s) return;
-        const CellId<d> uc = unpack_cell<d>(pu);
-        split(x, ctx(x), uc, unpack_cell<d>(pc));
-        regrade(x, ctx(x), uc);
-      });
+    CellId<d> u;
+    for (unsigned mask = 1; mask < static_cast<unsigned>(kChildren<d>); ++mask)
+      if (coarser_touching_at(c, mask, u))
+        r.read(cx->slot(r, u).split, [pc, mask](sac::Engine& x, std::uint8_t s) {
+          if (s) return;
+          const CellId<d> cc = unpack_cell<d>(pc);
+          CellId<d> uc;
+          coarser_touching_at(cc, mask, uc);
+          split(x, ctx(x), uc, cc);
+          regrade(x, ctx(x), uc);
+        });
   }
 
   /// Figure 2's SPLIT: c becomes split and its points go to its children. The witness (c

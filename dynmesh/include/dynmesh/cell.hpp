@@ -12,7 +12,7 @@
 //   touches(a, b)          closed boxes intersect (faces, edges and vertices count), any levels.
 //   for_each_neighbour     N(c) \ {c}: the up to 3^d − 1 same-level cells around c, in the box.
 //   neighbourhood(c)       N(c) ∩ box, c included (the block whose points make c crowded).
-//   for_each_coarser_touching / coarser_touching
+//   for_each_coarser_touching / coarser_touching / coarser_touching_at
 //                          the level m−1 cells that touch a level-m cell: its parent and the
 //                          parent's neighbours on the sides the cell lies on (up to 2^d).
 //   CellHash               hash for unordered containers and detail::CellTable.
@@ -219,28 +219,34 @@ constexpr CellList<d, kNeighbourhood<d>> neighbourhood(const CellId<d>& c) {
   return out;
 }
 
-/// Calls f(u) for each cell u of level c.level − 1 that touches c (c.level ≥ 1): per axis the
-/// parent's index P and, on the side c lies on, P − 1 (c is a lower child) or P + 1 (c is an
-/// upper child) when inside the box. The parent itself comes first.
+/// The cell u of level c.level − 1 that touches c (c.level ≥ 1) selected by `mask`
+/// (0 ≤ mask < 2^d): per axis the parent's index P where the mask bit is 0, and where it is
+/// 1 the index on the side c lies on, P − 1 (c is a lower child) or P + 1 (c is an upper
+/// child). Mask 0 is the parent. False when u would lie outside the box.
+template <std::size_t d>
+constexpr bool coarser_touching_at(const CellId<d>& c, unsigned mask, CellId<d>& u) {
+  u = parent(c);
+  const std::uint64_t n = cells_per_axis(u.level);
+  for (std::size_t a = 0; a < d; ++a) {
+    if (!((mask >> a) & 1u)) continue;
+    if (c.index[a] & 1u) {
+      if (u.index[a] + 1 >= n) return false;
+      ++u.index[a];
+    } else {
+      if (u.index[a] == 0) return false;
+      --u.index[a];
+    }
+  }
+  return true;
+}
+
+/// Calls f(u) for each cell u of level c.level − 1 that touches c (c.level ≥ 1), by mask
+/// (coarser_touching_at): the parent itself first.
 template <std::size_t d, class F>
 constexpr void for_each_coarser_touching(const CellId<d>& c, F&& f) {
-  const CellId<d> p = parent(c);
-  const std::uint64_t n = cells_per_axis(p.level);
-  for (unsigned mask = 0; mask < static_cast<unsigned>(kChildren<d>); ++mask) {
-    CellId<d> u = p;
-    bool inside = true;
-    for (std::size_t a = 0; a < d; ++a) {
-      if (!((mask >> a) & 1u)) continue;
-      if (c.index[a] & 1u) {
-        if (p.index[a] + 1 >= n) inside = false;
-        u.index[a] = p.index[a] + 1;
-      } else {
-        if (p.index[a] == 0) inside = false;
-        u.index[a] = p.index[a] - 1;
-      }
-    }
-    if (inside) f(u);
-  }
+  CellId<d> u;
+  for (unsigned mask = 0; mask < static_cast<unsigned>(kChildren<d>); ++mask)
+    if (coarser_touching_at(c, mask, u)) f(u);
 }
 
 template <std::size_t d>
