@@ -47,16 +47,17 @@ struct MemoryCost {
 // Measured on x86-64 (-O2, glibc malloc) with uniform points written by python3
 // (random.random(), repr): peak RSS ("Maximum resident set size" of /usr/bin/time -v) at
 // n = 10^5, less that of a 10-point run (7 MB, the program itself), over n; then about 30%
-// added, because the cost per point grows slowly with n (2D, 10^6 points: 11,521,524 KiB,
-// 11,798 B/point) and clustered points cost about 5% more than uniform ones. Under
-// `ulimit -v` set to the estimate, the 10^5-point runs below complete. (Before issue 9's
-// first levers: 14,954 and 34,271 B/point, and 20,000 and 44,000 here.)
-//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells          1,136,000 KiB: 11,561 B/point
-//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells --check  1,446,204 KiB: +3,176 B/point
-inline constexpr MemoryCost kQuadtree2dCost{15'500, 4'500};
-//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells          2,339,688 KiB: 23,887 B/point
-//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells --check  3,019,148 KiB: +6,958 B/point
-inline constexpr MemoryCost kOctree3dCost{31'000, 9'000};
+// added, because the cost per point grows slowly with n (2D, 10^6 points: 7,943,080 KiB,
+// 8,134 B/point) and clustered points cost about 5% more than uniform ones. Under
+// `ulimit -v` set to the estimate, the 10^5-point runs below complete. (Before issue 9:
+// 14,954 and 34,271 B/point, and 20,000 and 44,000 here; after its first levers 11,561 and
+// 23,887, and 15,500 and 31,000.)
+//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells          773,184 KiB: 7,841 B/point
+//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells --check  1,111,220 KiB: +3,461 B/point
+inline constexpr MemoryCost kQuadtree2dCost{10'500, 4'500};
+//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells          1,523,724 KiB: 15,526 B/point
+//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells --check  1,944,384 KiB: +4,308 B/point
+inline constexpr MemoryCost kOctree3dCost{20'500, 5'600};
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o          7,050,276 KiB: 72,112 B/point
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o --check  8,130,208 KiB: +11,057 B/point
 inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};

@@ -571,16 +571,16 @@ GNUPLOT
     awk 'BEGIN { for (i = 1; i <= 1000; i++) printf "%d %d\n", i, (i * 7919) % 1009 }' >p.txt
     awk 'BEGIN { for (i = 1; i <= 10; i++) printf "+ %d.5 3.5\n", i }' >e.txt
     { cat p.txt; echo 'x 1'; } >bad.txt # malformed on line 1001: reading it is an error
-    # Unlimited (this machine has the 47 MiB it needs), --force is accepted and changes nothing.
+    # Unlimited (this machine has the 43 MiB it needs), --force is accepted and changes nothing.
     run "$dynmesh" quadtree p.txt --edits e.txt --cells plain.cells
     run "$dynmesh" quadtree p.txt --edits e.txt --cells forced.cells --force
     cmp plain.cells forced.cells || fail "--force changed the tree"
-    # Under ulimit -v: 1010 points (1000 and 10 inserted) need about 32 MiB + 1010 * 15500 bytes.
+    # Under ulimit -v: 1010 points (1000 and 10 inserted) need about 32 MiB + 1010 * 10500 bytes.
     # A sanitizer build reserves terabytes of address space and cannot run under any such limit.
     limit_kib=48000
     if (ulimit -v $limit_kib && "$dynmesh" --help) >/dev/null 2>&1; then
       limited() (ulimit -v $limit_kib && "$@")
-      expect_error 1 'building the quadtree of 1010 points needs about 46.9 MiB, but only ' \
+      expect_error 1 'building the quadtree of 1010 points needs about 42.1 MiB, but only ' \
         limited "$dynmesh" quadtree p.txt --edits e.txt --cells e.cells
       grep -qF 'MiB are available (under the address-space limit, ulimit -v); pass --force to try anyway' err.txt ||
         fail "unclear message: $(cat err.txt)"
@@ -600,8 +600,8 @@ GNUPLOT
     else
       echo "the program cannot run under ulimit -v $limit_kib (a sanitizer build?): the limit is not tested"
     fi
-    # MemAvailable: no machine has the 18 TiB of 10^9 points; refused before generating any.
-    expect_error 1 'building the quadtree of 1000000000 points needs about 18.2 TiB, but only ' \
+    # MemAvailable: no machine has the 14 TiB of 10^9 points; refused before generating any.
+    expect_error 1 'building the quadtree of 1000000000 points needs about 13.6 TiB, but only ' \
       "$dynmesh" stability --dim 2 --dist uniform --n 1000000000 --updates 0 --csv e.csv
     expect_error 1 'building the octree of 1000000001 points needs about ' \
       "$dynmesh" stability --dim 3 --dist uniform --n 1000000000 --updates 2 --csv e.csv
