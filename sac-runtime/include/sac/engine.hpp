@@ -90,11 +90,13 @@ class Engine {
   void init(Mod<T>& m, U&& value);
 
   /// Gives a never-written m the default T{}: what a read sees when no version of m
-  /// precedes it. Costs nothing until such a read runs, which makes the base version then
-  /// (as init(m, T{}) would have), so modifiables named by the thousands outside the trace
-  /// and mostly written before they are read (a directory's cells) hold no memory for
-  /// their defaults. May be called inside the computation, like init(). UsageError if m is
-  /// already written.
+  /// precedes it. Costs no memory of its own: while m has no version, the reads that see
+  /// the default hang on m itself; once m has a version too, the default becomes a base
+  /// version (as init(m, T{}) would have made). So modifiables named by the thousands
+  /// outside the trace (a directory's cells, the ends of lists) hold nothing for their
+  /// defaults. May be called inside the computation, like init(). UsageError if m is
+  /// already written. As for any modifiable, m must outlive the reads of it (unused()
+  /// says when nothing refers to it).
   template <class T>
   void init_default(Mod<T>& m);
 
