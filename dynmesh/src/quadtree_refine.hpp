@@ -35,7 +35,7 @@
 //     child level is its own, PNode::down, so it needs no keyed allocation), so a new point
 //     changes O(1) expected trace per level; a list ends where nothing more is written (its
 //     last `next`, or an empty child's `pts`, keeps its null default);
-//   * a crowded entry says whether its cell holds two points or one (QNode::two), which
+//   * a crowded entry says whether its cell holds two points or one (QNode::two()), which
 //     decides its children's tests without looking around (classify): when it holds two,
 //     a child's test reads the child's first two list cells; when it holds one, the test
 //     reads the cell's list head, and then the list heads of the rest of N(k) for the one
@@ -65,6 +65,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
 #include <tuple>
 #include <utility>
 
@@ -111,13 +112,34 @@ struct Slot {
   sac::Mod<PNode<d>*> pts;       // the cell's points (written by its parent's SPLIT)
 };
 
-/// A crowded-queue entry (C_l), keyed by its cell and `two`.
+/// A crowded-queue entry's key: its cell, packed, and `two` in a bit the packing leaves free
+/// (bit 52 of the first word, below the level's byte). 8·d bytes, not 8·d + 16.
+template <std::size_t d>
+struct QKey {
+  static constexpr std::uint64_t kTwo = std::uint64_t{1} << 52;
+  PackedCell<d> k;
+  QKey(const CellId<d>& c, bool two) : k(pack_cell<d>(c)) { k[0] |= two ? kTwo : 0; }
+  bool operator==(const QKey&) const = default;
+  std::size_t hash() const noexcept {
+    std::uint64_t h = k[0];
+    for (std::size_t a = 1; a < d; ++a) h = mix64(h) ^ k[a];
+    return static_cast<std::size_t>(mix64(h));
+  }
+};
+
+/// A crowded-queue entry (C_l), keyed by its QKey, which it also holds.
 template <std::size_t d>
 struct QNode {
-  QNode(const CellId<d>& c, bool t) : cell(c), two(t) {}
-  CellId<d> cell;
-  bool two;  // the cell holds two or more points; else one, and N(cell) holds another
+  explicit QNode(const QKey<d>& q) : key(q) {}
+  QKey<d> key;
   sac::Mod<QNode*> next;
+  CellId<d> cell() const noexcept {
+    PackedCell<d> k = key.k;
+    k[0] &= ~QKey<d>::kTwo;
+    return unpack_cell<d>(k);
+  }
+  /// The cell holds two or more points; else one, and N(cell) holds another.
+  bool two() const noexcept { return (key.k[0] & QKey<d>::kTwo) != 0; }
 };
 
 /// What the program needs from its owner: the cell directory and the root's point list.
@@ -166,7 +188,8 @@ struct Refine {
       if (!a) return x.write(*c0, nullptr);
       x.read(a->next, [c0](sac::Engine& y, Node* b) {
         if (!b) return y.write(*c0, nullptr);
-        QNode<d>* root = y.alloc<QNode<d>>(std::pair{CellId<d>::root(), true}, CellId<d>::root(), true);
+        const QKey<d> key(CellId<d>::root(), true);
+        QNode<d>* root = y.alloc<QNode<d>>(key, key);
         y.write(root->next, nullptr);
         y.write(*c0, root);
       });
@@ -190,8 +213,9 @@ struct Refine {
   static void split_crowded(sac::Engine& r, QNode<d>* e) {
     if (!e) return;
     Refine* cx = ctx(r);
-    split(r, cx, e->cell, e->cell);
-    regrade(r, cx, e->cell);
+    const CellId<d> c = e->cell();
+    split(r, cx, c, c);
+    regrade(r, cx, c);
     r.memo_read(e->next, sac::fn<&split_crowded>());
   }
 
@@ -201,20 +225,35 @@ struct Refine {
   /// cell of the tree), so it is not read.
   static void regrade(sac::Engine& r, Refine* cx, const CellId<d>& c) {
     if (c.level == 0) return;
-    // The closure holds c packed and the mask that names u from c (8·d + 8 bytes, not
-    // 2·8·d): there are 11 (2D) to 31 (3D) of these reads per point.
-    const PackedCell<d> pc = pack_cell<d>(c);
+    // The closure holds c packed, with the mask that names u from c in spare index bits
+    // (8·d bytes, not 2·8·d): there are 11 (2D) to 31 (3D) of these reads per point.
     CellId<d> u;
     for (unsigned mask = 1; mask < static_cast<unsigned>(kChildren<d>); ++mask)
       if (coarser_touching_at(c, mask, u))
-        r.read(cx->slot(r, u).split, [pc, mask](sac::Engine& x, std::uint8_t s) {
+        r.read(cx->slot(r, u).split, [pm = pack_with_mask(c, mask)](sac::Engine& x, std::uint8_t s) {
           if (s) return;
-          const CellId<d> cc = unpack_cell<d>(pc);
+          unsigned mk;
+          const CellId<d> cc = unpack_with_mask(pm, mk);
           CellId<d> uc;
-          coarser_touching_at(cc, mask, uc);
+          coarser_touching_at(cc, mk, uc);
           split(x, ctx(x), uc, cc);
           regrade(x, ctx(x), uc);
         });
+  }
+
+  /// A cell packed with a coarser-touching mask (< 2^d) in bits 52.. of its last index word,
+  /// which indices (< 2^52) leave free (in the first word, below the level's byte).
+  static constexpr int kMaskShift = 52;
+  static constexpr std::uint64_t kMaskBits = static_cast<std::uint64_t>(kChildren<d> - 1);
+  static PackedCell<d> pack_with_mask(const CellId<d>& c, unsigned mask) {
+    PackedCell<d> k = pack_cell<d>(c);
+    k[d - 1] |= static_cast<std::uint64_t>(mask) << kMaskShift;
+    return k;
+  }
+  static CellId<d> unpack_with_mask(PackedCell<d> k, unsigned& mask) {
+    mask = static_cast<unsigned>((k[d - 1] >> kMaskShift) & kMaskBits);
+    k[d - 1] &= ~(kMaskBits << kMaskShift);
+    return unpack_cell<d>(k);
   }
 
   /// Figure 2's SPLIT: c becomes split and its points go to its children. The witness (c
@@ -228,12 +267,24 @@ struct Refine {
     for (unsigned w = 0; w < static_cast<unsigned>(kChildren<d>); ++w)
       to.to[w] = &cx->slot(r, child(c, w)).pts;
     List& points = c.level == 0 ? *cx->input : cell.pts;
-    r.memo_read(points, sac::fn<&partition>(pack_cell<d>(witness), c.level + 1, to));
+    r.memo_read(points, sac::fn<&partition>(partition_key(witness, c.level + 1), to));
   }
 
-  /// One step of the partition; `witness` (packed: one record per point per level) is only
-  /// part of the memo key.
-  static void partition(sac::Engine& r, Node* p, PackedCell<d> witness, int child_level, Dests to) {
+  /// A partition step's memo key besides its list cell and destinations: the child level
+  /// (low 6 bits) and a 58-bit hash of the witness. The witness only keeps a memo match
+  /// near its own split; the step computes the same thing whatever it is, so two witnesses
+  /// that collide cost stability at worst, never correctness. Hashing it saves 8·d bytes in
+  /// each of the partition's records, one per point and level.
+  static std::uint64_t partition_key(const CellId<d>& witness, int child_level) {
+    const PackedCell<d> w = pack_cell<d>(witness);
+    std::uint64_t h = w[0];
+    for (std::size_t a = 1; a < d; ++a) h = mix64(h) ^ w[a];
+    return (mix64(h) << 6) | static_cast<std::uint64_t>(child_level);
+  }
+  static int key_level(std::uint64_t key) { return static_cast<int>(key & 63u); }
+
+  /// One step of the partition (`key`: partition_key()).
+  static void partition(sac::Engine& r, Node* p, std::uint64_t key, Dests to) {
     // The lists end without a write: every destination is a slot's `pts` or a node's
     // `next`, written at most once in a consistent trace and defaulting to null
     // (Engine::init_default), so "null from here on" is what the default already says. A
@@ -241,11 +292,11 @@ struct Refine {
     // 45% of the 2D versions and 69% of the 3D ones; a third (2D) and half (3D) of them were
     // never read.
     if (!p) return;
-    const unsigned w = child_code(p->q, child_level);
+    const unsigned w = child_code(p->q, key_level(key));
     Node* copy = ctx(r)->dir->below(r, p);
     r.write(*to.to[w], copy);
     to.to[w] = &copy->next;
-    r.memo_read(p->next, sac::fn<&partition>(witness, child_level, to));
+    r.memo_read(p->next, sac::fn<&partition>(key, to));
   }
 
   /// Step of the second walk over C_l, after all its splits: queue the crowded children of
@@ -254,7 +305,7 @@ struct Refine {
   /// key holds the queue's tail).
   ///
   /// Child k of e's cell c is crowded when it holds two points, or one while a cell of N(k)
-  /// holds another; the entry says which of its own cases c is in (QNode::two):
+  /// holds another; the entry says which of its own cases c is in (QNode::two()):
   ///   * c holds two or more points: every nonempty child is crowded, since a child holding
   ///     one has another point in a sibling, and siblings lie in N(k). Its second list cell
   ///     only tells which case the child's own entry is in.
@@ -263,7 +314,7 @@ struct Refine {
   /// So no test scans a neighbourhood to learn what its parent's entry already says.
   static void classify(sac::Engine& r, QNode<d>* e, Crowded* out) {
     if (!e) return r.write(*out, nullptr);
-    if (e->two) test_child(r, ctx(r), e, 0, out);
+    if (e->two()) test_child(r, ctx(r), e, 0, out);
     else test_lone(r, ctx(r), e, out);
   }
   /// The walk's next step, once e's children are tested.
@@ -271,23 +322,41 @@ struct Refine {
     r.memo_read(e->next, sac::fn<&classify>(out));
   }
 
-  /// The tests of e's children (e->two), one after another: each continues with the
+  /// An entry with the child number and scan position of a test, in one word: a crowding
+  /// closure is then 16 bytes, not 24 (about 11 reads per point in 2D). User-space
+  /// addresses fit in 48 bits on x86-64 and AArch64 Linux (checked).
+  struct At {
+    std::uint64_t bits;
+    At(QNode<d>* e, unsigned w, int i = 0)
+        : bits(reinterpret_cast<std::uintptr_t>(e) | std::uint64_t{w} << 48 |
+               static_cast<std::uint64_t>(i) << 56) {
+      if (reinterpret_cast<std::uintptr_t>(e) >> 48 != 0) [[unlikely]]
+        throw std::logic_error("dynmesh: a heap address above 2^48; crowding closures cannot pack it");
+    }
+    QNode<d>* e() const { return reinterpret_cast<QNode<d>*>(bits & ((std::uint64_t{1} << 48) - 1)); }
+    unsigned w() const { return static_cast<unsigned>((bits >> 48) & 0xffu); }
+    int i() const { return static_cast<int>(bits >> 56); }
+  };
+
+  /// The tests of e's children (e->two()), one after another: each continues with the
   /// queue's new tail.
   static void test_child(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, Crowded* out) {
     if (w == static_cast<unsigned>(kChildren<d>)) return next_entry(r, e, out);
-    r.read(cx->slot(r, child(e->cell, w)).pts, [e, w, out](sac::Engine& x, Node* a) {
-      if (!a) return test_child(x, ctx(x), e, w + 1, out);  // empty: not crowded
-      x.read(a->next, [e, w, out](sac::Engine& y, Node* b) { queue_crowded(y, ctx(y), e, w, b != nullptr, out); });
+    r.read(cx->slot(r, child(e->cell(), w)).pts, [at = At(e, w), out](sac::Engine& x, Node* a) {
+      if (!a) return test_child(x, ctx(x), at.e(), at.w() + 1, out);  // empty: not crowded
+      x.read(a->next, [at, out](sac::Engine& y, Node* b) {
+        queue_crowded(y, ctx(y), at.e(), at.w(), b != nullptr, out);
+      });
     });
   }
 
-  /// e's cell holds one point (!e->two; never the root): the child holding it is crowded
+  /// e's cell holds one point (!e->two(); never the root): the child holding it is crowded
   /// when a cell of its neighbourhood outside the parent holds a point.
   static void test_lone(sac::Engine& r, Refine* cx, QNode<d>* e, Crowded* out) {
-    r.read(cx->slot(r, e->cell).pts, [e, out](sac::Engine& x, Node* p) {
+    r.read(cx->slot(r, e->cell()).pts, [e, out](sac::Engine& x, Node* p) {
       // Null only while an update is half propagated: the entry's own test re-runs first.
       if (!p) return next_entry(x, e, out);
-      const unsigned w = child_code(p->q, e->cell.level + 1);
+      const unsigned w = child_code(p->q, e->cell().level + 1);
       scan_neighbourhood(x, ctx(x), e, w, kChildren<d> - 1, out);  // siblings are empty
     });
   }
@@ -335,23 +404,24 @@ struct Refine {
 
   static void scan_neighbourhood(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, int i,
                                  Crowded* out) {
-    const CellId<d> k = child(e->cell, w);
+    const CellId<d> k = child(e->cell(), w);
     CellId<d> nb;
     while (i < kAround && !offset_cell(k, kScanOrder[w][static_cast<std::size_t>(i)], nb)) ++i;
     if (i >= kAround) return next_entry(r, e, out);
-    r.read(cx->slot(r, nb).pts, [e, w, i, out](sac::Engine& x, Node* p) {
-      if (p) return queue_crowded(x, ctx(x), e, w, false, out);
-      scan_neighbourhood(x, ctx(x), e, w, i + 1, out);
+    r.read(cx->slot(r, nb).pts, [at = At(e, w, i), out](sac::Engine& x, Node* p) {
+      if (p) return queue_crowded(x, ctx(x), at.e(), at.w(), false, out);
+      scan_neighbourhood(x, ctx(x), at.e(), at.w(), at.i() + 1, out);
     });
   }
 
   /// Queues child w of e's cell, holding two or more points (`two`) or one; then the rest
   /// of e's children (none after a lone point's child).
   static void queue_crowded(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, bool two, Crowded* out) {
-    const CellId<d> k = child(e->cell, w);
-    QNode<d>* q = r.alloc<QNode<d>>(std::pair{k, two}, k, two);
+    const CellId<d> k = child(e->cell(), w);
+    const QKey<d> key(k, two);
+    QNode<d>* q = r.alloc<QNode<d>>(key, key);
     r.write(*out, q);
-    if (e->two) test_child(r, cx, e, w + 1, &q->next);
+    if (e->two()) test_child(r, cx, e, w + 1, &q->next);
     else next_entry(r, e, &q->next);
   }
 };
