@@ -235,6 +235,7 @@ int run_mesh(const MeshCommandOptions& o) {
     if (!v.ok) throw InvariantError("--check failed: " + v.problem);
   }
 
+  built.reset();  // as in `dynmesh quadtree`: the outputs are formatted without the trace
   write_outputs(o, mesh, box, inputs, feed, initial.duplicates_skipped);
   return 0;
 }
