@@ -276,10 +276,7 @@ struct Refine {
   /// that collide cost stability at worst, never correctness. Hashing it saves 8·d bytes in
   /// each of the partition's records, one per point and level.
   static std::uint64_t partition_key(const CellId<d>& witness, int child_level) {
-    const PackedCell<d> w = pack_cell<d>(witness);
-    std::uint64_t h = w[0];
-    for (std::size_t a = 1; a < d; ++a) h = mix64(h) ^ w[a];
-    return (mix64(h) << 6) | static_cast<std::uint64_t>(child_level);
+    return (static_cast<std::uint64_t>(witness.hash()) << 6) | static_cast<std::uint64_t>(child_level);
   }
   static int key_level(std::uint64_t key) { return static_cast<int>(key & 63u); }
 

@@ -5,9 +5,9 @@
 // The mutator gives a modifiable its base value with Engine::set() (a version that precedes
 // all computation time), or a default with Engine::init_default() (T{}: while the
 // modifiable has no version, the reads that see the default hang on the modifiable itself;
-// it becomes a base version only when a version is written too). A Mod is 8 bytes and may live anywhere: in
-// mutator-owned structures (inputs) or in objects allocated by the computation
-// (Engine::alloc).
+// it becomes a base version only when a version is written too). A Mod is 8 bytes and may
+// live anywhere: in mutator-owned structures (inputs) or in objects allocated by the
+// computation (Engine::alloc).
 // Invariants: versions are kept newest first, strictly decreasing in time; a base version,
 // if any, is last; the oldest version's link names the modifiable and says whether it has
 // a default; a modifiable has default readers only while it has no version. Only the

@@ -1,9 +1,9 @@
 // sac/detail/ops.hpp — the static ops tables of the trace records, one per instantiated type.
 //
 // Purpose: a record stores one pointer to its type's ops (destroy, compare, hash, invoke, size;
-// see trace_nodes.hpp), or for a read its number, instead of a vtable; the Engine's templates fill it from the tables
-// here. Also the StampQueue traits of a read and the calls of a body with or without the
-// Engine.
+// see trace_nodes.hpp), or for a read its number, instead of a vtable; the Engine's
+// templates fill it from the tables here. Also the StampQueue traits of a read and the calls
+// of a body with or without the Engine.
 // Invariants: ops.size == sizeof(the record type); a table's equal/key_equal/hash are only
 // called on records that carry that same table, so the casts are exact; an ops table with
 // key_equal set is the `ops` member of a KeyedAllocOps.
