@@ -10,7 +10,7 @@
 #include <string>
 #include <tuple>
 
-#include "cell_index.hpp"
+#include "quadtree/cell_index.hpp"
 #include "dynmesh/errors.hpp"
 
 namespace dynmesh {

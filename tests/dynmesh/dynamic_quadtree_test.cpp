@@ -31,7 +31,7 @@
 #include "dynmesh/errors.hpp"
 #include "dynmesh/io.hpp"
 #include "dynmesh/static_quadtree.hpp"
-#include "dynamic_quadtree_state.hpp"  // dynmesh/src: the private state, for the hook below
+#include "quadtree/dynamic_quadtree_state.hpp"  // dynmesh/src: the private state, for the hook below
 
 namespace dynmesh {
 

@@ -1,4 +1,4 @@
-// hpu_mesh_test.cpp — hpu_mesh.hpp and its triangulation (src/delaunay.hpp): the mesh
+// hpu_mesh_test.cpp — hpu_mesh.hpp and its triangulation (src/geometry/delaunay.hpp): the mesh
 // contract at 20.7°, 25° and 30° (Delaunay by exact predicates, every angle, tiling, inputs
 // present) on every distribution, independence of the input order, bad input, and the
 // size against Triangle's on the unif1e4 input.
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "delaunay.hpp"
+#include "geometry/delaunay.hpp"
 #include "dynamic_test_support.hpp"
 #include "dynmesh/distributions.hpp"
 #include "dynmesh/errors.hpp"

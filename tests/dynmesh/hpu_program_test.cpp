@@ -1,10 +1,10 @@
-// hpu_program_test.cpp — src/hpu_program.hpp, DynHPU's off-center refinement as a
+// hpu_program_test.cpp — src/hpu/hpu_program.hpp, DynHPU's off-center refinement as a
 // self-adjusting program: from scratch (uniform, clustered, points near and on the box
 // sides, a grid) and after every update of a dynamic run, its triangles equal the static
 // twin HpuMesh's on the current points at 20.7°, 25° and 30°; the engine's and the
 // triangulation's invariants hold; the per-update trace distance is printed against the
 // from-scratch trace, and bounded to catch a program that re-runs everything.
-#include "hpu_program.hpp"
+#include "hpu/hpu_program.hpp"
 
 #include <gtest/gtest.h>
 
@@ -30,9 +30,9 @@
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
 #include "dynmesh/edit.hpp"
-#include "hpu_geometry.hpp"
-#include "hpu_inputs.hpp"
-#include "sa_delaunay.hpp"
+#include "hpu/hpu_geometry.hpp"
+#include "hpu/hpu_inputs.hpp"
+#include "hpu/sa_delaunay.hpp"
 #include "../sanitized.hpp"
 #include "same_triangles.hpp"
 

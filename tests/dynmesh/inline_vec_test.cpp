@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "inline_vec.hpp"
+#include "hpu/inline_vec.hpp"
 
 namespace dynmesh {
 namespace {

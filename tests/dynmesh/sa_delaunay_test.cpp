@@ -1,10 +1,10 @@
-// sa_delaunay_test.cpp — src/sa_delaunay.hpp, the self-adjusting Delaunay triangulation:
+// sa_delaunay_test.cpp — src/hpu/sa_delaunay.hpp, the self-adjusting Delaunay triangulation:
 // from scratch and after every update (single and batched, on random and on degenerate
-// points) its triangles equal the static twin's (src/delaunay.hpp) on the current points;
+// points) its triangles equal the static twin's (src/geometry/delaunay.hpp) on the current points;
 // the engine's and the triangulation's invariants hold; the trace distance of an update is
 // a small fraction of the from-scratch trace (printed, and bounded to catch a program that
 // re-runs everything); the star building block, read in a later run, stays up to date.
-#include "sa_delaunay.hpp"
+#include "hpu/sa_delaunay.hpp"
 
 #include <gtest/gtest.h>
 
@@ -24,7 +24,7 @@
 
 #include <sac/engine.hpp>
 
-#include "delaunay.hpp"
+#include "geometry/delaunay.hpp"
 #include "dynamic_test_support.hpp"
 #include "same_triangles.hpp"
 #include "dynmesh/box.hpp"

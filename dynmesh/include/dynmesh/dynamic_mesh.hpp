@@ -6,8 +6,8 @@
 // carries the change through the tree into the mesh, and the triangles it removed and added
 // are reported as the change feed (last_change()). The mesh is always exactly the static
 // twin's mesh of the current point set: HpuMesh for Postprocess::Hpu (the default; the
-// program is src/hpu_program.hpp on src/sa_delaunay.hpp, reading the inputs and their side
-// midpoints from a list the mutator keeps, src/hpu_inputs.hpp), QuadtreeMesh for
+// program is src/hpu/hpu_program.hpp on src/hpu/sa_delaunay.hpp, reading the inputs and their side
+// midpoints from a list the mutator keeps, src/hpu/hpu_inputs.hpp), QuadtreeMesh for
 // Postprocess::Quadtree.
 //
 // Invariants (check_invariants()): the engine's invariants; the quadtree program's

@@ -6,7 +6,7 @@
 // the points by off-centers processed in size classes, smallest first (Har-Peled & Üngör's
 // order, the seed's Figure 5), and treats the box's sides as segments, as Triangle does with
 // a .poly file. It is the oracle and the baseline of the self-adjusting hpu mesh
-// (src/hpu_program.hpp).
+// (src/hpu/hpu_program.hpp).
 //
 // The algorithm is the seed's Figure 5 on loose pairs, with the choices it leaves open made
 // as follows (ρ = 1/(2 sin θ), k = √(ρ² − 1/4) = 1/(2 tan θ); DESIGN.md, "DynHPU"):
@@ -15,7 +15,7 @@
 //      inside one projects strictly inside the edge, so these form one path down the
 //      halvings per point, computed from the points alone). Candidates are edges of their
 //      Delaunay triangulation (unique: degenerate cases follow a symbolic perturbation by
-//      (x, y) rank, src/delaunay.hpp).
+//      (x, y) rank, src/geometry/delaunay.hpp).
 //   2. Loose: p→q is ccw-loose when no vertex lies strictly inside its ccw-leaf, the disc
 //      through p and q with centre m + k·J(q − p) (m the midpoint, J the +90° turn), decided
 //      exactly by predicates.hpp's pencil(). For a Delaunay edge pq the leaf is empty exactly
@@ -25,7 +25,7 @@
 //   3. Classes: the class of pq is ⌊log2 |pq|⌋ (from the double exponent of |pq|²). Queue
 //      entries are vertices, Q_j a FIFO per class. A vertex enters at the class of its
 //      shortest edge (the first entries: the corners, then the other vertices in BRIO order,
-//      src/hpu_geometry.hpp's insertion_less, which keeps the self-adjusting version's
+//      src/hpu/hpu_geometry.hpp's insertion_less, which keeps the self-adjusting version's
 //      updates local); its entry in Q_j collects its loose pairs of class ≤ j (both sides,
 //      in (x, y) order of their ends) and re-enters it in the queue of its next longer
 //      edge's class. A new vertex enters at max(current class, its shortest edge's class).
@@ -56,9 +56,9 @@
 // spiral).
 //
 // The self-adjusting version: DynamicMesh with Postprocess::Hpu (dynamic_mesh.hpp) runs
-// this algorithm on the runtime (src/hpu_program.hpp, on the self-adjusting triangulation of
-// src/sa_delaunay.hpp, reading the inputs and side midpoints from a list the mutator keeps,
-// src/hpu_inputs.hpp), and is bit-identical to this twin after every update
+// this algorithm on the runtime (src/hpu/hpu_program.hpp, on the self-adjusting triangulation of
+// src/hpu/sa_delaunay.hpp, reading the inputs and side midpoints from a list the mutator keeps,
+// src/hpu/hpu_inputs.hpp), and is bit-identical to this twin after every update
 // (tests/dynmesh/dynamic_mesh_test.cpp, hpu_program_test.cpp).
 //
 // Invariants: check_invariants(): the triangulation's own invariants (Delaunay, tiling) and

@@ -8,7 +8,7 @@
 // ccwerrboundA and iccerrboundA); otherwise, and whenever a coordinate difference leaves the
 // range in which that bound holds (no product may underflow or overflow), it asks
 // CGAL's Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
-// interval filter with an exact fallback. CGAL's headers are confined to src/predicates.cpp.
+// interval filter with an exact fallback. CGAL's headers are confined to src/geometry/predicates.cpp.
 // The inline stage decides nearly all calls on meshing input and saves the call and CGAL's
 // own filter setup (the predicates were a third of the hpu mesh's build time).
 //

@@ -13,7 +13,7 @@
 #include <cstddef>
 
 #include "dynmesh/cell.hpp"
-#include "quadtree_core.hpp"
+#include "quadtree/quadtree_core.hpp"
 
 namespace dynmesh::detail {
 

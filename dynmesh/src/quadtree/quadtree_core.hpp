@@ -40,8 +40,8 @@
 #include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/edit.hpp"
 #include "dynmesh/errors.hpp"
-#include "cell_index.hpp"
-#include "quadtree_refine.hpp"
+#include "quadtree/cell_index.hpp"
+#include "quadtree/quadtree_refine.hpp"
 
 namespace dynmesh::detail {
 

@@ -48,8 +48,8 @@
 #include "dynmesh/edit.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
-#include "hpu_geometry.hpp"
-#include "sa_delaunay.hpp"
+#include "hpu/hpu_geometry.hpp"
+#include "hpu/sa_delaunay.hpp"
 
 namespace dynmesh::detail {
 

@@ -43,7 +43,7 @@
 
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/mesh.hpp"
-#include "quadtree_core.hpp"
+#include "quadtree/quadtree_core.hpp"
 
 namespace dynmesh::detail {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <utility>
 
-#include "dynamic_quadtree_state.hpp"
+#include "quadtree/dynamic_quadtree_state.hpp"
 #include "dynmesh/detail/touching_leaves.hpp"
 
 namespace dynmesh {

@@ -13,12 +13,12 @@
 
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/mesh_check.hpp"
-#include "hpu_geometry.hpp"
-#include "hpu_inputs.hpp"
-#include "hpu_program.hpp"
-#include "quadtree_core.hpp"
-#include "quadtree_mesh_program.hpp"
-#include "sa_delaunay.hpp"
+#include "hpu/hpu_geometry.hpp"
+#include "hpu/hpu_inputs.hpp"
+#include "hpu/hpu_program.hpp"
+#include "quadtree/quadtree_core.hpp"
+#include "quadtree_mesh/quadtree_mesh_program.hpp"
+#include "hpu/sa_delaunay.hpp"
 
 namespace dynmesh {
 namespace detail {

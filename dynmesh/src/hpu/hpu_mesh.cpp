@@ -13,14 +13,14 @@
 #include <utility>
 #include <vector>
 
-#include "delaunay.hpp"
-#include "hpu_geometry.hpp"
+#include "geometry/delaunay.hpp"
+#include "hpu/hpu_geometry.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh_check.hpp"
 #include "dynmesh/predicates.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
-#include "locate_points.hpp"
-#include "z_order.hpp"
+#include "io/locate_points.hpp"
+#include "geometry/z_order.hpp"
 
 namespace dynmesh {
 namespace {

@@ -74,8 +74,8 @@
 #include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
 #include "dynmesh/predicates.hpp"
-#include "hpu_geometry.hpp"
-#include "sa_delaunay.hpp"
+#include "hpu/hpu_geometry.hpp"
+#include "hpu/sa_delaunay.hpp"
 
 namespace dynmesh::detail {
 

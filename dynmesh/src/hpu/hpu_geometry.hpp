@@ -28,7 +28,7 @@
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
 #include "dynmesh/predicates.hpp"
-#include "z_order.hpp"
+#include "geometry/z_order.hpp"
 
 namespace dynmesh::detail {
 

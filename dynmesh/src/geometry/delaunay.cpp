@@ -1,5 +1,5 @@
 // delaunay.cpp — Bowyer–Watson insertion with a perturbed in-circle test (see delaunay.hpp).
-#include "delaunay.hpp"
+#include "geometry/delaunay.hpp"
 
 #include <algorithm>
 #include <string>

@@ -13,7 +13,7 @@
 #include "dynmesh/detail/cell_table.hpp"
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/errors.hpp"
-#include "locate_points.hpp"
+#include "io/locate_points.hpp"
 
 namespace dynmesh {
 namespace {

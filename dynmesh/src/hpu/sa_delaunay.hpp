@@ -122,8 +122,8 @@
 #include <sac/fn.hpp>
 #include <sac/mod.hpp>
 
-#include "delaunay.hpp"
-#include "inline_vec.hpp"
+#include "geometry/delaunay.hpp"
+#include "hpu/inline_vec.hpp"
 #include "dynmesh/box.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh.hpp"

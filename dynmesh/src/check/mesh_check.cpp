@@ -10,7 +10,7 @@
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/predicates.hpp"
-#include "z_order.hpp"
+#include "geometry/z_order.hpp"
 
 namespace dynmesh {
 
