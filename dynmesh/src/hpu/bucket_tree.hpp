@@ -1,0 +1,181 @@
+// bucket_tree.hpp (private) — the mesh vertices by cell: a point-region quadtree whose leaves
+// hold at most kCapacity vertices each.
+//
+// Purpose: the store that the hpu mesh's questions are answered from (cell_questions.hpp).
+// A question of size class j is a disc of radius O(2^j) around a pair; it reads the leaves
+// that meet the disc's bounding box and runs exact predicates on their vertices, so the
+// vertices far from the question are never looked at, however they are triangulated.
+// Cells are the quadtree's dyadic cells of the box, located by the exact integer position
+// of the mesh contract (q = ⌊(x − o)·2^52/L⌋, clamped to the grid so that the box's far
+// sides fall in the last cells).
+//
+// Invariants (check_invariants()): a leaf holds at most kCapacity vertices unless it is at
+// the finest level; a split cell holds more than kCapacity vertices in its subtree, so the
+// tree is a function of the vertex set (not of the insertion order); every vertex lies in
+// the leaf whose cell contains its position, exactly once.
+// Complexity: insert O(depth + kCapacity); a box query O(cells met + depth).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/errors.hpp"
+#include "dynmesh/point.hpp"
+
+namespace dynmesh::detail {
+
+class BucketTree {
+ public:
+  using Vid = std::uint32_t;
+  static constexpr std::size_t kCapacity = 8;
+  static constexpr int kMaxLevel = 52;
+
+  explicit BucketTree(const Box<2>& box) : box_(box), scale_(box.scale()) { nodes_.emplace_back(); }
+
+  /// The clamped grid position of x (monotone in each coordinate).
+  std::array<std::uint64_t, 2> position(const Point<2>& x) const noexcept {
+    std::array<std::uint64_t, 2> q{};
+    for (unsigned a = 0; a < 2; ++a) {
+      const double u = std::floor((x[a] - box_.origin[a]) * scale_);
+      q[a] = u <= 0 ? 0 : u >= 0x1p52 ? (std::uint64_t{1} << 52) - 1 : static_cast<std::uint64_t>(u);
+    }
+    return q;
+  }
+
+  /// Adds vertex v at p (the caller keeps the points; p is not stored yet).
+  void insert(Vid v, const Point<2>& p, std::span<const Point<2>> pts) {
+    const auto q = position(p);
+    std::uint32_t n = 0;
+    int level = 0;
+    for (;;) {
+      ++nodes_[n].count;
+      if (nodes_[n].child == kLeaf) break;
+      n = nodes_[n].child + quadrant(q, level);
+      ++level;
+    }
+    nodes_[n].items.push_back(v);
+    ++size_;
+    while (nodes_[n].items.size() > kCapacity && level < kMaxLevel) {
+      // Split: the items move to the four children, and the one holding them all splits on.
+      const auto first = static_cast<std::uint32_t>(nodes_.size());
+      nodes_.resize(nodes_.size() + 4);
+      std::vector<Vid> items = std::move(nodes_[n].items);
+      nodes_[n].items.clear();
+      nodes_[n].child = first;
+      for (const Vid w : items) {
+        Node& c = nodes_[first + quadrant(position(pts[w]), level)];
+        c.items.push_back(w);
+        ++c.count;
+      }
+      n = first + quadrant(q, level);
+      ++level;
+    }
+  }
+
+  /// Calls f(v) for every vertex whose position lies in the closed rectangle of the positions
+  /// of lo and hi (so every vertex x with lo ≤ x ≤ hi, and possibly a few more).
+  template <class F>
+  void visit(const Point<2>& lo, const Point<2>& hi, F&& f) const {
+    const auto a = position(lo), b = position(hi);
+    visit_node(0, 0, 0, 0, a, b, f);
+    ++queries_;
+  }
+
+  /// Every vertex within distance r of c (tested in doubles with a relative margin, so that
+  /// no vertex at distance ≤ r is missed), in no particular order.
+  void gather(const Point<2>& c, double r, std::span<const Point<2>> pts, std::vector<Vid>& out) const {
+    out.clear();
+    const double rr = r * (1 + 0x1p-20);
+    const double r2 = rr * rr;
+    visit(Point<2>{c[0] - rr, c[1] - rr}, Point<2>{c[0] + rr, c[1] + rr}, [&](Vid v) {
+      const double dx = pts[v][0] - c[0], dy = pts[v][1] - c[1];
+      if (dx * dx + dy * dy <= r2) out.push_back(v);
+    });
+  }
+
+  std::size_t size() const noexcept { return size_; }
+  /// Leaves met by all queries so far (the events a self-adjusting version would read).
+  std::size_t leaves_read() const noexcept { return leaves_read_; }
+  std::size_t queries() const noexcept { return queries_; }
+
+  /// Throws InvariantError naming the first broken rule (see the header).
+  void check_invariants(std::span<const Point<2>> pts) const {
+    std::vector<std::uint8_t> seen(pts.size(), 0);
+    std::size_t total = check_node(0, 0, 0, 0, pts, seen);
+    if (total != size_) throw InvariantError("dynmesh: BucketTree: the root counts " + std::to_string(total) +
+                                             " vertices, the tree " + std::to_string(size_));
+  }
+
+ private:
+  static constexpr std::uint32_t kLeaf = 0;  // node 0 is the root, never a child
+
+  struct Node {
+    std::uint32_t child = kLeaf;  // the first of four children, or kLeaf
+    std::uint32_t count = 0;      // vertices in the subtree
+    std::vector<Vid> items;       // a leaf's vertices
+  };
+
+  static unsigned quadrant(const std::array<std::uint64_t, 2>& q, int level) noexcept {
+    const int s = kMaxLevel - 1 - level;
+    return static_cast<unsigned>(((q[0] >> s) & 1) | (((q[1] >> s) & 1) << 1));
+  }
+
+  template <class F>
+  void visit_node(std::uint32_t n, int level, std::uint64_t ix, std::uint64_t iy, const std::array<std::uint64_t, 2>& a,
+                  const std::array<std::uint64_t, 2>& b, F& f) const {
+    const Node& N = nodes_[n];
+    if (N.count == 0) return;
+    const int s = kMaxLevel - level;
+    const std::uint64_t x0 = ix << s, y0 = iy << s;
+    const std::uint64_t x1 = x0 + ((std::uint64_t{1} << s) - 1), y1 = y0 + ((std::uint64_t{1} << s) - 1);
+    if (x1 < a[0] || x0 > b[0] || y1 < a[1] || y0 > b[1]) return;
+    if (N.child == kLeaf) {
+      ++leaves_read_;
+      for (const Vid v : N.items) f(v);
+      return;
+    }
+    for (unsigned k = 0; k < 4; ++k)
+      visit_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), a, b, f);
+  }
+
+  std::size_t check_node(std::uint32_t n, int level, std::uint64_t ix, std::uint64_t iy, std::span<const Point<2>> pts,
+                         std::vector<std::uint8_t>& seen) const {
+    const auto fail = [&](const std::string& what) {
+      throw InvariantError("dynmesh: BucketTree: cell at level " + std::to_string(level) + ": " + what);
+    };
+    const Node& N = nodes_[n];
+    std::size_t total = 0;
+    if (N.child == kLeaf) {
+      if (N.items.size() > kCapacity && level < kMaxLevel) fail("a leaf over capacity");
+      for (const Vid v : N.items) {
+        if (v >= pts.size() || seen[v]) fail("a vertex stored twice or unknown");
+        seen[v] = 1;
+        const auto q = position(pts[v]);
+        const int s = kMaxLevel - level;
+        if ((q[0] >> s) != ix || (q[1] >> s) != iy) fail("a vertex outside its leaf's cell");
+      }
+      total = N.items.size();
+    } else {
+      if (!N.items.empty()) fail("a split cell holds vertices");
+      for (unsigned k = 0; k < 4; ++k)
+        total += check_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), pts, seen);
+      if (total <= kCapacity) fail("a split cell with " + std::to_string(total) + " vertices (at most the capacity)");
+    }
+    if (total != N.count) fail("a count that is not its subtree's");
+    return total;
+  }
+
+  Box<2> box_;
+  double scale_;
+  std::vector<Node> nodes_;
+  std::size_t size_ = 0;
+  mutable std::size_t leaves_read_ = 0, queries_ = 0;
+};
+
+}  // namespace dynmesh::detail

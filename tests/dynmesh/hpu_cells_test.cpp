@@ -1,0 +1,150 @@
+// hpu_cells_test.cpp — src/hpu/bucket_tree.hpp and src/hpu/cell_refiner.hpp: the refinement
+// answered from cells reaches HpuMesh's mesh bit for bit (and its counts), on every
+// distribution and at 20.7°, 25° and 30°; the bucket tree's checker, with a negative test;
+// and the cost of a question stays bounded as n grows on a spiral.
+#include "hpu/cell_refiner.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "dynamic_test_support.hpp"
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/errors.hpp"
+#include "dynmesh/hpu_mesh.hpp"
+#include "hpu/bucket_tree.hpp"
+
+namespace {
+
+using namespace dynmesh;
+using dynmesh_test::kSanitized;
+
+void expect_same_as_twin(std::span<const Point<2>> pts, const Box<2>& box, double angle, const std::string& what) {
+  const HpuMesh twin(box, pts, angle);
+  const detail::CellRefinement cells = detail::cell_refine(box, pts, angle);
+  EXPECT_EQ(cells.triangles.size(), twin.triangles().size()) << what;
+  EXPECT_TRUE(cells.triangles == twin.triangles()) << what << ": the meshes differ";
+  const HpuStats &a = cells.stats, &b = twin.stats();
+  EXPECT_EQ(a.off_centers, b.off_centers) << what;
+  EXPECT_EQ(a.circumcentres, b.circumcentres) << what;
+  EXPECT_EQ(a.side_splits, b.side_splits) << what;
+  EXPECT_EQ(a.rounds, b.rounds) << what;
+  EXPECT_EQ(a.entries, b.entries) << what;
+  EXPECT_EQ(a.loose_pairs, b.loose_pairs) << what;
+}
+
+TEST(BucketTree, HoldsEveryPointOnceAndAnswersBoxQueries) {
+  const Box<2> box{{-1, 2}, 4};
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Point<2>> pts;
+  detail::BucketTree tree(box);
+  for (int i = 0; i < 3000; ++i) {
+    // Clusters at many scales, and the box's far sides (located in the last cells).
+    const double s = std::ldexp(1.0, -static_cast<int>(u(rng) * 30));
+    Point<2> p{box.origin[0] + 2 + s * u(rng), box.origin[1] + 1 + s * u(rng)};
+    if (i % 97 == 0) p = Point<2>{box.origin[0] + box.side, box.origin[1] + box.side * u(rng)};
+    if (std::find(pts.begin(), pts.end(), p) != pts.end()) continue;
+    pts.push_back(p);
+    tree.insert(static_cast<std::uint32_t>(pts.size() - 1), p, pts);
+    if (i % 500 == 0) tree.check_invariants(pts);
+  }
+  tree.check_invariants(pts);
+  for (int k = 0; k < 200; ++k) {
+    const Point<2> c{box.origin[0] + box.side * u(rng), box.origin[1] + box.side * u(rng)};
+    const double r = box.side * std::ldexp(u(rng), -static_cast<int>(u(rng) * 20));
+    std::vector<std::uint32_t> got;
+    tree.gather(c, r, pts, got);
+    std::sort(got.begin(), got.end());
+    for (std::uint32_t v = 0; v < pts.size(); ++v) {
+      const double d = std::hypot(pts[v][0] - c[0], pts[v][1] - c[1]);
+      if (d <= r) {
+        EXPECT_TRUE(std::binary_search(got.begin(), got.end(), v)) << "missed a point at distance " << d;
+      }
+    }
+  }
+}
+
+TEST(BucketTree, CheckerRejectsAVertexOutsideItsLeaf) {
+  // A vertex whose leaf does not contain it is what a broken split would leave: move a
+  // stored point across the box and the checker must name it.
+  const Box<2> box{{0, 0}, 1};
+  std::vector<Point<2>> pts;
+  detail::BucketTree tree(box);
+  for (int i = 0; i < 20; ++i) {
+    pts.push_back(Point<2>{0.1 + 0.01 * i, 0.3 + 0.001 * i});
+    tree.insert(static_cast<std::uint32_t>(i), pts.back(), pts);
+  }
+  tree.check_invariants(pts);
+  pts[2] = Point<2>{0.9, 0.9};
+  EXPECT_THROW(tree.check_invariants(pts), InvariantError);
+}
+
+struct Case {
+  Distribution dist;
+  std::size_t n;
+  double spread;
+};
+
+TEST(CellRefiner, SameMeshAsTheTwinOnEveryDistributionAndAngle) {
+  const std::size_t n = kSanitized ? 120 : 700;
+  const Case cases[] = {
+      {Distribution::Uniform, n, 0x1p20},   {Distribution::Clusters, n, 0x1p20},
+      {Distribution::Shrinking, n, 0x1p30}, {Distribution::Grid, n, 0x1p20},
+      {Distribution::Collinear, n, 0x1p20}, {Distribution::Boundary, n, 0x1p20},
+      {Distribution::Spiral, n, 0x1p20},
+  };
+  for (const double angle : {20.7, 25.0, 30.0})
+    for (const Case& c : cases)
+      for (const std::uint64_t seed : {3u, 11u}) {
+        const auto pts = generate<2>(c.dist, c.n, seed, c.spread);
+        const std::string what = std::string(distribution_name(c.dist)) + " n=" + std::to_string(c.n) +
+                                 " seed=" + std::to_string(seed) + " angle=" + std::to_string(angle);
+        expect_same_as_twin(pts, derive_box<2>(pts), angle, what);
+      }
+}
+
+TEST(CellRefiner, SameMeshOnTheIssueInputAndATightBox) {
+  if (kSanitized) GTEST_SKIP() << "4,000 points at -O0 under the sanitizers";
+  const auto pts = python_uniform(4000, 1);
+  expect_same_as_twin(pts, Box<2>{{0, 0}, 1}, 20.7, "python_uniform(4000) in the unit box");
+  // A box whose sides pass close to the points: many box-edge splits and encroachments.
+  const auto c = generate<2>(Distribution::Clusters, 1500, 9);
+  const Box<2> from = derive_box<2>(c);
+  expect_same_as_twin(c, Box<2>{from.origin, from.side}, 20.7, "clusters in their own box");
+}
+
+TEST(CellRefiner, RejectsWhatTheTwinRejects) {
+  const Box<2> box{{0, 0}, 1};
+  const std::vector<Point<2>> dup{{0.5, 0.5}, {0.25, 0.25}, {0.5, 0.5}};
+  EXPECT_THROW(detail::cell_refine(box, dup, 20.7), InputError);
+  const std::vector<Point<2>> outside{{0.5, 0.5}, {1.5, 0.5}};
+  EXPECT_THROW(detail::cell_refine(box, outside, 20.7), InputError);
+  const std::vector<Point<2>> ok{{0.5, 0.5}};
+  EXPECT_THROW(detail::cell_refine(box, ok, 45.0), InputError);
+}
+
+TEST(CellRefiner, QuestionsReadABoundedNumberOfVerticesOnASpiral) {
+  // The point of answering from cells: a question's local triangulation holds the vertices
+  // near it, not a stretch of the curve. Points per question and leaves per question must
+  // not grow with n on a spiral (the triangulation-based program's worst case).
+  if (kSanitized) GTEST_SKIP() << "thousands of points at -O0 under the sanitizers";
+  double per_question[2] = {0, 0};
+  std::size_t idx = 0;
+  for (const std::size_t n : {1000u, 8000u}) {
+    const auto pts = generate<2>(Distribution::Spiral, n, 7);
+    const auto r = detail::cell_refine(derive_box<2>(pts), pts, 20.7);
+    const auto& q = r.questions;
+    const double asks = static_cast<double>(q.stars + q.neighbour_asks);
+    per_question[idx++] = static_cast<double>(q.points_gathered) / asks;
+    std::printf("spiral n=%zu: %.1f vertices and %.1f leaves per question, max %zu\n", n, per_question[idx - 1],
+                static_cast<double>(q.leaves_read) / (asks + static_cast<double>(q.leaf_tests)), q.max_gathered);
+  }
+  EXPECT_LT(per_question[1], 1.5 * per_question[0]) << "vertices per question grow with n";
+}
+
+}  // namespace
