@@ -87,6 +87,20 @@ class BucketTree {
     ++queries_;
   }
 
+  /// Calls stop = f(v) for the vertices of every leaf whose cell meets the disc (c, r) (cells
+  /// are tested in doubles, widened by a margin, so no vertex in the disc is missed), until
+  /// f returns true.
+  template <class F>
+  void visit_disc(const Point<2>& c, double r, F&& f) const {
+    ++queries_;
+    // Point location rounds (x − o)·2^52/L: allow for a few ulps of the coordinates.
+    const double mag = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(box_.origin[0]), std::abs(box_.origin[1])});
+    const double margin = r * 0x1p-30 + (mag + box_.side) * 0x1p-40;
+    const double rr = r + margin;
+    bool stop = false;
+    visit_disc_node(0, 0, 0, 0, c, rr * rr, margin, f, stop);
+  }
+
   /// Every vertex within distance r of c (tested in doubles with a relative margin, so that
   /// no vertex at distance ≤ r is missed), in no particular order.
   void gather(const Point<2>& c, double r, std::span<const Point<2>> pts, std::vector<Vid>& out) const {
@@ -142,6 +156,31 @@ class BucketTree {
     }
     for (unsigned k = 0; k < 4; ++k)
       visit_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), a, b, f);
+  }
+
+  template <class F>
+  void visit_disc_node(std::uint32_t n, int level, std::uint64_t ix, std::uint64_t iy, const Point<2>& c, double r2,
+                       double margin, F& f, bool& stop) const {
+    const Node& N = nodes_[n];
+    if (N.count == 0 || stop) return;
+    // The cell's box, widened by the margin: [o + i·L/2^level, o + (i + 1)·L/2^level].
+    const double w = std::ldexp(box_.side, -level);
+    const double x0 = box_.origin[0] + static_cast<double>(ix) * w - margin, x1 = x0 + w + 2 * margin;
+    const double y0 = box_.origin[1] + static_cast<double>(iy) * w - margin, y1 = y0 + w + 2 * margin;
+    const double dx = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
+    const double dy = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
+    if (dx * dx + dy * dy > r2) return;
+    if (N.child == kLeaf) {
+      ++leaves_read_;
+      for (const Vid v : N.items)
+        if (f(v)) {
+          stop = true;
+          return;
+        }
+      return;
+    }
+    for (unsigned k = 0; k < 4 && !stop; ++k)
+      visit_disc_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), c, r2, margin, f, stop);
   }
 
   std::size_t check_node(std::uint32_t n, int level, std::uint64_t ix, std::uint64_t iy, std::span<const Point<2>> pts,

@@ -16,7 +16,7 @@
 #include "dynmesh/errors.hpp"
 #include "dynmesh/predicates.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
-#include "geometry/delaunay.hpp"
+#include "geometry/delaunay.hpp"  // perturbed_incircle: the twin's tie rule
 #include "hpu/bucket_tree.hpp"
 #include "hpu/hpu_geometry.hpp"
 #include "io/locate_points.hpp"
@@ -31,103 +31,20 @@ constexpr Vid kNone = 0xffff'ffffu;
 /// of the circumcentre (a few ulps), far below any gap the tests rely on.
 constexpr double kSlack = 0x1p-20;
 
-/// The circumcentre of a, b, c and its squared radius, in doubles relative to a (scaled by
-/// a power of two, exact, so that squares neither overflow nor underflow); nullopt when the
-/// three are (numerically) collinear.
-std::optional<std::pair<Point<2>, double>> circumcircle(const Point<2>& a, const Point<2>& b, const Point<2>& c) {
-  double bx = b[0] - a[0], by = b[1] - a[1], cx = c[0] - a[0], cy = c[1] - a[1];
-  const double m = std::max({std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)});
-  if (!(m > 0)) return std::nullopt;
-  const int e = std::ilogb(m);
-  bx = std::ldexp(bx, -e), by = std::ldexp(by, -e), cx = std::ldexp(cx, -e), cy = std::ldexp(cy, -e);
-  const double d = 2.0 * (bx * cy - by * cx);
-  if (d == 0) return std::nullopt;
-  const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
-  const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
-  if (!std::isfinite(ux) || !std::isfinite(uy)) return std::nullopt;
-  return std::pair{Point<2>{a[0] + std::ldexp(ux, e), a[1] + std::ldexp(uy, e)},
-                   std::ldexp(ux * ux + uy * uy, 2 * e)};
-}
-
 /// An absolute allowance for the rounding of coordinates near p: computed centres and
 /// differences are off by a few ulps of the coordinates, which can be large against a small
 /// question's radius.
 double ulp_room(const Point<2>& p) noexcept { return std::max(std::abs(p[0]), std::abs(p[1])) * 0x1p-40; }
 
-/// Does the circumdisc of a, b, c lie inside the disc (centre, r), with slack to spare?
-bool disc_inside(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& centre, double r) {
-  const auto cc = circumcircle(a, b, c);
-  if (!cc) return false;
-  const double dx = cc->first[0] - centre[0], dy = cc->first[1] - centre[1];
-  const double reach = std::sqrt(dx * dx + dy * dy) + std::sqrt(cc->second) + 2 * ulp_room(centre);
-  return reach <= r * (1 - kSlack);
-}
-
-/// A Delaunay triangulation of the box's corners and the vertices within r of a centre:
-/// the answers of one question. Local vertex i < 4 is global corner i.
-class Local {
- public:
-  explicit Local(const Box<2>& box) : box_(box) {}
-
-  /// Gathers and triangulates; `want` are global vertices whose local ids the caller needs
-  /// (each must lie within the radius).
-  void build(const BucketTree& tree, std::span<const Point<2>> pts, const Point<2>& centre, double r,
-             CellQuestionStats& qs) {
-    centre_ = centre;
-    r_ = r;
-    const std::size_t before = tree.leaves_read();
-    tree.gather(centre, r + ulp_room(centre), pts, ids_);
-    qs.leaves_read += tree.leaves_read() - before;
-    ids_.erase(std::remove_if(ids_.begin(), ids_.end(), [](Vid v) { return v < 4; }), ids_.end());
-    std::sort(ids_.begin(), ids_.end(), [&](Vid a, Vid b) { return morton_less(box_, pts[a], pts[b]); });
-    dt_.emplace(box_);
-    global_ = {0, 1, 2, 3};
-    global_.reserve(ids_.size() + 4);
-    Delaunay::Tid hint = dt_->any_live();
-    for (const Vid v : ids_) {
-      created_.clear();
-      const auto lv = dt_->insert(pts[v], hint, created_);
-      if (!lv) throw InvariantError("dynmesh: cell refiner: a vertex stored twice");
-      global_.push_back(v);
-      if (!created_.empty()) hint = created_.back();
-    }
-    qs.points_gathered += ids_.size();
-    qs.max_gathered = std::max(qs.max_gathered, ids_.size());
-  }
-
-  const Delaunay& dt() const noexcept { return *dt_; }
-  Vid global(Delaunay::Vid l) const noexcept { return global_[l]; }
-  /// The local id of global vertex g (which build() gathered).
-  Delaunay::Vid local(Vid g) const {
-    if (g < 4) return g;
-    for (std::size_t i = 4; i < global_.size(); ++i)
-      if (global_[i] == g) return static_cast<Delaunay::Vid>(i);
-    throw InvariantError("dynmesh: cell refiner: a vertex outside its question's disc");
-  }
-  /// Is the local triangle (a, b, c) a triangle of the whole vertex set? (Its circumdisc lies
-  /// in the gathered disc, so no vertex left out can be inside it.)
-  bool certain(Delaunay::Vid a, Delaunay::Vid b, Delaunay::Vid c) const {
-    return disc_inside(dt_->point(a), dt_->point(b), dt_->point(c), centre_, r_);
-  }
-
- private:
-  Box<2> box_;
-  Point<2> centre_{};
-  double r_ = 0;
-  std::optional<Delaunay> dt_;
-  std::vector<Vid> ids_, global_;
-  std::vector<Delaunay::Tid> created_;
-};
-
 class CellRefiner {
  public:
   CellRefiner(const Box<2>& box, double min_angle_deg, std::size_t max_vertices, CellRefinement& out, bool check_tree)
-      : box_(box), tree_(box), local_(box), max_vertices_(max_vertices), out_(out), check_tree_(check_tree) {
+      : box_(box), tree_(box), max_vertices_(max_vertices), out_(out), check_tree_(check_tree) {
     apex_height_ = apex_height(min_angle_deg);
     leaf_height_ = leaf_height(min_angle_deg);
     lo_[0] = box.origin[0], lo_[1] = box.origin[1];
     hi_[0] = box.origin[0] + box.side, hi_[1] = box.origin[1] + box.side;
-    // The corners, in the order of Delaunay's (so that local ids 0-3 are the corners).
+    // The corners first (vertices 0-3: the first entries' order puts them ahead).
     for (const Point<2>& c : {Point<2>{lo_[0], lo_[1]}, Point<2>{hi_[0], lo_[1]}, Point<2>{hi_[0], hi_[1]},
                               Point<2>{lo_[0], hi_[1]}})
       add(c);
@@ -174,8 +91,9 @@ class CellRefiner {
   /// its (x, y)-smallest corner.
   std::vector<Triangle> triangles() {
     std::vector<Triangle> out;
+    const std::size_t before = out_.questions.leaves_read;
     for (Vid v = 0; v < pts_.size(); ++v) {
-      star_of(v, initial_radius(v), std::numeric_limits<double>::infinity());
+      star_of(v);
       const std::size_t d = star_.size();
       const bool cycle = !on_boundary(v);
       for (std::size_t i = 0; i < d; ++i) {
@@ -186,6 +104,7 @@ class CellRefiner {
       }
     }
     std::sort(out.begin(), out.end());
+    out_.questions.leaves_final += out_.questions.leaves_read - before;
     return out;
   }
 
@@ -256,103 +175,199 @@ class CellRefiner {
     const double r = std::hypot(c[0] - a[0], c[1] - a[1]) * (1 + kSlack) + ulp_room(c);
     bool empty = true;
     const std::size_t before = tree_.leaves_read();
-    tree_.visit(Point<2>{c[0] - r, c[1] - r}, Point<2>{c[0] + r, c[1] + r}, [&](Vid v) {
-      if (empty && v != p && v != q && pencil(a, b, leaf_height_, pts_[v]) < 0) empty = false;
+    tree_.visit_disc(c, r, [&](Vid v) {
+      if (v != p && v != q && pencil(a, b, leaf_height_, pts_[v]) < 0) empty = false;
+      return !empty;
     });
     out_.questions.leaves_read += tree_.leaves_read() - before;
     return empty;
   }
 
-  /// A radius that holds v's nearest neighbours: twice the distance to the nearest vertex
-  /// found in v's own leaf neighbourhood, grown until one is found.
-  double initial_radius(Vid v) const {
+  /// The distance from v to its nearest vertex, in doubles (found from v's own cells
+  /// outwards).
+  double nearest_distance(Vid v) const {
     double r = box_.side * 0x1p-20;
     for (;;) {
       double best = std::numeric_limits<double>::infinity();
-      tree_.visit(Point<2>{pts_[v][0] - r, pts_[v][1] - r}, Point<2>{pts_[v][0] + r, pts_[v][1] + r}, [&](Vid w) {
+      tree_.visit_disc(pts_[v], r, [&](Vid w) {
         if (w != v) best = std::min(best, std::hypot(pts_[w][0] - pts_[v][0], pts_[w][1] - pts_[v][1]));
+        return false;
       });
-      if (best <= r) return 2 * best;
+      if (best <= r) return best;
       r *= 4;
     }
   }
 
-  /// v's star (counter-clockwise, as Delaunay::star gives it) from the local triangulation of
-  /// the vertices within r of v, r growing from `r0` until every star triangle is certain or
-  /// r reaches `cap`. Returns whether the star is the true one (every triangle certain).
-  bool star_of(Vid v, double r0, double cap) {
-    ++out_.questions.stars;
-    double r = std::min(r0, cap);
+  /// Some vertex that v has an edge to in every Delaunay triangulation: the nearest one whose
+  /// closed diametral disc with v holds no other vertex (a vertex inside or on that disc is
+  /// strictly nearer, so the search ends).
+  Vid sure_neighbour(Vid v) const {
+    const double d = nearest_distance(v);
+    Vid a = kNone;
+    tree_.visit_disc(pts_[v], d * (1 + kSlack) + ulp_room(pts_[v]), [&](Vid w) {
+      if (w != v && (a == kNone || std::hypot(pts_[w][0] - pts_[v][0], pts_[w][1] - pts_[v][1]) <
+                                       std::hypot(pts_[a][0] - pts_[v][0], pts_[a][1] - pts_[v][1])))
+        a = w;
+      return false;
+    });
     for (;;) {
-      local_.build(tree_, pts_, pts_[v], r, out_.questions);
-      const Delaunay::Vid lv = local_.local(v);
-      local_.dt().star(lv, lstar_);
-      const std::size_t d = lstar_.size();
-      const bool cycle = !on_boundary(v);
-      bool sure = true;
-      for (std::size_t i = 0; i < d && sure; ++i) {
-        if (i + 1 == d && !cycle) break;
-        sure = local_.certain(lv, lstar_[i], lstar_[(i + 1) % d]);
-      }
-      star_.clear();
-      for (const Delaunay::Vid l : lstar_) star_.push_back(local_.global(l));
-      if (sure || r >= cap) return sure;
-      ++out_.questions.star_retries;
-      r = std::min(2 * r, cap);
+      const Point<2>&p = pts_[v], &q = pts_[a];
+      const Point<2> m{0.5 * p[0] + 0.5 * q[0], 0.5 * p[1] + 0.5 * q[1]};
+      Vid inside = kNone;
+      tree_.visit_disc(m, 0.5 * std::hypot(q[0] - p[0], q[1] - p[1]) * (1 + kSlack) + ulp_room(m), [&](Vid w) {
+        if (w != v && w != a && pencil(p, q, 0.0, pts_[w]) <= 0) inside = w;
+        return inside != kNone;
+      });
+      if (inside == kNone) return a;
+      a = inside;
     }
   }
 
-  /// The class of v's shortest true edge. Local edges can be false only where both their
-  /// triangles are uncertain; the radius grows until the shortest candidates are certain.
-  int first_class(Vid v) {
-    ++out_.questions.stars;
-    double r = initial_radius(v);
-    for (;;) {
-      local_.build(tree_, pts_, pts_[v], r, out_.questions);
-      const Delaunay::Vid lv = local_.local(v);
-      local_.dt().star(lv, lstar_);
-      const std::size_t d = lstar_.size();
-      const bool cycle = !on_boundary(v);
-      const auto tri_certain = [&](std::size_t i) {  // the triangle (v, star[i], star[i + 1])
-        if (i + 1 >= d && !cycle) return false;
-        return local_.certain(lv, lstar_[i], lstar_[(i + 1) % d]);
-      };
-      int best = INT_MAX;
-      bool sure = true;
-      for (std::size_t i = 0; i < d; ++i) {
-        const int c = edge_class(pts_[v], local_.dt().point(lstar_[i]));
-        const bool edge_true = tri_certain(i) || tri_certain((i + d - 1) % d);
-        if (c <= best && !edge_true) sure = false;
-        best = std::min(best, c);
-      }
-      // An uncertain edge of class above the best cannot lower it; one at or below can be
-      // false, and then a certain edge of lower class may be hiding: look wider.
-      if (sure || r >= 4 * box_.side) return best;
-      ++out_.questions.star_retries;
-      r *= 2;
+  /// The Delaunay neighbour of p→q on its left (the third corner of the triangle on its
+  /// left, under the triangulations' perturbation): of the vertices on the left, the one
+  /// whose circle through p and q lies lowest in the pencil of circles through p and q,
+  /// searched among the circles centred at most h_max·|pq| along J(q − p) from pq's
+  /// midpoint, smallest first, each asked of the cells its disc meets. kNone when none
+  /// lies that low (or the left is outside the box).
+  Vid left_search(Vid p, Vid q, double h_max) const {
+    ++out_.questions.neighbour_asks;
+    if (outside_left(p, q)) return kNone;  // a box edge seen from outside: no triangle there
+    const Point<2>&a = pts_[p], &b = pts_[q];
+    const double dx = b[0] - a[0], dy = b[1] - a[1];
+    const double len = std::hypot(dx, dy);
+    const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
+    const std::size_t before = tree_.leaves_read();
+    Vid best = kNone;
+    for (double h = std::min(0.25, h_max);; h = std::min(2 * h, h_max)) {
+      const Point<2> c{m[0] - h * dy, m[1] + h * dx};
+      const double r = len * std::sqrt(0.25 + h * h) * (1 + kSlack) + ulp_room(c);
+      tree_.visit_disc(c, r, [&](Vid w) {
+        if (w == p || w == q || orient2d(a, b, pts_[w]) <= 0 || pencil(a, b, h, pts_[w]) > 0) return false;
+        if (best == kNone || perturbed_incircle(a, b, pts_[best], pts_[w])) best = w;
+        return false;
+      });
+      if (best != kNone || h >= h_max) break;
     }
+    out_.questions.leaves_read += tree_.leaves_read() - before;
+    return best;
+  }
+
+  /// v's star, counter-clockwise (as Delaunay::star gives it: a cycle for an interior
+  /// vertex, from one box side to the other for a vertex on the boundary), walked from a
+  /// sure neighbour by left searches. With a radius R, each step searches only the circles
+  /// of radius at most R: the walk then stops where the next triangle's circumradius
+  /// exceeds R, and returns false (star_ then holds the star's two ends around that gap,
+  /// cut into at most two runs: the counter-clockwise run from the sure neighbour, then the
+  /// clockwise one, put first).
+  bool star_of(Vid v, double R = std::numeric_limits<double>::infinity()) {
+    ++out_.questions.stars;
+    const Vid q0 = sure_neighbour(v);
+    const auto h_cap = [&](Vid a, Vid b) {
+      if (R == std::numeric_limits<double>::infinity()) return R;
+      const double half = 0.5 * std::hypot(pts_[b][0] - pts_[a][0], pts_[b][1] - pts_[a][1]);
+      return R > half ? std::sqrt((R / (2 * half)) * (R / (2 * half)) - 0.25) : -1.0;
+    };
+    star_.assign(1, q0);
+    bool whole = true;
+    for (Vid q = q0;;) {
+      if (outside_left(v, q)) break;  // a box side: the fan ends
+      const double h = h_cap(v, q);
+      const Vid t = h < 0 ? kNone : left_search(v, q, h);
+      if (t == kNone) {
+        whole = false;
+        break;
+      }
+      if (t == q0) return true;
+      star_.push_back(t);
+      q = t;
+    }
+    back_.clear();
+    for (Vid q = q0;;) {
+      if (outside_left(q, v)) break;
+      const double h = h_cap(q, v);
+      const Vid t = h < 0 ? kNone : left_search(q, v, h);
+      if (t == kNone) {
+        whole = false;
+        break;
+      }
+      if (!whole && std::find(star_.begin(), star_.end(), t) != star_.end()) break;  // met the other run
+      back_.push_back(t);
+      q = t;
+    }
+    star_.insert(star_.begin(), back_.rbegin(), back_.rend());
+    return whole;
+  }
+
+  /// The class of v's shortest Delaunay edge. The vertices within 4·d of v (d the distance
+  /// to the nearest, in doubles) hold every star edge that could be shortest: beyond, an
+  /// edge is at least twice as long as v's nearest edge (itself a Delaunay edge), and
+  /// edge_class is within one of ⌊log2 |pq|⌋. So the answer is the least class among them
+  /// as soon as one of that class is an edge, which a closed diametral disc empty of other
+  /// vertices shows; otherwise (rounding at a power of two), the star decides.
+  int first_class(Vid v) {
+    const double d = nearest_distance(v);
+    near_.clear();
+    tree_.visit_disc(pts_[v], 4 * d * (1 + kSlack) + ulp_room(pts_[v]), [&](Vid w) {
+      if (w != v) near_.push_back(w);
+      return false;
+    });
+    out_.questions.gathered_first += near_.size();
+    int best = INT_MAX;
+    for (const Vid q : near_) best = std::min(best, edge_class(pts_[v], pts_[q]));
+    for (const Vid q : near_) {
+      if (edge_class(pts_[v], pts_[q]) != best) continue;
+      const Point<2>&a = pts_[v], &b = pts_[q];
+      const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
+      bool empty = true;
+      tree_.visit_disc(m, 0.5 * std::hypot(b[0] - a[0], b[1] - a[1]) * (1 + kSlack) + ulp_room(m), [&](Vid w) {
+        if (w != v && w != q && pencil(a, b, 0.0, pts_[w]) <= 0) empty = false;
+        return !empty;
+      });
+      if (empty) return best;
+    }
+    star_of(v);
+    best = INT_MAX;
+    for (const Vid q : star_) best = std::min(best, edge_class(pts_[v], pts_[q]));
+    return best;
   }
 
   /// Figure 5, line 7, for one vertex (the twin's collect): its loose pairs of class j (≤ j
   /// at its first entry), in (x, y) order, and its continuation into Q_{j+1}.
   void collect(Vid v, int j, bool birth) {
     ++out_.stats.entries;
-    // The continuation rule looks at triangles of circumradius up to 2^(j+1): their discs
-    // lie within 2^(j+2) of v. (The slack keeps a triangle at the rule's edge certain.)
-    const double cap = std::ldexp(1.0 + 4 * kSlack, j + 2);
-    const bool sure = star_of(v, std::min(initial_radius(v), cap), cap);
+    const std::size_t before = out_.questions.leaves_read;
+    // The continuation needs the triangles of circumradius up to 2^(j+1) only: a star
+    // triangle beyond it (the walk's gap) already says "go on". The slack keeps a triangle
+    // at the rule's edge on the walked side.
+    const bool whole = star_of(v, std::ldexp(1.0 + 0x1p-20, j + 1));
     const std::size_t d = star_.size();
-    const bool cycle = !on_boundary(v);
-    bool go_on = !sure;
+    const bool cycle = !on_boundary(v) && whole;
+    bool go_on = !whole;
     local_pairs_.clear();
-    for (std::size_t i = 0; i < d; ++i) {
-      const Vid q = star_[i];
+    const auto take = [&](Vid q) {
       const int c = edge_class(pts_[v], pts_[q]);
-      if (sure && (i + 1 < d || cycle)) go_on = go_on || circumradius_above(pts_[v], pts_[q], pts_[star_[(i + 1) % d]], j);
-      if (c > j) go_on = true;
-      if (birth ? c > j : c != j) continue;
+      if (birth ? c > j : c != j) return;
       if (loose(v, q)) local_pairs_.push_back({v, q});
       if (loose(q, v)) local_pairs_.push_back({q, v});
+    };
+    for (std::size_t i = 0; i < d; ++i) {
+      const Vid q = star_[i];
+      // Consecutive vertices of star_ bound a walked (true) triangle; the wrap-around does
+      // only in a whole cycle (otherwise the gap lies there).
+      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(pts_[v], pts_[q], pts_[star_[(i + 1) % d]], j);
+      if (edge_class(pts_[v], pts_[q]) > j) go_on = true;
+      take(q);
+    }
+    if (!whole) {
+      // Edges inside the gap have both triangles beyond 2^(j+1); those of class ≤ j end
+      // within 2^(j+1) of v, and a loose one is an edge (its leaf is empty): ask each vertex
+      // there that the walk did not reach.
+      near_.clear();
+      tree_.visit_disc(pts_[v], std::ldexp(1.0 + 0x1p-20, j + 1) + ulp_room(pts_[v]), [&](Vid w) {
+        if (w != v && std::find(star_.begin(), star_.end(), w) == star_.end()) near_.push_back(w);
+        return false;
+      });
+      for (const Vid q : near_) take(q);
     }
     std::sort(local_pairs_.begin(), local_pairs_.end(), [&](const auto& a, const auto& b) {
       if (pts_[a[0]] != pts_[b[0]]) return xy_less(pts_[a[0]], pts_[b[0]]);
@@ -360,35 +375,24 @@ class CellRefiner {
     });
     pairs_.insert(pairs_.end(), local_pairs_.begin(), local_pairs_.end());
     if (go_on) queues_[j + 1].push_back({v, false});
-  }
-
-  /// The Delaunay neighbour of p→q on its left when the circle through p, q and it is
-  /// centred within `reach` of pq's midpoint; kNone when it is farther (or the box's outside).
-  Vid left_neighbour(Vid p, Vid q, double reach) {
-    ++out_.questions.neighbour_asks;
-    const Point<2>&a = pts_[p], &b = pts_[q];
-    const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
-    const double half = 0.5 * std::hypot(b[0] - a[0], b[1] - a[1]);
-    // Every circle through p and q centred within `reach` of m lies within reach + its
-    // radius (≤ √(reach² + half²)) of m.
-    const double r = (reach + std::hypot(reach, half)) * (1 + 4 * kSlack);
-    local_.build(tree_, pts_, m, r, out_.questions);
-    const auto e = local_.dt().left_of(local_.local(p), local_.local(q));
-    if (!e) throw InvariantError("dynmesh: cell refiner: a loose pair that is not a local edge");
-    const auto& T = local_.dt().tri(e->first);
-    const Delaunay::Vid t = T.v[e->second];
-    if (!local_.certain(local_.local(p), local_.local(q), t)) return kNone;
-    return local_.global(t);
+    out_.questions.leaves_collect += out_.questions.leaves_read - before;
   }
 
   /// Figure 5, lines 10-14, for the ccw side of p→q (the twin's process).
   void process(Vid p, Vid q, int j) {
+    const std::size_t before = out_.questions.leaves_read;
+    struct Count {
+      std::size_t& total;
+      std::size_t& mine;
+      std::size_t before;
+      ~Count() { mine += total - before; }
+    } count{out_.questions.leaves_read, out_.questions.leaves_process, before};
     for (;;) {
       if (!loose(p, q)) return;
       ++out_.stats.loose_pairs;
       const Point<2>&a = pts_[p], &b = pts_[q];
-      const double len = std::hypot(b[0] - a[0], b[1] - a[1]);
-      const Vid t = left_neighbour(p, q, apex_height_ * len);
+      // Beyond the apex's circle the neighbour does not matter: the off-center is the apex.
+      const Vid t = left_search(p, q, apex_height_ * (1 + 4 * kSlack));
       // With no neighbour within the apex's reach the off-center is the apex; a far corner
       // stands in for t (the apex's bits do not depend on it: the frame's scaling is exact).
       const Point<2>& tp = t != kNone ? pts_[t] : far_corner(a, b);
@@ -442,18 +446,13 @@ class CellRefiner {
     // The edge in counter-clockwise order along the boundary (the inside on its left).
     const bool forward = s == 0 || s == 1;
     const Vid ea = forward ? lo_end : hi_end, eb = forward ? hi_end : lo_end;
-    // Its triangle: the edge's left neighbour; the circle through ea, eb and it holds r
-    // unless it lies inside the diametral disc, so only that disc must be gathered.
-    ++out_.questions.neighbour_asks;
-    const Point<2>&a = pts_[ea], &b = pts_[eb];
-    const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
-    const double half = 0.5 * std::hypot(b[0] - a[0], b[1] - a[1]);
-    local_.build(tree_, pts_, m, half * (1 + 4 * kSlack), out_.questions);
-    const auto e = local_.dt().left_of(local_.local(ea), local_.local(eb));
-    if (!e) throw InvariantError("dynmesh: cell refiner: a box edge that is not an edge");
-    const auto& T = local_.dt().tri(e->first);
-    const bool inside_disc = encroaches(a, b, local_.dt().point(T.v[e->second]));
-    if (inside_disc && !local_.dt().in_conflict(e->first, r)) return std::nullopt;
+    // Its triangle: the edge's left neighbour x. The circle through ea, eb and x holds r
+    // (strictly inside the diametral disc, on the inner side) unless x lies strictly
+    // inside the diametral disc too; then the perturbed in-circle test decides, as for the
+    // twin's cavity.
+    const Vid x = left_search(ea, eb, 0.0);
+    if (x != kNone && encroaches(pts_[ea], pts_[eb], pts_[x]) && !perturbed_incircle(pts_[ea], pts_[eb], pts_[x], r))
+      return std::nullopt;
     return std::array<Vid, 2>{ea, eb};
   }
 
@@ -477,7 +476,6 @@ class CellRefiner {
 
   Box<2> box_;
   BucketTree tree_;
-  Local local_;
   double lo_[2], hi_[2];
   double apex_height_ = 0, leaf_height_ = 0;
   std::size_t max_vertices_;
@@ -487,8 +485,7 @@ class CellRefiner {
   std::map<int, std::vector<Entry>> queues_;
   std::map<double, Vid> sides_[4];
   std::vector<Entry> batch_;
-  std::vector<Vid> star_;
-  std::vector<Delaunay::Vid> lstar_;
+  std::vector<Vid> star_, back_, near_;
   std::vector<std::array<Vid, 2>> pairs_, local_pairs_, encroached_;
 };
 

@@ -41,13 +41,13 @@ namespace dynmesh::detail {
 
 /// What the cell questions cost: the figures a self-adjusting version pays in reads.
 struct CellQuestionStats {
-  std::size_t stars = 0;           // local stars computed (first classes, collects, final mesh)
-  std::size_t star_retries = 0;    // stars whose radius had to grow
+  std::size_t stars = 0;           // stars walked (first classes, collects, final mesh)
   std::size_t leaf_tests = 0;      // loose tests asked of the cells
-  std::size_t neighbour_asks = 0;  // off-center neighbours and box-edge triangles
-  std::size_t points_gathered = 0; // vertices put in local triangulations
+  std::size_t neighbour_asks = 0;  // left searches (star steps, off-centers, box edges)
   std::size_t leaves_read = 0;     // bucket-tree leaves met by all questions
-  std::size_t max_gathered = 0;    // the most vertices one local triangulation took
+  std::size_t gathered_first = 0;  // vertices looked at for first classes
+  // Leaves read by the collects, by the pairs' processing and by the final mesh.
+  std::size_t leaves_collect = 0, leaves_process = 0, leaves_final = 0;
 };
 
 struct CellRefinement {
