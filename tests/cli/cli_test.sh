@@ -162,6 +162,43 @@ case $case_name in
     fi
     ;;
 
+  mesh_stats) # mesh --edits --stats: the quality report as before, then the propagations
+    edits=$(grep -c '^[+-]' "$data/edits2d.txt")
+    run "$dynmesh" quadtree "$data/points2d.node" --cells box.cells
+    box=$(box_of box.cells)
+    for pp in hpu quadtree; do
+      # The quality report of the final mesh: the same lines as a from-scratch run's, first.
+      # shellcheck disable=SC2086  # the box is several numbers
+      run "$dynmesh" mesh "$data/final2d.txt" --postprocess $pp --box $box -o scratch --stats
+      ! grep -q 'Propagation' err.txt || fail "$pp: propagation figures without --edits"
+      cp err.txt quality.txt
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits "$data/edits2d.txt" -o dyn --stats
+      cmp <(head -n "$(wc -l <quality.txt)" err.txt) quality.txt || fail "$pp: the quality report changed"
+      tail -n +"$(($(wc -l <quality.txt) + 1))" err.txt >prop.txt
+      [[ $(sed -n 2p prop.txt) == 'Propagation statistics:' ]] || fail "$pp: $(cat prop.txt)"
+      grep -qx "  Propagations: $edits    Edits: $edits" prop.txt || fail "$pp: count: $(cat prop.txt)"
+      grep -qE '^  Mean time: +[0-9.e+-]+ s +\|  Median time: +[0-9.e+-]+ s$' prop.txt || fail "$pp: times"
+      grep -qE '^  Maximum time: +[0-9.e+-]+ s +\|  Mean trace distance: [1-9][0-9.e+]*$' prop.txt ||
+        fail "$pp: maximum time, trace distance: $(cat prop.txt)"
+      grep -qE '^  Mean triangles changed: [1-9][0-9.e+]* \(removed \+ added\)$' prop.txt ||
+        fail "$pp: triangles changed: $(cat prop.txt)"
+      # The maximum time is at least the median and the mean.
+      awk '/Mean time:/ { mean = $3; median = $8 } /Maximum time:/ { max = $3 }
+        END { exit !(max >= median && max >= mean && median > 0) }' prop.txt || fail "$pp: times: $(cat prop.txt)"
+      # The mean triangles changed is that of the change feed.
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits "$data/edits2d.txt" -o dyn --feed f.feed \
+        --stats
+      want=$(awk '/^update / { t += $4 + $6; k++ } END { printf "%g", t / k }' f.feed)
+      grep -qx "  Mean triangles changed: $want (removed + added)" err.txt || fail "$pp: not the feed's $want"
+      # With --batch 3, one propagation per batch.
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits "$data/edits2d.txt" --batch 3 -o b --stats
+      grep -qx "  Propagations: $(((edits + 2) / 3))    Edits: $edits" err.txt || fail "$pp --batch 3: $(cat err.txt)"
+      # Without --stats, nothing on stderr.
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits "$data/edits2d.txt" -o q
+      [[ ! -s err.txt ]] || fail "$pp: stderr without --stats: $(cat err.txt)"
+    done
+    ;;
+
   svg)
     run "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits2d.txt" --cells s.cells --svg tree.svg
     head -c 5 tree.svg | grep -q '^<?xml\|^<svg' || fail "tree.svg does not start like SVG"
