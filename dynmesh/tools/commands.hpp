@@ -2,8 +2,8 @@
 //
 // Purpose: one options struct and one entry point per subcommand; main.cpp parses the
 // command line into these with CLI11 and calls the entry point. The contracts are
-// shared/FORMATS.md's `dynmesh quadtree`, `dynmesh mesh` (2D) and `dynmesh stability`; `demo` is the README's
-// main job.
+// shared/FORMATS.md's `dynmesh quadtree`, `dynmesh mesh` (2D) and `dynmesh stability` (on a
+// distribution, or on a point file and an edit file); `demo` is the README's main job.
 // Invariants: an entry point returns the exit status (0 success, 1 failure) or throws; every
 // exception becomes one line `dynmesh: <message>` on stderr in main.cpp, so the commands
 // never print errors themselves.
@@ -61,6 +61,11 @@ struct MeshCommandOptions {
 
 struct StabilityOptions {
   int dim = 2;
+  bool dim_given = false;        // --dim appeared (with --points, else a .node header decides)
+  std::string points;            // --points POINTS (instead of --dist): the user's points
+  bool points_given = false;     // --points appeared
+  std::string edits;             // --edits FILE (with --points): the edits measured, one row each
+  std::vector<double> box;       // --box o1 o2 [o3] L (with --points; empty: derived)
   std::string postprocess;       // --postprocess none|quadtree|hpu (empty: none, the tree alone)
   double min_angle = 0;          // --min-angle DEG (checked on the final mesh)
   bool min_angle_given = false;  // --min-angle appeared

@@ -3,7 +3,8 @@
 // off-center Delaunay mesh (DynamicMesh, Postprocess::Hpu, 20.7 degrees), applies U
 // single-point updates (alternating deletions and insertions, one propagation each), prints
 // the figures (led by the speedup of an update over re-meshing the points from scratch with
-// the static twin HpuMesh), verifies the final mesh against a from-scratch mesh and the
+// the static twin HpuMesh; the update figures as `mesh --stats` measures them,
+// propagation_log.hpp), verifies the final mesh against a from-scratch mesh and the
 // checkers, and draws the final mesh as SVG.
 // Complexity: the build O(n lg n + m) expected; each update O(lg L/s) expected trace
 // distance plus the driver's O(n) spread bookkeeping (untimed); the check O(m lg m).
@@ -27,31 +28,11 @@
 #include "dynmesh/mesh_io.hpp"
 #include "dynmesh/svg.hpp"
 #include "progress.hpp"
+#include "propagation_log.hpp"
 #include "update_driver.hpp"
 #include "verify.hpp"
 
 namespace dynmesh::tool {
-namespace {
-
-template <class T>
-double median(std::vector<T> v) {
-  if (v.empty()) return 0.0;
-  const std::size_t mid = v.size() / 2;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid), v.end());
-  const double hi = static_cast<double>(v[mid]);
-  if (v.size() % 2) return hi;
-  const double lo = static_cast<double>(*std::max_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(mid)));
-  return (lo + hi) / 2;
-}
-
-template <class T>
-double mean(const std::vector<T>& v) {
-  double s = 0;
-  for (const T& x : v) s += static_cast<double>(x);
-  return v.empty() ? 0.0 : s / static_cast<double>(v.size());
-}
-
-}  // namespace
 
 int run_demo(const DemoOptions& o) {
   constexpr Distribution kDist = Distribution::Clusters;
@@ -75,17 +56,13 @@ int run_demo(const DemoOptions& o) {
 
   UpdateDriver<2, DynamicMesh> driver(mesh, std::move(pool), o.seed);
   const double spread = driver.log2_spread();
-  std::vector<double> seconds;
-  std::vector<std::uint64_t> distances;
-  std::vector<std::size_t> changed;
+  PropagationLog log;
   std::size_t deletions = 0;
   {
     Progress progress("updates", o.updates);
     for (std::size_t u = 0; u < o.updates; ++u) {
       const auto step = driver.step();
-      seconds.push_back(step.stats.seconds);
-      distances.push_back(step.stats.trace_distance);
-      changed.push_back(mesh.last_change().removed.size() + mesh.last_change().added.size());
+      log.record(step.stats, mesh.last_change());
       deletions += step.op == EditOp::Delete;
       progress.tick(u + 1);
     }
@@ -108,7 +85,7 @@ int run_demo(const DemoOptions& o) {
     out.commit();
   }
 
-  const double mean_s = mean(seconds);
+  const double mean_s = mean(log.seconds());
   std::printf("dynmesh demo: a quality Delaunay mesh (DynHPU, smallest angle >= %.1f degrees) kept up to date by "
               "change propagation\n",
               options.min_angle);
@@ -127,10 +104,11 @@ int run_demo(const DemoOptions& o) {
   std::printf("  updates            %zu (%zu deletions, %zu insertions), one propagation each\n", o.updates,
               deletions, o.updates - deletions);
   if (o.updates > 0) {
-    std::printf("  update time        mean %.1f us, median %.1f us\n", mean_s * 1e6, median(seconds) * 1e6);
-    std::printf("  trace distance     mean %.0f, median %.0f per update\n", mean(distances), median(distances));
-    std::printf("  triangles changed  mean %.1f, median %.0f per update (removed + added)\n", mean(changed),
-                median(changed));
+    std::printf("  update time        mean %.1f us, median %.1f us\n", mean_s * 1e6, median(log.seconds()) * 1e6);
+    std::printf("  trace distance     mean %.0f, median %.0f per update\n", mean(log.distances()),
+                median(log.distances()));
+    std::printf("  triangles changed  mean %.1f, median %.0f per update (removed + added)\n", mean(log.changed()),
+                median(log.changed()));
   }
   std::printf("  live trace         %.0f bytes per point\n",
               static_cast<double>(mesh.trace_bytes()) / static_cast<double>(std::max<std::size_t>(1, mesh.size())));

@@ -9,6 +9,9 @@
 //   dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]
 //                     [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv [--plot OUT.svg]
 //                     [--force]
+//   dynmesh stability --points POINTS --edits FILE [--dim 2|3] [--box o1 o2 [o3] L]
+//                     [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv [--plot OUT.svg]
+//                     [--force]
 //   dynmesh demo [--n N] [--updates U] [--seed X] [--svg OUT.svg]
 // Exit status: 0 on success; 1 with exactly one line `dynmesh: <message>` on stderr on any
 // error (a build refused by the memory guard included); 2 for a command line CLI11 rejects
@@ -24,6 +27,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "dynmesh/distributions.hpp"
 #include "memory_guard.hpp"
 #include "number_options.hpp"
 #include "verify.hpp"
@@ -137,22 +141,48 @@ int main(int argc, char** argv) {
   StabilityOptions s;
   CLI::App* stability = app.add_subcommand(
       "stability",
-      "Measure the trace distance of single-point updates (alternating deletions and insertions) and append "
-      "one CSV row per update: dist,dim,n,log2_spread,op,trace_distance,seconds. log2_spread is log2(L/s) of "
-      "the point set after that update, exact for every row (the closest-pair distance is maintained)");
-  stability->add_option("--dim", s.dim, "dimension")->required()->check(CLI::IsMember({2, 3}));
-  stability
-      ->add_option("--dist", s.dist, "distribution: uniform, clusters, spiral, shrinking, grid, collinear, boundary")
-      ->required();
-  stability->add_option("--n", s.n, "number of points the tree is built on")
-      ->required()
-      ->check(whole_number(2, kMaxCount));
-  stability->add_option("--spread", s.spread, "target spread L/s of the 'shrinking' distribution")
-      ->capture_default_str();
-  stability->add_option("--updates", s.updates, "updates measured")
-      ->capture_default_str()
-      ->check(whole_number(0, kMaxCount));
-  stability->add_option("--seed", s.seed, "random seed")->capture_default_str()->check(any_seed);
+      "Measure the trace distance of single-point updates and append one CSV row per update: "
+      "dist,dim,n,log2_spread,op,trace_distance,seconds. The updates alternate deletions and insertions of a "
+      "distribution's points (--dist), or are the edits of a file applied to a point file (--points, --edits). "
+      "log2_spread is log2(L/s) of the point set after that update, exact for every row (the closest-pair "
+      "distance is maintained)");
+  CLI::Option* stability_dim_opt =
+      stability->add_option("--dim", s.dim, "dimension (with --points: of plain-text points; a .node header decides when omitted)")
+          ->check(CLI::IsMember({2, 3}));
+  std::string distribution_names;
+  for (const dynmesh::Distribution dist : dynmesh::all_distributions())
+    distribution_names += (distribution_names.empty() ? "" : ", ") + std::string(dynmesh::distribution_name(dist));
+  CLI::Option* dist_opt = stability->add_option("--dist", s.dist, "distribution: " + distribution_names);
+  CLI::Option* n_opt = stability->add_option("--n", s.n, "number of points the tree is built on (with --dist)")
+                           ->check(whole_number(2, kMaxCount));
+  CLI::Option* spread_opt =
+      stability->add_option("--spread", s.spread, "target spread L/s of the 'shrinking' distribution")
+          ->capture_default_str();
+  CLI::Option* updates_opt = stability->add_option("--updates", s.updates, "updates measured (with --dist)")
+                                 ->capture_default_str()
+                                 ->check(whole_number(0, kMaxCount));
+  CLI::Option* seed_opt =
+      stability->add_option("--seed", s.seed, "random seed (with --dist)")->capture_default_str()->check(any_seed);
+  CLI::Option* points_opt = stability->add_option(
+      "--points", s.points,
+      "instead of --dist: build on this point file (.node or plain text, as quadtree and mesh read it); the CSV's "
+      "dist is its base name without the extension, n its number of points");
+  CLI::Option* stability_edits_opt = stability->add_option(
+      "--edits", s.edits, "with --points: edit script ('+ x y [z]' inserts, '- x y [z]' deletes), one row per edit");
+  CLI::Option* stability_box_opt =
+      stability->add_option("--box", s.box, "with --points: domain box, origin and side length (default: derived)")
+          ->expected(3, 4)
+          ->type_name("o1 o2 [o3] L");
+  // Which of the two sources, and the options each takes: a wrong mix is a malformed command
+  // line (exit 2), reported by CLI11 as "--X excludes --Y" or "--X requires --Y".
+  dist_opt->excludes(points_opt)->needs(stability_dim_opt)->needs(n_opt);
+  points_opt->needs(stability_edits_opt);
+  stability_edits_opt->needs(points_opt);
+  stability_box_opt->needs(points_opt);
+  for (CLI::Option* opt : {n_opt, spread_opt, updates_opt, seed_opt}) opt->excludes(points_opt);
+  stability->parse_complete_callback([dist_opt, points_opt] {
+    if (dist_opt->count() == 0 && points_opt->count() == 0) throw CLI::RequiredError("--dist or --points");
+  });
   stability->add_option("--postprocess", s.postprocess,
                         "none (the default: the quadtree alone), quadtree (2D: the quadtree mesh too) or hpu (2D: "
                         "the off-center Delaunay mesh too); "
@@ -166,11 +196,15 @@ int main(int argc, char** argv) {
       "\nSynopsis (shared/FORMATS.md):\n"
       "  dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]\n"
       "                    [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv\n"
+      "                    [--plot OUT.svg] [--force]\n"
+      "  dynmesh stability --points POINTS --edits FILE [--dim 2|3] [--box o1 o2 [o3] L]\n"
+      "                    [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv\n"
       "                    [--plot OUT.svg] [--force]\n\n" +
       memory_note(cost_text("quadtree (2D)", kQuadtree2dCost, "for the final check") + "; " +
                   cost_text("octree (3D)", kOctree3dCost, "for the final check") + "; " +
                   cost_text("quadtree mesh", kQuadtreeMeshCost, "for the final check") +
-                  "; the structure holds at most N + U/2 points"));
+                  "; the structure holds at most N + U/2 points (--dist), or the points of POINTS and the '+' "
+                  "lines of FILE (--points)"));
 
   DemoOptions m;
   CLI::App* demo = app.add_subcommand(
@@ -203,6 +237,8 @@ int main(int argc, char** argv) {
     }
     if (*stability) {
       s.min_angle_given = stability_angle_opt->count() > 0;
+      s.dim_given = stability_dim_opt->count() > 0;
+      s.points_given = points_opt->count() > 0;
       return run_stability(s);
     }
     if (*demo) return run_demo(m);

@@ -9,7 +9,8 @@
 // only after all of them were written (atomic_file.hpp), so a failed run leaves old files
 // untouched. Before anything is read, the memory guard (memory_guard.hpp) refuses a mesh that
 // cannot fit in memory, unless --force; the long phases (reading, building, --check) show
-// their elapsed time on stderr (progress.hpp).
+// their elapsed time on stderr (progress.hpp). With --edits, --stats also reports the
+// propagations (count, time, trace distance, triangles changed: propagation_log.hpp).
 // Complexity: construction O(n lg n + |T'|) expected, then O(lg L/s) expected trace distance
 // per edit (DynamicMesh); hpu O(n lg n + m) expected for m vertices; the outputs are linear
 // in the mesh (the SVG O(t log t)); --check adds a from-scratch mesh and check_mesh,
@@ -43,6 +44,7 @@
 #include "dynmesh/svg.hpp"
 #include "memory_guard.hpp"
 #include "progress.hpp"
+#include "propagation_log.hpp"
 #include "verify.hpp"
 
 namespace dynmesh::tool {
@@ -59,9 +61,12 @@ PostprocessChoice check_mesh_options(const MeshCommandOptions& o) {
 }
 
 /// Writes the outputs aside and renames them into place together (atomic_file.hpp); then
-/// the duplicate count and --stats. `feed` is empty unless --feed was given.
+/// the duplicate count and --stats. `feed` is empty unless --feed was given; `propagations`
+/// is the log of the edits' propagations, null without --edits (--stats reports them after
+/// the quality report).
 void write_outputs(const MeshCommandOptions& o, const Mesh& mesh, const Box<2>& box, std::span<const Point<2>> inputs,
-                   const std::string& feed, std::size_t duplicates_skipped) {
+                   const std::string& feed, std::size_t duplicates_skipped,
+                   const PropagationLog* propagations = nullptr, std::size_t edits = 0) {
   AtomicOutputs out;
   out.add(o.outbase + ".node", format_node(mesh, box));
   out.add(o.outbase + ".ele", format_ele(mesh));
@@ -84,7 +89,8 @@ void write_outputs(const MeshCommandOptions& o, const Mesh& mesh, const Box<2>& 
   // After the outputs are in place, so that a failed run prints only its error line.
   if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", duplicates_skipped);
   if (o.stats) {
-    const std::string report = format_stats(mesh_stats(mesh));
+    std::string report = format_stats(mesh_stats(mesh));
+    if (propagations) report += format_propagation_stats(*propagations, edits);
     std::fflush(stdout);
     std::fputs(report.c_str(), stderr);
     std::fflush(stderr);
@@ -182,10 +188,10 @@ int run_mesh(const MeshCommandOptions& o) {
   const bool want_feed = !o.feed.empty();
   std::string feed;
   if (want_feed) feed = feed_header();
-  std::size_t propagations = 0;
+  PropagationLog propagations;  // for --stats
   auto record = [&] {
-    ++propagations;
-    if (want_feed) feed += format_feed_update(propagations, dm.last_change());
+    propagations.record(dm.last_update(), dm.last_change());
+    if (want_feed) feed += format_feed_update(propagations.count(), dm.last_change());
   };
 
   if (!edits.empty()) {
@@ -236,7 +242,8 @@ int run_mesh(const MeshCommandOptions& o) {
   }
 
   built.reset();  // as in `dynmesh quadtree`: the outputs are formatted without the trace
-  write_outputs(o, mesh, box, inputs, feed, initial.duplicates_skipped);
+  write_outputs(o, mesh, box, inputs, feed, initial.duplicates_skipped, o.edits.empty() ? nullptr : &propagations,
+                edits.size());
   return 0;
 }
 

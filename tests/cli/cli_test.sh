@@ -162,6 +162,141 @@ case $case_name in
     fi
     ;;
 
+  stability_points) # --points POINTS --edits FILE: one row per edit, dist = POINTS' base name
+    header='dist,dim,n,log2_spread,op,trace_distance,seconds'
+    edits=$(grep -c '^[+-]' "$data/edits2d.txt")
+    grep '^[+-]' "$data/edits2d.txt" | cut -c1 >signs.txt # the edits' kinds, in order
+    for pp in none quadtree hpu; do
+      run "$dynmesh" stability --points "$data/points2d.node" --edits "$data/edits2d.txt" --postprocess $pp \
+        --csv $pp.csv
+      [[ $(head -1 $pp.csv) == "$header" ]] || fail "$pp: CSV header: $(head -1 $pp.csv)"
+      [[ $(wc -l <$pp.csv) -eq $((edits + 1)) ]] || fail "$pp: expected header + $edits rows, got $(wc -l <$pp.csv)"
+      # Every row: points2d, 2D, n = 50 (the initial points), op the edit's kind, distance > 0.
+      paste -d, <(tail -n +2 $pp.csv) signs.txt | awk -F, 'NF != 8 || $1 != "points2d" || $2 != 2 || $3 != 50 ||
+        !(($5 == "insert" && $8 == "+") || ($5 == "delete" && $8 == "-")) || $6 !~ /^[0-9]+$/ || $6 <= 0 ||
+        $7 <= 0 { bad = 1; print } END { exit bad }' || fail "$pp: rows do not follow the edits"
+      grep -q "points2d 2D, n = 50, .*, $edits edits, mean trace distance" out.txt || fail "$pp: summary: $(cat out.txt)"
+    done
+    grep -q '^stability: hpu mesh, points2d 2D' out.txt || fail "the hpu run did not say it measured the hpu mesh"
+    # Through a mesh, the same edits cost more than through the tree alone (same ops and spreads).
+    for pp in quadtree hpu; do
+      paste -d, <(tail -n +2 none.csv) <(tail -n +2 $pp.csv) | awk -F, '$4 != $11 || $5 != $12 || $13 <= $6 {
+        bad = 1; print } END { exit bad }' || fail "$pp rows do not follow the tree rows"
+    done
+    # The last row's log2_spread is log2(L/s) of the final points (final2d.txt), L the side of the
+    # box derived from points2d.node, s their closest pair (brute force here).
+    run "$dynmesh" quadtree "$data/points2d.node" --cells box.cells
+    side=$(box_of box.cells | awk '{print $3}')
+    want=$(grep -v '^#' "$data/final2d.txt" | awk -v L="$side" '{ x[NR] = $1; y[NR] = $2 }
+      END { s = -1; for (i = 1; i <= NR; i++) for (j = i + 1; j <= NR; j++) {
+        d = sqrt((x[i] - x[j]) ^ 2 + (y[i] - y[j]) ^ 2); if (s < 0 || d < s) s = d }
+        printf "%.4f", log(L / s) / log(2) }')
+    got=$(tail -1 none.csv | cut -d, -f4)
+    awk -v a="$got" -v b="$want" 'BEGIN { exit !(a - b < 2e-4 && b - a < 2e-4) }' ||
+      fail "last row's log2_spread $got, expected $want"
+    # Appending works as with --dist: the old rows stay, the header is not repeated.
+    cp none.csv saved.csv
+    run "$dynmesh" stability --points "$data/points2d.node" --edits "$data/edits2d.txt" --csv none.csv
+    cmp <(head -c "$(wc -c <saved.csv)" none.csv) saved.csv || fail "an append changed the old rows"
+    [[ $(wc -l <none.csv) -eq $((2 * edits + 1)) && $(grep -c '^dist,' none.csv) -eq 1 ]] || fail "append"
+    # 3D: a .node header decides the dimension; --box as quadtree takes it.
+    edits3=$(grep -c '^[+-]' "$data/edits3d.txt")
+    run "$dynmesh" stability --points "$data/points3d.node" --edits "$data/edits3d.txt" --csv d3.csv
+    run "$dynmesh" stability --points "$data/points3d.node" --dim 3 --box -20 -20 -20 60 --edits "$data/edits3d.txt" \
+      --csv d3.csv
+    [[ $(wc -l <d3.csv) -eq $((2 * edits3 + 1)) ]] || fail "3D: expected header + $((2 * edits3)) rows"
+    tail -n +2 d3.csv | awk -F, '$1 != "points3d" || $2 != 3 || $6 <= 0 { bad = 1; print } END { exit bad }' ||
+      fail "3D rows"
+    # A bad file: one line naming file and line, exit 1, and the CSV as it was.
+    cp none.csv saved.csv
+    { head -4 "$data/edits2d.txt"; echo '+ 1.5 x'; } >bad_edits.txt
+    expect_error 1 'bad_edits.txt:5: ' "$dynmesh" stability --points "$data/points2d.node" --edits bad_edits.txt \
+      --csv none.csv
+    expect_error 1 'edits_absent.txt:3: ' "$dynmesh" stability --points "$data/points2d.node" \
+      --edits "$data/edits_absent.txt" --postprocess hpu --csv none.csv
+    grep -q 'not in the set' err.txt || fail "absent point: unclear message: $(cat err.txt)"
+    expect_error 1 'edits_outside.txt:3: ' "$dynmesh" stability --points "$data/points2d.node" \
+      --edits "$data/edits_outside.txt" --csv none.csv
+    expect_error 1 'bad_number.txt:3: ' "$dynmesh" stability --points "$data/bad_number.txt" \
+      --edits "$data/edits2d.txt" --csv none.csv
+    expect_error 1 'meshes in 2D only' "$dynmesh" stability --points "$data/points3d.node" \
+      --edits "$data/edits3d.txt" --postprocess quadtree --csv none.csv
+    cmp none.csv saved.csv || fail "a failed run changed the CSV"
+    expect_error 1 'bad_edits.txt:5: ' "$dynmesh" stability --points "$data/points2d.node" --edits bad_edits.txt \
+      --csv new.csv
+    [[ ! -e new.csv ]] || fail "a failed run wrote its CSV"
+    if command -v gnuplot >/dev/null; then
+      run "$dynmesh" stability --points "$data/points2d.node" --edits "$data/edits2d.txt" --csv none.csv --plot p.svg
+      head -c 200 p.svg | grep -q '<svg\|<?xml' || fail "p.svg is not SVG"
+    fi
+    ;;
+
+  stability_options) # --dist and --points exclude each other, and each its own options: exit 2
+    p=(--points "$data/points2d.node" --edits "$data/edits2d.txt")
+    expect_error 2 'excludes' "$dynmesh" stability "${p[@]}" --dist uniform --dim 2 --n 50 --csv e.csv
+    grep -qF -- '--dist' err.txt && grep -qF -- '--points' err.txt || fail "the options are not named: $(cat err.txt)"
+    for opt in "--n 50" "--spread 64" "--updates 10" "--seed 3"; do
+      # shellcheck disable=SC2086  # $opt is two words
+      expect_error 2 "${opt% *} excludes --points" "$dynmesh" stability "${p[@]}" $opt --csv e.csv
+    done
+    expect_error 2 '--points requires --edits' "$dynmesh" stability --points "$data/points2d.node" --csv e.csv
+    expect_error 2 '--edits requires --points' "$dynmesh" stability --edits "$data/edits2d.txt" --dist uniform \
+      --dim 2 --n 50 --csv e.csv
+    expect_error 2 '--box requires --points' "$dynmesh" stability --dist uniform --dim 2 --n 50 --box 0 0 1 --csv e.csv
+    expect_error 2 '--dist or --points is required' "$dynmesh" stability --dim 2 --n 50 --csv e.csv
+    expect_error 2 '--dist requires --n' "$dynmesh" stability --dim 2 --dist uniform --csv e.csv
+    expect_error 2 '--dist requires --dim' "$dynmesh" stability --dist uniform --n 50 --csv e.csv
+    [[ ! -e e.csv ]] || fail "a refused run wrote its CSV"
+    ;;
+
+  curves) # the curves distribution, everywhere a distribution name is taken
+    run "$dynmesh" stability --dim 2 --dist curves --n 400 --updates 20 --csv c.csv
+    run "$dynmesh" stability --dim 3 --dist curves --n 300 --updates 10 --seed 2 --csv c.csv
+    run "$dynmesh" stability --dim 2 --dist curves --n 400 --updates 10 --postprocess hpu --csv c.csv
+    grep -q '^stability: hpu mesh, curves 2D' out.txt || fail "the hpu run: $(cat out.txt)"
+    [[ $(wc -l <c.csv) -eq 41 ]] || fail "expected header + 40 rows, got $(wc -l <c.csv)"
+    tail -n +2 c.csv | awk -F, '$1 != "curves" || $6 <= 0 { bad = 1; print } END { exit bad }' || fail "rows"
+    "$dynmesh" stability --help >help.txt 2>&1
+    grep -q 'boundary, curves' help.txt || fail "--help does not list curves: $(grep -- --dist help.txt)"
+    ;;
+
+  mesh_stats) # mesh --edits --stats: the quality report as before, then the propagations
+    edits=$(grep -c '^[+-]' "$data/edits2d.txt")
+    run "$dynmesh" quadtree "$data/points2d.node" --cells box.cells
+    box=$(box_of box.cells)
+    for pp in hpu quadtree; do
+      # The quality report of the final mesh: the same lines as a from-scratch run's, first.
+      # shellcheck disable=SC2086  # the box is several numbers
+      run "$dynmesh" mesh "$data/final2d.txt" --postprocess $pp --box $box -o scratch --stats
+      ! grep -q 'Propagation' err.txt || fail "$pp: propagation figures without --edits"
+      cp err.txt quality.txt
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits "$data/edits2d.txt" -o dyn --stats
+      cmp <(head -n "$(wc -l <quality.txt)" err.txt) quality.txt || fail "$pp: the quality report changed"
+      tail -n +"$(($(wc -l <quality.txt) + 1))" err.txt >prop.txt
+      [[ $(sed -n 2p prop.txt) == 'Propagation statistics:' ]] || fail "$pp: $(cat prop.txt)"
+      grep -qx "  Propagations: $edits    Edits: $edits" prop.txt || fail "$pp: count: $(cat prop.txt)"
+      grep -qE '^  Mean time: +[0-9.e+-]+ s +\|  Median time: +[0-9.e+-]+ s$' prop.txt || fail "$pp: times"
+      grep -qE '^  Maximum time: +[0-9.e+-]+ s +\|  Mean trace distance: [1-9][0-9.e+]*$' prop.txt ||
+        fail "$pp: maximum time, trace distance: $(cat prop.txt)"
+      grep -qE '^  Mean triangles changed: [1-9][0-9.e+]* \(removed \+ added\)$' prop.txt ||
+        fail "$pp: triangles changed: $(cat prop.txt)"
+      # The maximum time is at least the median and the mean.
+      awk '/Mean time:/ { mean = $3; median = $8 } /Maximum time:/ { max = $3 }
+        END { exit !(max >= median && max >= mean && median > 0) }' prop.txt || fail "$pp: times: $(cat prop.txt)"
+      # The mean triangles changed is that of the change feed.
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits "$data/edits2d.txt" -o dyn --feed f.feed \
+        --stats
+      want=$(awk '/^update / { t += $4 + $6; k++ } END { printf "%g", t / k }' f.feed)
+      grep -qx "  Mean triangles changed: $want (removed + added)" err.txt || fail "$pp: not the feed's $want"
+      # With --batch 3, one propagation per batch.
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits "$data/edits2d.txt" --batch 3 -o b --stats
+      grep -qx "  Propagations: $(((edits + 2) / 3))    Edits: $edits" err.txt || fail "$pp --batch 3: $(cat err.txt)"
+      # Without --stats, nothing on stderr.
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits "$data/edits2d.txt" -o q
+      [[ ! -s err.txt ]] || fail "$pp: stderr without --stats: $(cat err.txt)"
+    done
+    ;;
+
   svg)
     run "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits2d.txt" --cells s.cells --svg tree.svg
     head -c 5 tree.svg | grep -q '^<?xml\|^<svg' || fail "tree.svg does not start like SVG"
@@ -586,6 +721,9 @@ GNUPLOT
         fail "unclear message: $(cat err.txt)"
       expect_error 1 'building the quadtree mesh of 1000 points with --check needs about 133 MiB' \
         limited "$dynmesh" mesh p.txt --postprocess quadtree -o e --check
+      # stability --points counts as they do: the 1000 points and the 10 '+' lines (and its check).
+      expect_error 1 'building the quadtree of 1010 points needs about 46.4 MiB' \
+        limited "$dynmesh" stability --points p.txt --edits e.txt --csv e.csv
       # Before reading: the malformed line is not reached.
       expect_error 1 'building the quadtree of 1001 points needs about' limited "$dynmesh" quadtree bad.txt \
         --cells e.cells

@@ -1,7 +1,9 @@
 // distributions_test.cpp — generators, the random source, closest pair and spread.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <set>
@@ -92,11 +94,12 @@ TEST(Distributions, PythonUniformMatchesCPython) {
 }
 
 TEST(Distributions, NamesRoundTrip) {
-  EXPECT_EQ(all_distributions().size(), 7u);
+  EXPECT_EQ(all_distributions().size(), 8u);
   for (const Distribution dist : all_distributions()) EXPECT_EQ(parse_distribution(distribution_name(dist)), dist);
   EXPECT_FALSE(parse_distribution("gaussian").has_value());
   EXPECT_EQ(parse_distribution("uniform"), Distribution::Uniform);
   EXPECT_EQ(parse_distribution("shrinking"), Distribution::Shrinking);
+  EXPECT_EQ(parse_distribution("curves"), Distribution::Curves);
 }
 
 template <std::size_t d>
@@ -201,6 +204,99 @@ void shrinking_spread_is_independent_of_n() {
 TEST(Distributions, ShrinkingSpreadFollowsTheParameter) {
   shrinking_spread_is_independent_of_n<2>();
   shrinking_spread_is_independent_of_n<3>();
+}
+
+// --- curves ----------------------------------------------------------------------------------
+
+template <std::size_t d>
+double squared_distance(const Point<d>& a, const Point<d>& b) {
+  double s = 0;
+  for (std::size_t k = 0; k < d; ++k) s += (a[k] - b[k]) * (a[k] - b[k]);
+  return s;
+}
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+template <std::size_t d>
+void curves_are_curves(std::size_t n, std::uint64_t seed) {
+  SCOPED_TRACE("d=" + std::to_string(d) + " n=" + std::to_string(n) + " seed=" + std::to_string(seed));
+  const auto pts = generate<d>(Distribution::Curves, n, seed);
+  ASSERT_EQ(pts.size(), n);
+  EXPECT_EQ(pts, generate<d>(Distribution::Curves, n, seed));  // deterministic for the seed
+  EXPECT_NE(pts, generate<d>(Distribution::Curves, n, seed + 1));
+  // Strictly inside the unit box, as the other distributions are.
+  for (const auto& p : pts)
+    for (const double x : p) {
+      EXPECT_GT(x, 0.0);
+      EXPECT_LT(x, 1.0);
+    }
+  // Distinct, also as located positions in the derived box.
+  EXPECT_EQ(std::set<Point<d>>(pts.begin(), pts.end()).size(), n);
+  PointFile<d> f{"curves", pts, std::vector<std::size_t>(n, 1)};
+  EXPECT_NO_THROW((void)locate_points(f, derive_box<d>(pts)));
+
+  // curve_points: the same points, curve by curve; max(2, round(√n/4)) curves, none empty.
+  const auto curves = curve_points<d>(n, seed);
+  const std::size_t k = std::max<std::size_t>(2, static_cast<std::size_t>(std::round(std::sqrt(double(n)) / 4)));
+  ASSERT_EQ(curves.size(), k);
+  std::vector<Point<d>> joined;
+  for (const auto& c : curves) {
+    EXPECT_GE(c.size(), 1u);
+    joined.insert(joined.end(), c.begin(), c.end());
+  }
+  std::vector<Point<d>> sorted = pts;
+  std::sort(sorted.begin(), sorted.end());
+  std::sort(joined.begin(), joined.end());
+  EXPECT_EQ(joined, sorted);
+
+  // Curve-like: the median distance from a point to its nearest neighbour on its own curve is
+  // at least 10 times smaller than the median distance to the nearest point of another curve.
+  std::vector<double> along, across;
+  for (std::size_t c = 0; c < curves.size(); ++c) {
+    const std::size_t first = along.size();
+    for (std::size_t i = 0; i < curves[c].size(); ++i) {
+      double same = std::numeric_limits<double>::infinity(), other = same;
+      for (std::size_t e = 0; e < curves.size(); ++e)
+        for (std::size_t j = 0; j < curves[e].size(); ++j) {
+          if (e == c && j == i) continue;
+          double& best = e == c ? same : other;
+          best = std::min(best, squared_distance<d>(curves[c][i], curves[e][j]));
+        }
+      along.push_back(std::sqrt(same));
+      across.push_back(std::sqrt(other));
+    }
+    // Even spacing along each curve (stratified arc lengths): neighbours are 0.5 to 1.5
+    // spacings apart, so the curve's median is within a small factor of its smallest.
+    const std::vector<double> own(along.begin() + static_cast<std::ptrdiff_t>(first), along.end());
+    if (own.size() >= 3) {
+      EXPECT_LT(median_of(own), 4 * *std::min_element(own.begin(), own.end())) << "curve " << c;
+    }
+  }
+  const double along_median = median_of(along), across_median = median_of(across);
+  std::printf("[ curves d=%zu n=%zu ] %zu curves, median spacing along a curve %.3g, to another curve %.3g (%.0fx)\n",
+              d, n, curves.size(), along_median, across_median, across_median / along_median);
+  EXPECT_GE(across_median, 10 * along_median);
+}
+
+TEST(Distributions, CurvesAreDeterministicInsideDistinctAndCurveLike) {
+  for (const std::size_t n : {400u, 3000u}) {
+    curves_are_curves<2>(n, 11);
+    curves_are_curves<2>(n, 12);
+    curves_are_curves<3>(n, 13);
+  }
+  // Few points: at least two curves, every point placed.
+  for (const std::size_t n : {2u, 3u, 5u}) {
+    EXPECT_EQ(curve_points<2>(n, 1).size(), 2u);
+    EXPECT_EQ(generate<2>(Distribution::Curves, n, 1).size(), n);
+  }
+  EXPECT_EQ(curve_points<2>(1, 1).size(), 1u);
+  EXPECT_TRUE(curve_points<3>(0, 1).empty());
+  // Pinned bits: the generator uses + − × / and sqrt only (no libm), so these hold on every
+  // platform; a change here changes every recorded curves experiment.
+  EXPECT_EQ(generate<2>(Distribution::Curves, 100, 7)[0], (Point<2>{0x1.292bf62563208p-1, 0x1.545bb6cf4c321p-2}));
 }
 
 TEST(Distributions, BadSpreadIsRejected) {

@@ -27,6 +27,15 @@
 //                puts about half of these coordinates at q = i·2^(52−l) (the upper cell) and
 //                half at q = i·2^(52−l) − 1 (the lower cell); with L = 3 all would land on
 //                the upper side. This distribution exercises both.
+//   curves     – points along random smooth curves, spaced much more closely along each curve
+//                than the curves are apart (like contours, coastlines and scan lines):
+//                max(2, round(√n/4)) Fourier-perturbed star-shaped loops of radius 0.02 to
+//                0.08 (3D: in random planes, with a small out-of-plane wobble), half of them
+//                cut to open arcs, centres in [0.15, 0.85]^d, every point in [0.03, 0.97]^d.
+//                The points are shared out in proportion to the curves' lengths, at stratified
+//                arc lengths, so the spacing is the same on every curve; the median distance
+//                to the nearest other curve is some 30 to 150 times that spacing in 2D (more
+//                in 3D), independently of n. curve_points gives the points curve by curve.
 // Every generator returns exactly n distinct points (distinct located positions in their
 // derived box, as far as the construction guarantees: exactly for grid, collinear and
 // boundary; with overwhelming probability for the others) in a seeded random order.
@@ -36,7 +45,8 @@
 // (Box–Muller) are computed here, never by std:: distributions or std::shuffle, whose
 // output differs across standard libraries. The clusters, spiral and shrinking generators
 // call libm's log/pow/sin/cos, which are identical on one platform and may differ in the last bit
-// across C libraries; the other generators use + − × / only.
+// across C libraries; the other generators use + − × / only (curves also the correctly rounded
+// sqrt, and a rational parametrization of the circle instead of sin and cos).
 //
 // closest_pair_distance: expected O(n) randomized-grid algorithm (Rabin; Khuller & Matias)
 // with a fixed internal seed, so the result is deterministic (it is exact in any case).
@@ -89,7 +99,7 @@ class Rng {
   double spare_ = 0.0;
 };
 
-enum class Distribution { Uniform, Clusters, Spiral, Shrinking, Grid, Collinear, Boundary };
+enum class Distribution { Uniform, Clusters, Spiral, Shrinking, Grid, Collinear, Boundary, Curves };
 
 std::span<const Distribution> all_distributions() noexcept;
 std::string_view distribution_name(Distribution dist) noexcept;
@@ -99,6 +109,11 @@ std::optional<Distribution> parse_distribution(std::string_view name) noexcept;
 /// distributions ignore it). Throws std::invalid_argument for a bad spread.
 template <std::size_t d>
 std::vector<Point<d>> generate(Distribution dist, std::size_t n, std::uint64_t seed, double spread = 0x1p20);
+
+/// The points of generate(Distribution::Curves, n, seed), curve by curve and in order along
+/// each curve: generate() returns their concatenation in a seeded random order.
+template <std::size_t d>
+std::vector<std::vector<Point<d>>> curve_points(std::size_t n, std::uint64_t seed);
 
 /// The peers' benchmark inputs: n points (x, y) from CPython's random.Random(seed), drawn as
 /// `x = rng.random(); y = rng.random()` n times (seed 1 makes the unif1e4 / unif1e5 inputs

@@ -41,9 +41,9 @@ double Rng::normal() {
 
 namespace {
 
-constexpr std::array<Distribution, 7> kAll = {Distribution::Uniform,   Distribution::Clusters, Distribution::Spiral,
+constexpr std::array<Distribution, 8> kAll = {Distribution::Uniform,   Distribution::Clusters, Distribution::Spiral,
                                               Distribution::Shrinking, Distribution::Grid,     Distribution::Collinear,
-                                              Distribution::Boundary};
+                                              Distribution::Boundary,  Distribution::Curves};
 
 template <std::size_t d>
 double distance(const Point<d>& a, const Point<d>& b) {
@@ -210,6 +210,214 @@ std::vector<Point<d>> shrinking_points(std::size_t n, double spread, Rng& rng) {
   return best;
 }
 
+// --- curves -----------------------------------------------------------------------------------
+// K = max(2, round(√n / 4)) curves (at most n), each a Fourier-perturbed star-shaped loop
+// around a centre c uniform in [0.15, 0.85]^d: c + R·(ρ(θ)·(cos θ·e1 + sin θ·e2) + h(θ)·e3), with
+//   ρ(θ) = 1 + Σ_{j=2..4} (a_j cos jθ + b_j sin jθ),  |a_j|, |b_j| ≤ 0.3/j, so ρ ∈ [0.54, 1.46];
+//   R uniform in [0.02, 0.08], so every point lies within 0.118 of c, in [0.03, 0.97]^d;
+//   2D: e1, e2 the axes, h = 0; 3D: (e1, e2, e3) a random orthonormal frame and the wobble
+//   h(θ) = Σ_{j=1,2} (α_j cos jθ + β_j sin jθ), |α_j|, |β_j| ≤ 0.05.
+// A loop is star-shaped (ρ > 0), so it never crosses itself. Half the curves (at random) are
+// open arcs: a random fraction in [0.25, 0.75] of their loop, from a random start. Each curve
+// gets one point, and the other n − K are shared out in proportion to the curves' lengths
+// (largest remainders), so that the spacing is the same on every curve (as a digitizer or a
+// scanner samples); a curve's m points lie at stratified arc lengths, (i + u)·ℓ/m with u
+// uniform in [0.25, 0.75] for its length ℓ, so two neighbours on a curve are between 0.5 and
+// 1.5 spacings apart. Why the curves are far apart for their spacing, at every n: K curves of
+// mean length ℓ̄ ≈ 0.25 spaced over an area A ≈ 0.6 are about A/(K·ℓ̄) apart, and the
+// spacing along them is K·ℓ̄/n, so the ratio is A·n/(K·ℓ̄)² ≈ 16·A/ℓ̄² ≈ 150 for K = √n/4;
+// the median distance from a point to the nearest other curve is some 30 to 150 spacings in
+// 2D (the curves cross here and there; measured for n = 10^2 to 10^4), more in 3D.
+//
+// No libm: cos θ and sin θ come from the rational parametrization of the circle,
+// ((1 − u²)/(1 + u²), 2u/(1 + u²)) for u in [0, 1) on each quarter turn, and the harmonics
+// from complex powers, so only + − × / and the correctly rounded sqrt (the arc lengths and the
+// 3D frame) are used: the points are the same bits on every platform. Arc lengths come from a
+// polygon of 8m + 32 vertices on the curve; a point's parameter is interpolated linearly
+// between two of its vertices and the curve evaluated there, so every point lies on the
+// smooth curve itself.
+
+/// One curve: centre, radius, frame, shape coefficients, and the parameter range [t0, t0 + span)
+/// of the loop's parameter t in [0, 1) (one turn).
+template <std::size_t d>
+struct CurveShape {
+  Point<d> centre{};
+  double radius = 0;
+  std::array<Point<d>, 3> frame{};  // e1, e2, e3 (e3 unused in 2D)
+  std::array<double, 5> a{}, b{};   // ρ's coefficients, j = 2..4
+  std::array<double, 3> alpha{}, beta{};  // 3D wobble, j = 1..2
+  double t0 = 0, span = 1;
+};
+
+/// A point (cos θ, sin θ) of the unit circle for the parameter t in [0, 1) of one turn, without
+/// libm: quarter turn q = ⌊4t⌋, and within it u = 4t − q = tan(θ'/2) of the angle θ' past
+/// q·90°, so θ grows smoothly and monotonically with t within each quarter.
+inline std::array<double, 2> circle_point(double t) {
+  const double q4 = 4.0 * t;
+  const double q = std::floor(q4);
+  const double u = q4 - q;
+  const double den = 1.0 + u * u;
+  const double x = (1.0 - u * u) / den, y = 2.0 * u / den;
+  switch (static_cast<int>(q) & 3) {
+    case 0: return {x, y};
+    case 1: return {-y, x};
+    case 2: return {-x, -y};
+    default: return {y, -x};
+  }
+}
+
+template <std::size_t d>
+Point<d> curve_at(const CurveShape<d>& c, double t) {
+  t -= std::floor(t);  // one turn
+  const auto [x, y] = circle_point(t);
+  // z^j = (cos jθ, sin jθ) by complex multiplication.
+  double re = x, im = y, rho = 1.0, h = 0.0;
+  for (std::size_t j = 1; j <= 4; ++j) {
+    if (j >= 2) {
+      const double r2 = re * x - im * y, i2 = re * y + im * x;
+      re = r2;
+      im = i2;
+      rho += c.a[j] * re + c.b[j] * im;
+    }
+    if (j <= 2) h += c.alpha[j] * re + c.beta[j] * im;
+  }
+  Point<d> p = c.centre;
+  for (std::size_t k = 0; k < d; ++k) {
+    double off = rho * (x * c.frame[0][k] + y * c.frame[1][k]);
+    if constexpr (d == 3) off += h * c.frame[2][k];
+    p[k] += c.radius * off;
+  }
+  return p;
+}
+
+/// A unit vector uniform on the sphere, orthogonal to `against` when given (rejection from
+/// the cube; + − × / and sqrt only).
+inline Point<3> random_unit(Rng& rng, const Point<3>* against) {
+  for (;;) {
+    Point<3> v{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)};
+    if (against) {
+      const double dot = v[0] * (*against)[0] + v[1] * (*against)[1] + v[2] * (*against)[2];
+      for (std::size_t k = 0; k < 3; ++k) v[k] -= dot * (*against)[k];
+    }
+    const double n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if (n2 > 1.0 || n2 < 0x1p-10) continue;
+    const double len = std::sqrt(n2);
+    for (double& x : v) x /= len;
+    return v;
+  }
+}
+
+template <std::size_t d>
+CurveShape<d> random_curve(Rng& rng) {
+  CurveShape<d> c;
+  for (std::size_t k = 0; k < d; ++k) c.centre[k] = rng.uniform(0.15, 0.85);
+  c.radius = rng.uniform(0.02, 0.08);
+  for (std::size_t j = 2; j <= 4; ++j) {
+    const double bound = 0.3 / static_cast<double>(j);
+    c.a[j] = rng.uniform(-bound, bound);
+    c.b[j] = rng.uniform(-bound, bound);
+  }
+  if constexpr (d == 2) {
+    c.frame[0] = {1, 0};
+    c.frame[1] = {0, 1};
+  } else {
+    c.frame[0] = random_unit(rng, nullptr);
+    c.frame[1] = random_unit(rng, &c.frame[0]);
+    const Point<3>& e1 = c.frame[0];
+    const Point<3>& e2 = c.frame[1];
+    c.frame[2] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    for (std::size_t j = 1; j <= 2; ++j) {
+      c.alpha[j] = rng.uniform(-0.05, 0.05);
+      c.beta[j] = rng.uniform(-0.05, 0.05);
+    }
+  }
+  if (rng.below(2) == 1) {  // an open arc
+    c.t0 = rng.uniform();
+    c.span = rng.uniform(0.25, 0.75);
+  }
+  return c;
+}
+
+/// The cumulative lengths of a polygon of `vertices` + 1 vertices on curve c, vertex v at
+/// parameter t0 + span·v/vertices: entry v is the length up to vertex v.
+template <std::size_t d>
+std::vector<double> polygon_lengths(const CurveShape<d>& c, std::size_t vertices) {
+  std::vector<double> length(vertices + 1, 0.0);
+  Point<d> prev = curve_at<d>(c, c.t0);
+  for (std::size_t v = 1; v <= vertices; ++v) {
+    const Point<d> p = curve_at<d>(c, c.t0 + c.span * static_cast<double>(v) / static_cast<double>(vertices));
+    length[v] = length[v - 1] + distance<d>(prev, p);
+    prev = p;
+  }
+  return length;
+}
+
+/// m points of curve c at stratified arc lengths (see above), in order along the curve.
+template <std::size_t d>
+std::vector<Point<d>> points_along(const CurveShape<d>& c, std::size_t m, Rng& rng) {
+  const std::size_t vertices = 8 * m + 32;
+  const std::vector<double> length = polygon_lengths<d>(c, vertices);
+  const double total = length[vertices];
+  std::vector<Point<d>> pts;
+  pts.reserve(m);
+  std::size_t v = 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const double s = (static_cast<double>(i) + rng.uniform(0.25, 0.75)) * total / static_cast<double>(m);
+    while (v + 1 < vertices && length[v + 1] < s) ++v;
+    const double seg = length[v + 1] - length[v];
+    const double f = seg > 0 ? std::clamp((s - length[v]) / seg, 0.0, 1.0) : 0.0;
+    const double t = (static_cast<double>(v) + f) / static_cast<double>(vertices);
+    pts.push_back(curve_at<d>(c, c.t0 + c.span * t));
+  }
+  return pts;
+}
+
+template <std::size_t d>
+std::vector<std::vector<Point<d>>> curves_by_curve(std::size_t n, Rng& rng) {
+  if (n == 0) return {};
+  const double k_estimate = std::round(std::sqrt(static_cast<double>(n)) / 4.0);
+  const std::size_t k = std::min(n, std::max<std::size_t>(2, static_cast<std::size_t>(k_estimate)));
+  std::vector<CurveShape<d>> shapes;
+  std::vector<double> length(k);
+  double total = 0;
+  for (std::size_t c = 0; c < k; ++c) {
+    shapes.push_back(random_curve<d>(rng));
+    length[c] = polygon_lengths<d>(shapes[c], 256).back();
+    total += length[c];
+  }
+  // One point each, the rest in proportion to length: whole shares first (capped, so rounding
+  // cannot hand out more than n), then one more to the largest remainders, the first on ties.
+  std::vector<std::size_t> m(k, 1);
+  std::vector<double> remainder(k);
+  std::size_t given = k;
+  for (std::size_t c = 0; c < k; ++c) {
+    const double share = static_cast<double>(n - k) * length[c] / total;
+    const double whole = std::floor(share);
+    const std::size_t add = std::min(static_cast<std::size_t>(whole), n - given);
+    m[c] += add;
+    given += add;
+    remainder[c] = share - whole;
+  }
+  std::vector<std::size_t> order(k);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return remainder[a] > remainder[b]; });
+  for (std::size_t i = 0; given < n; i = (i + 1) % k, ++given) ++m[order[i]];
+
+  std::vector<std::vector<Point<d>>> curves;
+  curves.reserve(k);
+  for (std::size_t c = 0; c < k; ++c) curves.push_back(points_along<d>(shapes[c], m[c], rng));
+  return curves;
+}
+
+template <std::size_t d>
+std::vector<Point<d>> curve_distribution(std::size_t n, Rng& rng) {
+  std::vector<Point<d>> pts;
+  pts.reserve(n);
+  for (const auto& curve : curves_by_curve<d>(n, rng)) pts.insert(pts.end(), curve.begin(), curve.end());
+  rng.shuffle(pts);
+  return pts;
+}
+
 // --- lattice, line, boundary ------------------------------------------------------------------
 
 template <std::size_t d>
@@ -328,6 +536,7 @@ std::string_view distribution_name(Distribution dist) noexcept {
     case Distribution::Grid: return "grid";
     case Distribution::Collinear: return "collinear";
     case Distribution::Boundary: return "boundary";
+    case Distribution::Curves: return "curves";
   }
   return "unknown";
 }
@@ -351,6 +560,7 @@ std::vector<Point<d>> generate(Distribution dist, std::size_t n, std::uint64_t s
     case Distribution::Grid: return grid_points<d>(n, rng);
     case Distribution::Collinear: return collinear_points<d>(n, rng);
     case Distribution::Boundary: return boundary_points<d>(n, rng);
+    case Distribution::Curves: return curve_distribution<d>(n, rng);
   }
   throw std::invalid_argument("dynmesh::generate: unknown distribution");
 }
@@ -434,8 +644,16 @@ double log2_spread(const Box<d>& box, std::span<const Point<d>> points) {
   return std::log2(box.side / s);
 }
 
+template <std::size_t d>
+std::vector<std::vector<Point<d>>> curve_points(std::size_t n, std::uint64_t seed) {
+  Rng rng(seed);
+  return curves_by_curve<d>(n, rng);
+}
+
 template std::vector<Point<2>> generate<2>(Distribution, std::size_t, std::uint64_t, double);
 template std::vector<Point<3>> generate<3>(Distribution, std::size_t, std::uint64_t, double);
+template std::vector<std::vector<Point<2>>> curve_points<2>(std::size_t, std::uint64_t);
+template std::vector<std::vector<Point<3>>> curve_points<3>(std::size_t, std::uint64_t);
 template double closest_pair_distance<2>(std::span<const Point<2>>);
 template double closest_pair_distance<3>(std::span<const Point<3>>);
 template double log2_spread<2>(const Box<2>&, std::span<const Point<2>>);
