@@ -96,7 +96,7 @@ TEST(CellRefiner, SameMeshAsTheTwinOnEveryDistributionAndAngle) {
       {Distribution::Uniform, n, 0x1p20},   {Distribution::Clusters, n, 0x1p20},
       {Distribution::Shrinking, n, 0x1p30}, {Distribution::Grid, n, 0x1p20},
       {Distribution::Collinear, n, 0x1p20}, {Distribution::Boundary, n, 0x1p20},
-      {Distribution::Spiral, n, 0x1p20},
+      {Distribution::Spiral, n, 0x1p20},   {Distribution::Curves, n, 0x1p20},
   };
   for (const double angle : {20.7, 25.0, 30.0})
     for (const Case& c : cases)

@@ -94,11 +94,28 @@ class BucketTree {
   void visit_disc(const Point<2>& c, double r, F&& f) const {
     ++queries_;
     // Point location rounds (x − o)·2^52/L: allow for a few ulps of the coordinates.
-    const double mag = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(box_.origin[0]), std::abs(box_.origin[1])});
-    const double margin = r * 0x1p-30 + (mag + box_.side) * 0x1p-40;
+    const double margin = margin_for(c, r);
     const double rr = r + margin;
     bool stop = false;
     visit_disc_node(0, 0, 0, 0, c, rr * rr, margin, f, stop);
+  }
+
+  /// A pruned search: visits the leaves whose cell (widened by `margin`) `keep(x0, y0, x1, y1)`
+  /// accepts, nearest to `focus` first, calling stop = f(v) on their vertices. keep() is asked
+  /// again before every cell, so a search that narrows as it finds (a nearest-neighbour or a
+  /// lowest-circle search) reads only the cells that can still improve its answer.
+  template <class Keep, class F>
+  void search(const Point<2>& focus, double margin, Keep&& keep, F&& f) const {
+    ++queries_;
+    bool stop = false;
+    search_node(0, 0, 0, 0, focus, margin, keep, f, stop);
+  }
+
+  /// The widening of cells that keeps every vertex of a cell inside it despite the rounding
+  /// of point location, for a query of radius r around c.
+  double margin_for(const Point<2>& c, double r) const noexcept {
+    const double mag = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(box_.origin[0]), std::abs(box_.origin[1])});
+    return r * 0x1p-30 + (mag + box_.side) * 0x1p-40;
   }
 
   /// Every vertex within distance r of c (tested in doubles with a relative margin, so that
@@ -114,6 +131,16 @@ class BucketTree {
   }
 
   std::size_t size() const noexcept { return size_; }
+  /// While set, every vertex a query hands out adds digest(v) to *sum (an order-free record
+  /// of what a step looked at, for the locality experiment of cell_refiner.hpp).
+  /// `leaves`, when given, receives the id of every leaf read (repeats included).
+  void watch(std::uint64_t* sum, std::uint64_t (*digest)(const void* ctx, Vid v), const void* ctx,
+             std::vector<std::uint32_t>* leaves = nullptr) const noexcept {
+    watch_leaves_ = leaves;
+    watch_sum_ = sum;
+    watch_digest_ = digest;
+    watch_ctx_ = ctx;
+  }
   /// Leaves met by all queries so far (the events a self-adjusting version would read).
   std::size_t leaves_read() const noexcept { return leaves_read_; }
   std::size_t queries() const noexcept { return queries_; }
@@ -151,7 +178,11 @@ class BucketTree {
     if (x1 < a[0] || x0 > b[0] || y1 < a[1] || y0 > b[1]) return;
     if (N.child == kLeaf) {
       ++leaves_read_;
-      for (const Vid v : N.items) f(v);
+      if (watch_leaves_) watch_leaves_->push_back(n);
+      for (const Vid v : N.items) {
+        if (watch_sum_) *watch_sum_ += watch_digest_(watch_ctx_, v);
+        f(v);
+      }
       return;
     }
     for (unsigned k = 0; k < 4; ++k)
@@ -172,15 +203,53 @@ class BucketTree {
     if (dx * dx + dy * dy > r2) return;
     if (N.child == kLeaf) {
       ++leaves_read_;
-      for (const Vid v : N.items)
+      if (watch_leaves_) watch_leaves_->push_back(n);
+      for (const Vid v : N.items) {
+        if (watch_sum_) *watch_sum_ += watch_digest_(watch_ctx_, v);
         if (f(v)) {
           stop = true;
           return;
         }
+      }
       return;
     }
     for (unsigned k = 0; k < 4 && !stop; ++k)
       visit_disc_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), c, r2, margin, f, stop);
+  }
+
+  template <class Keep, class F>
+  void search_node(std::uint32_t n, int level, std::uint64_t ix, std::uint64_t iy, const Point<2>& focus, double margin,
+                   Keep& keep, F& f, bool& stop) const {
+    const Node& N = nodes_[n];
+    if (N.count == 0 || stop) return;
+    const double w = std::ldexp(box_.side, -level);
+    const double x0 = box_.origin[0] + static_cast<double>(ix) * w - margin, x1 = x0 + w + 2 * margin;
+    const double y0 = box_.origin[1] + static_cast<double>(iy) * w - margin, y1 = y0 + w + 2 * margin;
+    if (!keep(x0, y0, x1, y1)) return;
+    if (N.child == kLeaf) {
+      ++leaves_read_;
+      if (watch_leaves_) watch_leaves_->push_back(n);
+      for (const Vid v : N.items) {
+        if (watch_sum_) *watch_sum_ += watch_digest_(watch_ctx_, v);
+        if (f(v)) {
+          stop = true;
+          return;
+        }
+      }
+      return;
+    }
+    // Children nearest to the focus first (by their centres' distance).
+    std::array<std::pair<double, unsigned>, 4> order;
+    for (unsigned k = 0; k < 4; ++k) {
+      const double cx = box_.origin[0] + (static_cast<double>(2 * ix + (k & 1)) + 0.5) * 0.5 * w;
+      const double cy = box_.origin[1] + (static_cast<double>(2 * iy + (k >> 1)) + 0.5) * 0.5 * w;
+      order[k] = {(cx - focus[0]) * (cx - focus[0]) + (cy - focus[1]) * (cy - focus[1]), k};
+    }
+    std::sort(order.begin(), order.end());
+    for (const auto& [d2, k] : order) {
+      if (stop) return;
+      search_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), focus, margin, keep, f, stop);
+    }
   }
 
   std::size_t check_node(std::uint32_t n, int level, std::uint64_t ix, std::uint64_t iy, std::span<const Point<2>> pts,
@@ -215,6 +284,10 @@ class BucketTree {
   std::vector<Node> nodes_;
   std::size_t size_ = 0;
   mutable std::size_t leaves_read_ = 0, queries_ = 0;
+  mutable std::uint64_t* watch_sum_ = nullptr;
+  mutable std::vector<std::uint32_t>* watch_leaves_ = nullptr;
+  mutable std::uint64_t (*watch_digest_)(const void*, Vid) = nullptr;
+  mutable const void* watch_ctx_ = nullptr;
 };
 
 }  // namespace dynmesh::detail

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -36,10 +37,24 @@ constexpr double kSlack = 0x1p-20;
 /// question's radius.
 double ulp_room(const Point<2>& p) noexcept { return std::max(std::abs(p[0]), std::abs(p[1])) * 0x1p-40; }
 
+std::uint64_t mix(std::uint64_t h) noexcept {
+  h ^= h >> 30;
+  h *= 0xbf58476d1ce4e5b9ULL;
+  h ^= h >> 27;
+  h *= 0x94d049bb133111ebULL;
+  return h ^ (h >> 31);
+}
+std::uint64_t mix(std::uint64_t h, std::uint64_t x) noexcept { return mix(h * 0x9e3779b97f4a7c15ULL + x); }
+std::uint64_t mix(std::uint64_t h, const Point<2>& p) noexcept {
+  return mix(mix(h, std::bit_cast<std::uint64_t>(p[0] + 0.0)), std::bit_cast<std::uint64_t>(p[1] + 0.0));
+}
+
 class CellRefiner {
  public:
-  CellRefiner(const Box<2>& box, double min_angle_deg, std::size_t max_vertices, CellRefinement& out, bool check_tree)
-      : box_(box), tree_(box), max_vertices_(max_vertices), out_(out), check_tree_(check_tree) {
+  CellRefiner(const Box<2>& box, double min_angle_deg, std::size_t max_vertices, CellRefinement& out,
+              const CellRefineOptions& options)
+      : box_(box), tree_(box), sides_(box), max_vertices_(max_vertices), out_(out), check_tree_(options.check_tree),
+        log_steps_(options.log_steps) {
     apex_height_ = apex_height(min_angle_deg);
     leaf_height_ = leaf_height(min_angle_deg);
     lo_[0] = box.origin[0], lo_[1] = box.origin[1];
@@ -60,20 +75,12 @@ class CellRefiner {
   }
 
   void refine() {
-    struct Key {
-      int level;
-      std::uint64_t code;
-      Vid v;
-    };
-    std::vector<Key> order(pts_.size());
-    for (Vid v = 0; v < order.size(); ++v)
-      order[v] = {v < 4 ? INT_MAX : brio_level(pts_[v]), morton_of(box_, pts_[v]), v};
-    std::sort(order.begin(), order.end(), [&](const Key& a, const Key& b) {
-      if (a.level != b.level) return a.level > b.level;
-      if (a.code != b.code) return a.code < b.code;
-      return xy_less(pts_[a.v], pts_[b.v]);
-    });
-    for (const auto& [level, code, v] : order) queues_[first_class(v)].push_back({v, true});
+    for (const Vid v : first_entry_order(box_, pts_)) {
+      step_begin();
+      const int c = first_class(v);
+      step_end(CellStep::FirstClass, mix(0, pts_[v]), static_cast<std::uint64_t>(c));
+      queues_[c].push_back({v, true});
+    }
     while (!queues_.empty()) {
       const auto it = queues_.begin();
       const int j = it->first;
@@ -93,15 +100,20 @@ class CellRefiner {
     std::vector<Triangle> out;
     const std::size_t before = out_.questions.leaves_read;
     for (Vid v = 0; v < pts_.size(); ++v) {
+      step_begin();
+      std::uint64_t answer = 0;
       star_of(v);
       const std::size_t d = star_.size();
       const bool cycle = !on_boundary(v);
       for (std::size_t i = 0; i < d; ++i) {
         if (i + 1 == d && !cycle) break;
         const Vid a = star_[i], b = star_[(i + 1) % d];
-        if (xy_less(pts_[v], pts_[a]) && xy_less(pts_[v], pts_[b]))
+        if (xy_less(pts_[v], pts_[a]) && xy_less(pts_[v], pts_[b])) {
           out.push_back(canonical_triangle(pts_[v], pts_[a], pts_[b]));
+          answer = mix(mix(answer, pts_[a]), pts_[b]);
+        }
       }
+      step_end(CellStep::Final, mix(3, pts_[v]), answer);
     }
     std::sort(out.begin(), out.end());
     out_.questions.leaves_final += out_.questions.leaves_read - before;
@@ -116,11 +128,30 @@ class CellRefiner {
     bool birth;
   };
 
+  // The step log (CellStep): what the cells hand out between step_begin and step_end.
+  static std::uint64_t vertex_digest(const void* self, Vid v) {
+    return mix(0x5eed, static_cast<const CellRefiner*>(self)->pts_[v]);
+  }
+  void step_begin() {
+    if (!log_steps_) return;
+    seen_ = 0;
+    step_leaf_ids_.clear();
+    tree_.watch(&seen_, &vertex_digest, this, &step_leaf_ids_);
+  }
+  void step_end(CellStep::Kind kind, std::uint64_t key, std::uint64_t answer) {
+    if (!log_steps_) return;
+    tree_.watch(nullptr, nullptr, nullptr);
+    // A step reads a leaf once (a self-adjusting step keeps what it read): distinct leaves.
+    std::sort(step_leaf_ids_.begin(), step_leaf_ids_.end());
+    const auto distinct = std::unique(step_leaf_ids_.begin(), step_leaf_ids_.end()) - step_leaf_ids_.begin();
+    out_.steps.push_back(CellStep{mix(mix(mix(key, kind), answer), seen_), static_cast<std::uint32_t>(distinct), kind});
+  }
+
   Vid add(const Point<2>& p) {
     const auto v = static_cast<Vid>(pts_.size());
     pts_.push_back(p);
     tree_.insert(v, p, pts_);
-    note_side(v);
+    sides_.note(p, v);
     if (pts_.size() > max_vertices_)
       throw InvariantError("dynmesh: hpu refinement did not terminate (over " + std::to_string(max_vertices_) +
                            " vertices)");
@@ -142,14 +173,6 @@ class CellRefiner {
     return p[0] == lo_[0] || p[0] == hi_[0] || p[1] == lo_[1] || p[1] == hi_[1];
   }
 
-  /// Sides: 0 bottom, 1 right, 2 top, 3 left; keyed by the coordinate along the side.
-  void note_side(Vid v) {
-    const Point<2>& p = pts_[v];
-    if (p[1] == lo_[1]) sides_[0][p[0]] = v;
-    if (p[0] == hi_[0]) sides_[1][p[1]] = v;
-    if (p[1] == hi_[1]) sides_[2][p[0]] = v;
-    if (p[0] == lo_[0]) sides_[3][p[1]] = v;
-  }
 
   /// Is the outside of the box on the left of p→q? (Both on one side, q before p in the
   /// side's counter-clockwise direction.)
@@ -183,19 +206,23 @@ class CellRefiner {
     return empty;
   }
 
-  /// The distance from v to its nearest vertex, in doubles (found from v's own cells
-  /// outwards).
+  /// The distance from v to its nearest vertex, in doubles: a nearest-first search of the
+  /// cells that reads only those nearer than the best found so far.
   double nearest_distance(Vid v) const {
-    double r = box_.side * 0x1p-20;
-    for (;;) {
-      double best = std::numeric_limits<double>::infinity();
-      tree_.visit_disc(pts_[v], r, [&](Vid w) {
-        if (w != v) best = std::min(best, std::hypot(pts_[w][0] - pts_[v][0], pts_[w][1] - pts_[v][1]));
-        return false;
-      });
-      if (best <= r) return best;
-      r *= 4;
-    }
+    const Point<2>& p = pts_[v];
+    double best = std::numeric_limits<double>::infinity();
+    tree_.search(
+        p, tree_.margin_for(p, 0.0),
+        [&](double x0, double y0, double x1, double y1) {
+          const double ex = p[0] < x0 ? x0 - p[0] : p[0] > x1 ? p[0] - x1 : 0.0;
+          const double ey = p[1] < y0 ? y0 - p[1] : p[1] > y1 ? p[1] - y1 : 0.0;
+          return std::hypot(ex, ey) <= best;
+        },
+        [&](Vid w) {
+          if (w != v) best = std::min(best, std::hypot(pts_[w][0] - p[0], pts_[w][1] - p[1]));
+          return false;
+        });
+    return best;
   }
 
   /// Some vertex that v has an edge to in every Delaunay triangulation: the nearest one whose
@@ -237,15 +264,50 @@ class CellRefiner {
     const double len = std::hypot(dx, dy);
     const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
     const std::size_t before = tree_.leaves_read();
+    // Does the box [x0, x1] × [y0, y1] meet the disc (c, r)?
+    const auto meets = [](double x0, double y0, double x1, double y1, const Point<2>& c, double r) {
+      const double ex = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
+      const double ey = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
+      return ex * ex + ey * ey <= r * r;
+    };
+    // The disc of the circle through p and q at height h, widened for rounding.
+    const auto disc = [&](double h, Point<2>& c, double& r) {
+      c = Point<2>{m[0] - h * dy, m[1] + h * dx};
+      r = len * std::sqrt(0.25 + h * h) * (1 + kSlack) + ulp_room(c);
+    };
     Vid best = kNone;
     for (double h = std::min(0.25, h_max);; h = std::min(2 * h, h_max)) {
-      const Point<2> c{m[0] - h * dy, m[1] + h * dx};
-      const double r = len * std::sqrt(0.25 + h * h) * (1 + kSlack) + ulp_room(c);
-      tree_.visit_disc(c, r, [&](Vid w) {
-        if (w == p || w == q || orient2d(a, b, pts_[w]) <= 0 || pencil(a, b, h, pts_[w]) > 0) return false;
-        if (best == kNone || perturbed_incircle(a, b, pts_[best], pts_[w])) best = w;
-        return false;
-      });
+      Point<2> pc, bc{};
+      double pr, br = 0;
+      disc(h, pc, pr);
+      // Within the probe, a cell is read only while it can hold a vertex below the best
+      // circle found so far (a vertex on that circle can still win a perturbed tie, hence
+      // the widening).
+      tree_.search(
+          pc, tree_.margin_for(pc, pr),
+          [&](double x0, double y0, double x1, double y1) {
+            return meets(x0, y0, x1, y1, pc, pr) && (best == kNone || meets(x0, y0, x1, y1, bc, br));
+          },
+          [&](Vid w) {
+            if (w == p || w == q || orient2d(a, b, pts_[w]) <= 0 || pencil(a, b, h, pts_[w]) > 0) return false;
+            if (best == kNone || perturbed_incircle(a, b, pts_[best], pts_[w])) {
+              best = w;
+              const Point<2>& t = pts_[w];
+              // The best circle's height: (t − p)·(t − q) = 2h·orient(p, q, t). Only a
+              // well-conditioned one (t not nearly on pq's line) narrows the search; its
+              // relative error is then far below the widening.
+              const double tx = t[0] - a[0], ty = t[1] - a[1];
+              const double cross = dx * ty - dy * tx;
+              const double hb = (tx * (t[0] - b[0]) + ty * (t[1] - b[1])) / (2 * cross);
+              if (cross > 0x1p-20 * std::hypot(tx, ty) * len && std::isfinite(hb) && hb < h) {
+                disc(hb, bc, br);
+                br = br * (1 + 0x1p-10) + ulp_room(bc);
+              } else {
+                bc = pc, br = pr;
+              }
+            }
+            return false;
+          });
       if (best != kNone || h >= h_max) break;
     }
     out_.questions.leaves_read += tree_.leaves_read() - before;
@@ -298,33 +360,40 @@ class CellRefiner {
     return whole;
   }
 
-  /// The class of v's shortest Delaunay edge. The vertices within 4·d of v (d the distance
-  /// to the nearest, in doubles) hold every star edge that could be shortest: beyond, an
-  /// edge is at least twice as long as v's nearest edge (itself a Delaunay edge), and
-  /// edge_class is within one of ⌊log2 |pq|⌋. So the answer is the least class among them
-  /// as soon as one of that class is an edge, which a closed diametral disc empty of other
-  /// vertices shows; otherwise (rounding at a power of two), the star decides.
+  /// Does the closed diametral disc of v and q hold no other vertex? (Then vq is an edge
+  /// of every Delaunay triangulation.)
+  bool diametral_empty(Vid v, Vid q) const {
+    const Point<2>&a = pts_[v], &b = pts_[q];
+    const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
+    bool empty = true;
+    tree_.visit_disc(m, 0.5 * std::hypot(b[0] - a[0], b[1] - a[1]) * (1 + kSlack) + ulp_room(m), [&](Vid w) {
+      if (w != v && w != q && pencil(a, b, 0.0, pts_[w]) <= 0) empty = false;
+      return !empty;
+    });
+    return empty;
+  }
+
+  /// The class of v's shortest Delaunay edge. edge_class is ⌊log2 |pq|⌋ but where rounding
+  /// moves |pq|² across a power of four, so an edge longer than the nearest one by more
+  /// than a relative 2^-40 is of no lower class: only the nearest vertices (ties included)
+  /// can set the minimum. Each that has an empty closed diametral disc is an edge; if one
+  /// of a lower class has not, the star decides (exact ties at a power of two).
   int first_class(Vid v) {
     const double d = nearest_distance(v);
     near_.clear();
-    tree_.visit_disc(pts_[v], 4 * d * (1 + kSlack) + ulp_room(pts_[v]), [&](Vid w) {
+    tree_.visit_disc(pts_[v], d * (1 + 0x1p-39) + ulp_room(pts_[v]), [&](Vid w) {
       if (w != v) near_.push_back(w);
       return false;
     });
     out_.questions.gathered_first += near_.size();
-    int best = INT_MAX;
-    for (const Vid q : near_) best = std::min(best, edge_class(pts_[v], pts_[q]));
+    int best = INT_MAX, unsure = INT_MAX;
     for (const Vid q : near_) {
-      if (edge_class(pts_[v], pts_[q]) != best) continue;
-      const Point<2>&a = pts_[v], &b = pts_[q];
-      const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
-      bool empty = true;
-      tree_.visit_disc(m, 0.5 * std::hypot(b[0] - a[0], b[1] - a[1]) * (1 + kSlack) + ulp_room(m), [&](Vid w) {
-        if (w != v && w != q && pencil(a, b, 0.0, pts_[w]) <= 0) empty = false;
-        return !empty;
-      });
-      if (empty) return best;
+      const int c = edge_class(pts_[v], pts_[q]);
+      if (c >= best) continue;
+      if (diametral_empty(v, q)) best = c;
+      else unsure = std::min(unsure, c);
     }
+    if (best != INT_MAX && unsure >= best) return best;
     star_of(v);
     best = INT_MAX;
     for (const Vid q : star_) best = std::min(best, edge_class(pts_[v], pts_[q]));
@@ -335,6 +404,7 @@ class CellRefiner {
   /// at its first entry), in (x, y) order, and its continuation into Q_{j+1}.
   void collect(Vid v, int j, bool birth) {
     ++out_.stats.entries;
+    step_begin();
     const std::size_t before = out_.questions.leaves_read;
     // The continuation needs the triangles of circumradius up to 2^(j+1) only: a star
     // triangle beyond it (the walk's gap) already says "go on". The slack keeps a triangle
@@ -375,11 +445,21 @@ class CellRefiner {
     });
     pairs_.insert(pairs_.end(), local_pairs_.begin(), local_pairs_.end());
     if (go_on) queues_[j + 1].push_back({v, false});
+    std::uint64_t answer = go_on;
+    for (const auto& [a, b] : local_pairs_) answer = mix(mix(answer, pts_[a]), pts_[b]);
+    step_end(CellStep::Collect, mix(mix(mix(1, pts_[v]), static_cast<std::uint64_t>(j)), birth), answer);
     out_.questions.leaves_collect += out_.questions.leaves_read - before;
   }
 
   /// Figure 5, lines 10-14, for the ccw side of p→q (the twin's process).
   void process(Vid p, Vid q, int j) {
+    step_begin();
+    std::uint64_t answer = 0;
+    process_steps(p, q, j, answer);
+    step_end(CellStep::Process, mix(mix(mix(2, pts_[p]), pts_[q]), static_cast<std::uint64_t>(j)), answer);
+  }
+
+  void process_steps(Vid p, Vid q, int j, std::uint64_t& answer) {
     const std::size_t before = out_.questions.leaves_read;
     struct Count {
       std::size_t& total;
@@ -402,6 +482,7 @@ class CellRefiner {
       if (!std::isfinite(r[0]) || !std::isfinite(r[1])) throw InvariantError("dynmesh: a non-finite off-center");
       if (!(r[0] >= lo_[0] && r[0] <= hi_[0] && r[1] >= lo_[1] && r[1] <= hi_[1])) {
         split_crossed(a, b, r, j);
+        answer = mix(answer, pts_.back());
         continue;
       }
       if (find(r))
@@ -415,10 +496,14 @@ class CellRefiner {
         std::sort(encroached_.begin(), encroached_.end(), [&](const auto& x, const auto& y) {
           return pair_less(pts_[x[0]], pts_[x[1]], pts_[y[0]], pts_[y[1]]);
         });
-        for (const auto& s : encroached_) split_side(s[0], s[1], j);
+        for (const auto& s : encroached_) {
+          split_side(s[0], s[1], j);
+          answer = mix(answer, pts_.back());
+        }
         continue;
       }
       const Vid rv = add(r);
+      answer = mix(answer, r);
       ++out_.stats.off_centers;
       if (was_circumcentre) ++out_.stats.circumcentres;
       queues_[j].push_back({rv, true});
@@ -437,11 +522,9 @@ class CellRefiner {
   /// holding r's projection can have r strictly inside its diametral disc.
   std::optional<std::array<Vid, 2>> encroached_edge(int s, const Point<2>& r) {
     const unsigned along = s % 2 == 0 ? 0 : 1;
-    const auto& line = sides_[s];
-    auto it = line.upper_bound(r[along]);
-    if (it == line.begin() || it == line.end()) return std::nullopt;
-    const Vid hi_end = it->second, lo_end = std::prev(it)->second;
-    if (!(pts_[lo_end][along] < r[along])) return std::nullopt;  // r projects onto a vertex
+    const auto held = sides_.edge_holding(s, r[along]);  // none: r projects onto a vertex
+    if (!held) return std::nullopt;
+    const Vid lo_end = (*held)[0], hi_end = (*held)[1];
     if (!encroaches(pts_[lo_end], pts_[hi_end], r)) return std::nullopt;
     // The edge in counter-clockwise order along the boundary (the inside on its left).
     const bool forward = s == 0 || s == 1;
@@ -459,11 +542,8 @@ class CellRefiner {
   /// The twin's split_crossed: the box edge holding the first crossing of m→r with the box.
   void split_crossed(const Point<2>& p, const Point<2>& q, const Point<2>& r, int j) {
     const auto [side, x] = side_crossed(box_, p, q, r);
-    const auto& line = sides_[side];
-    auto it = line.upper_bound(x);
-    if (it == line.end()) --it;
-    if (it == line.begin()) ++it;
-    split_side(std::prev(it)->second, it->second, j);
+    const auto e = sides_.edge_around(side, x);
+    split_side(e[0], e[1], j);
   }
 
   void split_side(Vid a, Vid b, int j) {
@@ -476,14 +556,16 @@ class CellRefiner {
 
   Box<2> box_;
   BucketTree tree_;
+  BoxSides<Vid> sides_;
   double lo_[2], hi_[2];
   double apex_height_ = 0, leaf_height_ = 0;
   std::size_t max_vertices_;
   CellRefinement& out_;
-  bool check_tree_;
+  bool check_tree_, log_steps_;
+  std::uint64_t seen_ = 0;
+  std::vector<std::uint32_t> step_leaf_ids_;
   std::vector<Point<2>> pts_;
   std::map<int, std::vector<Entry>> queues_;
-  std::map<double, Vid> sides_[4];
   std::vector<Entry> batch_;
   std::vector<Vid> star_, back_, near_;
   std::vector<std::array<Vid, 2>> pairs_, local_pairs_, encroached_;
@@ -492,7 +574,7 @@ class CellRefiner {
 }  // namespace
 
 CellRefinement cell_refine(const Box<2>& box, std::span<const Point<2>> points, double min_angle_deg,
-                           bool check_tree) {
+                           const CellRefineOptions& options) {
   validate_min_angle(min_angle_deg);
   const auto qs = locate_all(box, points);
   check_separated(qs);
@@ -500,7 +582,7 @@ CellRefinement cell_refine(const Box<2>& box, std::span<const Point<2>> points, 
   validate_mesh_box(box);
   const std::size_t max_vertices = 1000 * (points.size() + 4) + (std::size_t{1} << 20);
   CellRefinement out;
-  CellRefiner refiner(box, min_angle_deg, max_vertices, out, check_tree);
+  CellRefiner refiner(box, min_angle_deg, max_vertices, out, options);
   refiner.insert_inputs(points);
   refiner.refine();
   out.triangles = refiner.triangles();

@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -50,14 +51,35 @@ struct CellQuestionStats {
   std::size_t leaves_collect = 0, leaves_process = 0, leaves_final = 0;
 };
 
+/// One step of the refinement as a self-adjusting version would record it: a digest of its
+/// key (what it is: a vertex's first class, an entry's collect, a pair's processing, a
+/// vertex's final triangles), of every vertex the cells it read handed it, and of its
+/// answer; and the leaves it read. Two runs on point sets that differ by one point share
+/// every step that a change-propagation of that update would leave alone, so the steps of
+/// one run that the other lacks (a multiset difference) bound the update's trace distance
+/// from above, up to the cost of each step (bench/dynmesh_hpu_locality.cpp).
+struct CellStep {
+  enum Kind : std::uint8_t { FirstClass, Collect, Process, Final };
+  std::uint64_t digest;
+  std::uint32_t leaves;  // distinct leaves read
+  Kind kind;
+  friend bool operator<(const CellStep& a, const CellStep& b) noexcept { return a.digest < b.digest; }
+};
+
 struct CellRefinement {
   std::vector<Triangle> triangles;  // canonical, sorted
   HpuStats stats;                   // triangles_made and max_cavity stay 0 (no triangulation)
   CellQuestionStats questions;
+  std::vector<CellStep> steps;      // with log_steps only
+};
+
+struct CellRefineOptions {
+  bool check_tree = false;  // BucketTree::check_invariants after every insertion (O(n) each)
+  bool log_steps = false;   // fill CellRefinement::steps
 };
 
 /// The hpu mesh of the points (validated as HpuMesh validates them) by cell questions.
 CellRefinement cell_refine(const Box<2>& box, std::span<const Point<2>> points, double min_angle_deg,
-                           bool check_tree = false);
+                           const CellRefineOptions& options = {});
 
 }  // namespace dynmesh::detail

@@ -1,7 +1,9 @@
 // hpu_geometry.hpp (private) — the pure geometry of the hpu mesh, shared by its static twin
 // (hpu_mesh.cpp, class Refiner) and its self-adjusting version (hpu_program.hpp).
 //
-// Purpose: both meshers must take the same decisions on the same bits, so every formula
+// Purpose: every mesher of the hpu rules (the twin, hpu_mesh.cpp; the cell refiner,
+// cell_refiner.cpp; the self-adjusting program) must take the same decisions on the same
+// bits, so every formula
 // that produces a coordinate or a class (side midpoints, off-centers, circumradii, size
 // classes, Morton codes, the leaf and apex heights) and the loose test live here once, as
 // functions of points only (no triangulation, no vertex ids).
@@ -14,10 +16,14 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <bit>
+#include <climits>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <string>
 #include <tuple>
@@ -275,6 +281,68 @@ inline SideCrossing side_crossed(const Box<2>& box, const Point<2>& p, const Poi
   if (r[0] < lo[0]) consider(3, 0, lo[0]);
   const unsigned along = side % 2 == 0 ? 0 : 1;
   return SideCrossing{side, std::clamp(m[along] + best * (r[along] - m[along]), lo[along], hi[along])};
+}
+
+/// The vertices on the box's sides, by side (0 bottom, 1 right, 2 top, 3 left) and keyed by
+/// the coordinate along it: the box edges are consecutive entries. Shared by both refiners,
+/// so that a split picks the same edge in each.
+template <class Vid>
+class BoxSides {
+ public:
+  explicit BoxSides(const Box<2>& box)
+      : lo_{box.origin[0], box.origin[1]}, hi_{box.origin[0] + box.side, box.origin[1] + box.side} {}
+
+  /// Records v at p if p lies on a side (a corner on two).
+  void note(const Point<2>& p, Vid v) {
+    if (p[1] == lo_[1]) line_[0][p[0]] = v;
+    if (p[0] == hi_[0]) line_[1][p[1]] = v;
+    if (p[1] == hi_[1]) line_[2][p[0]] = v;
+    if (p[0] == lo_[0]) line_[3][p[1]] = v;
+  }
+
+  /// The edge of side s around the coordinate x: the one holding x in [a, b), clamped to the
+  /// side's first and last edges (the refiners' rule for an off-center beyond the box).
+  std::array<Vid, 2> edge_around(int s, double x) const {
+    const auto& line = line_[s];
+    auto it = line.upper_bound(x);
+    if (it == line.end()) --it;
+    if (it == line.begin()) ++it;
+    return {std::prev(it)->second, it->second};
+  }
+
+  /// The edge of side s whose open interval holds x, as (lower, upper) along the side; none
+  /// when x is a vertex's coordinate or beyond the side.
+  std::optional<std::array<Vid, 2>> edge_holding(int s, double x) const {
+    const auto& line = line_[s];
+    const auto it = line.upper_bound(x);
+    if (it == line.begin() || it == line.end() || !(std::prev(it)->first < x)) return std::nullopt;
+    return std::array<Vid, 2>{std::prev(it)->second, it->second};
+  }
+
+ private:
+  double lo_[2], hi_[2];
+  std::map<double, Vid> line_[4];
+};
+
+/// The order of the first queue entries: the four box corners (vertices 0-3) first in
+/// (Morton, x, y) order, then the other vertices in insertion_less order. Returns indices.
+inline std::vector<std::uint32_t> first_entry_order(const Box<2>& box, std::span<const Point<2>> pts) {
+  struct Key {
+    int level;
+    std::uint64_t code;
+    std::uint32_t v;
+  };
+  std::vector<Key> keys(pts.size());
+  for (std::uint32_t v = 0; v < keys.size(); ++v)
+    keys[v] = {v < 4 ? INT_MAX : brio_level(pts[v]), morton_of(box, pts[v]), v};
+  std::sort(keys.begin(), keys.end(), [&](const Key& a, const Key& b) {
+    if (a.level != b.level) return a.level > b.level;
+    if (a.code != b.code) return a.code < b.code;
+    return xy_less(pts[a.v], pts[b.v]);
+  });
+  std::vector<std::uint32_t> out(keys.size());
+  for (std::size_t i = 0; i < keys.size(); ++i) out[i] = keys[i].v;
+  return out;
 }
 
 }  // namespace dynmesh::detail

@@ -36,12 +36,12 @@ using detail::side_midpoints;
 class Refiner {
  public:
   Refiner(const Box<2>& box, double min_angle_deg, std::size_t max_vertices, HpuStats& stats)
-      : box_(box), dt_(box), max_vertices_(max_vertices), stats_(stats) {
+      : box_(box), dt_(box), max_vertices_(max_vertices), stats_(stats), sides_(box) {
     apex_height_ = detail::apex_height(min_angle_deg);
     leaf_height_ = detail::leaf_height(min_angle_deg);
     lo_[0] = box.origin[0], lo_[1] = box.origin[1];
     hi_[0] = box.origin[0] + box.side, hi_[1] = box.origin[1] + box.side;
-    for (Vid v = 0; v < 4; ++v) note_side(v);
+    for (Vid v = 0; v < 4; ++v) sides_.note(dt_.point(v), v);
   }
 
   void insert_inputs(std::span<const Point<2>> points) {
@@ -49,7 +49,7 @@ class Refiner {
     for (const Point<2>& m : side_midpoints(box_, points)) {
       created_.clear();
       if (const auto v = dt_.insert(m, hint, created_)) {
-        note_side(*v);
+        sides_.note(m, *v);
         hint = created_.empty() ? hint : created_.back();
       }
       ++stats_.side_splits;
@@ -60,7 +60,7 @@ class Refiner {
     for (const auto& [code, i] : order) {
       created_.clear();
       if (const auto v = dt_.insert(points[i], hint, created_)) {
-        note_side(*v);
+        sides_.note(points[i], *v);
         hint = created_.empty() ? hint : created_.back();
       }
     }
@@ -69,20 +69,9 @@ class Refiner {
   void refine() {
     // The first entries: every vertex at the class of its shortest edge; the corners first
     // in (Morton, xy) order, then the rest in insertion_less order (hpu_geometry.hpp).
-    struct Key {
-      int level;
-      std::uint64_t code;
-      Vid v;
-    };
-    std::vector<Key> order(dt_.num_vertices());
-    for (Vid v = 0; v < order.size(); ++v)
-      order[v] = {v < 4 ? INT_MAX : detail::brio_level(dt_.point(v)), morton_of(dt_.point(v)), v};
-    std::sort(order.begin(), order.end(), [&](const Key& a, const Key& b) {
-      if (a.level != b.level) return a.level > b.level;
-      if (a.code != b.code) return a.code < b.code;
-      return xy_less(dt_.point(a.v), dt_.point(b.v));
-    });
-    for (const auto& [level, code, v] : order) {
+    std::vector<Point<2>> pts(dt_.num_vertices());
+    for (Vid v = 0; v < pts.size(); ++v) pts[v] = dt_.point(v);
+    for (const Vid v : detail::first_entry_order(box_, pts)) {
       dt_.star(v, star_);
       int c = std::numeric_limits<int>::max();
       for (const Vid q : star_) c = std::min(c, edge_class(v, q));
@@ -115,14 +104,6 @@ class Refiner {
     return p[0] == lo_[0] || p[0] == hi_[0] || p[1] == lo_[1] || p[1] == hi_[1];
   }
 
-  /// Sides: 0 bottom, 1 right, 2 top, 3 left; keyed by the coordinate along the side.
-  void note_side(Vid v) {
-    const Point<2>& p = dt_.point(v);
-    if (p[1] == lo_[1]) sides_[0][p[0]] = v;
-    if (p[0] == hi_[0]) sides_[1][p[1]] = v;
-    if (p[1] == hi_[1]) sides_[2][p[0]] = v;
-    if (p[0] == lo_[0]) sides_[3][p[1]] = v;
-  }
 
   /// A queue entry: a vertex, and whether this is its first (it then collects its shorter
   /// pairs too: a side's midpoint can have edges of classes already done).
@@ -229,11 +210,8 @@ class Refiner {
   /// crossing does too, and halving the edges around it puts a vertex into the leaf).
   void split_crossed(const Point<2>& p, const Point<2>& q, const Point<2>& r, int j) {
     const auto [side, x] = detail::side_crossed(box_, p, q, r);
-    const auto& line = sides_[side];
-    auto it = line.upper_bound(x);
-    if (it == line.end()) --it;
-    if (it == line.begin()) ++it;
-    split_side(std::prev(it)->second, it->second, j);
+    const auto e = sides_.edge_around(side, x);
+    split_side(e[0], e[1], j);
   }
 
   void split_side(Vid a, Vid b, int j) {
@@ -241,7 +219,7 @@ class Refiner {
     created_.clear();
     const auto v = dt_.insert(mid, dt_.incident(a), created_);
     if (!v) throw InvariantError("dynmesh: a box edge's midpoint is already a vertex");
-    note_side(*v);
+    sides_.note(mid, *v);
     ++stats_.side_splits;
     check_size();
     queues_[j].push_back({*v, true});
@@ -260,7 +238,7 @@ class Refiner {
   std::size_t max_vertices_;
   HpuStats& stats_;
   std::map<int, std::vector<Entry>> queues_;
-  std::map<double, Vid> sides_[4];
+  detail::BoxSides<Vid> sides_;
   std::vector<Entry> batch_;
   std::vector<Vid> star_;
   std::vector<std::array<Vid, 2>> pairs_, local_;

@@ -1,0 +1,151 @@
+// dynmesh_hpu_locality — how much of the hpu refinement one point update changes when every
+// question is answered from the cells (src/hpu/cell_refiner.hpp), measured before the
+// self-adjusting version of that refiner exists.
+//
+// Method: refine P with the step log on; then, for U points x of P drawn with a fixed seed,
+// refine P \ {x} in the same box and count the steps (CellStep: a step's key, what the cells
+// handed it, its answer) that one run has and the other has not: the steps an ideal change
+// propagation of "delete x" (or, read backwards, "insert x") must re-run or undo. Each such
+// step is weighted by the leaves it read, the reads its re-execution would record. Deletion
+// and insertion give the same figure (the difference is symmetric). Prints one row per
+// (distribution, n): the steps of a run, then the mean, median and largest number of
+// changed steps and the mean changed leaf reads per update. Flat in n is the goal.
+//
+//   dynmesh_hpu_locality [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
+//                        [--seed 1] [--angle 20.7] [--csv]
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "bench_stats.hpp"
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/distributions.hpp"
+#include "hpu/cell_refiner.hpp"
+
+namespace {
+
+using namespace dynmesh;
+
+struct Diff {
+  std::size_t steps = 0;
+  std::size_t leaves = 0;
+  std::size_t by_kind[4] = {0, 0, 0, 0};  // changed steps: first classes, collects, processes, final
+  std::size_t leaves_by_kind[4] = {0, 0, 0, 0};
+  void add(const detail::CellStep& s) {
+    ++steps, leaves += s.leaves;
+    ++by_kind[s.kind], leaves_by_kind[s.kind] += s.leaves;
+  }
+};
+
+/// The multiset difference of two digest-sorted step logs.
+Diff difference(const std::vector<detail::CellStep>& a, const std::vector<detail::CellStep>& b) {
+  Diff d;
+  std::size_t i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    if (j == b.size() || (i < a.size() && a[i].digest < b[j].digest)) {
+      d.add(a[i++]);
+    } else if (i == a.size() || b[j].digest < a[i].digest) {
+      d.add(b[j++]);
+    } else {
+      ++i, ++j;
+    }
+  }
+  return d;
+}
+
+std::vector<detail::CellStep> run(const Box<2>& box, const std::vector<Point<2>>& pts, double angle) {
+  auto r = detail::cell_refine(box, pts, angle, detail::CellRefineOptions{.log_steps = true});
+  std::sort(r.steps.begin(), r.steps.end());
+  return std::move(r.steps);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Steps of the cell-based hpu refinement that one point update changes"};
+  std::vector<std::string> dists{"spiral", "curves", "uniform"};
+  std::vector<std::size_t> sizes{1000, 4000, 16000};
+  std::size_t updates = 20;
+  std::uint64_t seed = 1;
+  double angle = 20.7;
+  bool csv = false, profile = false;
+  app.add_option("--dist", dists, "distributions")->delimiter(',');
+  app.add_option("--n", sizes, "sizes")->delimiter(',');
+  app.add_option("--updates", updates, "updates measured per size");
+  app.add_option("--seed", seed, "seed of the points and of the updates");
+  app.add_option("--angle", angle, "angle bound (degrees)");
+  app.add_flag("--csv", csv, "CSV output");
+  app.add_flag("--profile", profile, "also print, per step kind, the leaves one step reads (mean, median, p99, max)");
+  CLI11_PARSE(app, argc, argv);
+
+  if (csv)
+    std::printf("dist,n,steps,mean_changed,median_changed,max_changed,mean_changed_leaves,"
+                "first,collect,process,final,first_leaves,collect_leaves,process_leaves,final_leaves\n");
+  else
+    std::printf("%-8s %7s %8s %9s %9s %8s %11s   %s\n", "dist", "n", "steps", "mean chg", "median", "max",
+                "chg reads", "changed steps (reads) by kind: first / collect / process / final");
+  for (const std::string& name : dists) {
+    const auto dist = parse_distribution(name);
+    if (!dist) {
+      std::fprintf(stderr, "dynmesh_hpu_locality: unknown distribution %s\n", name.c_str());
+      return 2;
+    }
+    for (const std::size_t n : sizes) {
+      const auto pts = generate<2>(*dist, n, seed);
+      const Box<2> box = derive_box<2>(pts);
+      const auto base = run(box, pts, angle);
+      if (profile) {
+        static const char* const kKind[] = {"first class", "collect", "process", "final"};
+        for (int k = 0; k < 4; ++k) {
+          std::vector<double> l;
+          for (const auto& st : base)
+            if (st.kind == k) l.push_back(st.leaves);
+          std::sort(l.begin(), l.end());
+          double sum = 0;
+          for (const double x : l) sum += x;
+          if (!l.empty())
+            std::printf("# %s n=%zu %-12s steps %8zu  leaves/step mean %6.1f median %5.0f p99 %6.0f max %6.0f\n",
+                        name.c_str(), n, kKind[k], l.size(), sum / static_cast<double>(l.size()), l[l.size() / 2],
+                        l[l.size() * 99 / 100], l.back());
+        }
+      }
+      std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
+      std::vector<double> changed, reads;
+      double kind[4] = {0, 0, 0, 0}, kind_leaves[4] = {0, 0, 0, 0};
+      for (std::size_t u = 0; u < updates; ++u) {
+        std::vector<Point<2>> less = pts;
+        less.erase(less.begin() + static_cast<std::ptrdiff_t>(rng() % less.size()));
+        const Diff d = difference(base, run(box, less, angle));
+        changed.push_back(static_cast<double>(d.steps));
+        reads.push_back(static_cast<double>(d.leaves));
+        for (int k = 0; k < 4; ++k) {
+          kind[k] += static_cast<double>(d.by_kind[k]) / static_cast<double>(updates);
+          kind_leaves[k] += static_cast<double>(d.leaves_by_kind[k]) / static_cast<double>(updates);
+        }
+      }
+      const auto mean = [](const std::vector<double>& v) {
+        double s = 0;
+        for (const double x : v) s += x;
+        return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+      };
+      const double med = bench::median(changed);
+      const double mx = changed.empty() ? 0.0 : *std::max_element(changed.begin(), changed.end());
+      if (csv)
+        std::printf("%s,%zu,%zu,%.1f,%.1f,%.0f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f,%.1f\n", name.c_str(), n,
+                    base.size(), mean(changed), med, mx, mean(reads), kind[0], kind[1], kind[2], kind[3], kind_leaves[0],
+                    kind_leaves[1], kind_leaves[2], kind_leaves[3]);
+      else
+        std::printf("%-8s %7zu %8zu %9.1f %9.1f %8.0f %11.1f   %.0f (%.0f) / %.0f (%.0f) / %.0f (%.0f) / %.0f (%.0f)\n",
+                    name.c_str(), n, base.size(), mean(changed), med, mx, mean(reads), kind[0], kind_leaves[0], kind[1],
+                    kind_leaves[1], kind[2], kind_leaves[2], kind[3], kind_leaves[3]);
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
