@@ -149,4 +149,56 @@ TEST(CellRefiner, QuestionsReadABoundedNumberOfCellsOnASpiral) {
   EXPECT_LT(per_question[1], 1.5 * per_question[0]) << "leaves per question grow with n";
 }
 
+/// Steps of one log that the other lacks (multiset difference of digest-sorted logs), and
+/// the distinct leaves those steps read.
+std::pair<std::size_t, std::size_t> changed_steps(std::vector<detail::CellStep> a, std::vector<detail::CellStep> b) {
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  std::size_t steps = 0, leaves = 0, i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    if (j == b.size() || (i < a.size() && a[i].digest < b[j].digest)) {
+      ++steps, leaves += a[i++].leaves;
+    } else if (i == a.size() || b[j].digest < a[i].digest) {
+      ++steps, leaves += b[j++].leaves;
+    } else {
+      ++i, ++j;
+    }
+  }
+  return {steps, leaves};
+}
+
+TEST(CellRefiner, AnUpdateChangesABoundedNumberOfStepsOnCurves) {
+  // What a self-adjusting version of the refiner must redo for one deletion is bounded by
+  // the steps (key, vertices read, answer) that the two runs do not share. From n = 1000
+  // to 4000 on a spiral and on curves, that figure may grow with the spread (O(lg L/s)
+  // classes: a spiral's spread grows with n), not as the triangulation-based program's
+  // trace distance does (n^0.45 on a spiral: 1.7x over this range). Seeds fixed: points
+  // 21, deletions 5.
+  if (kSanitized) GTEST_SKIP() << "thousands of points at -O0 under the sanitizers";
+  for (const auto dist : {Distribution::Spiral, Distribution::Curves}) {
+    double mean_steps[2] = {0, 0}, mean_leaves[2] = {0, 0};
+    std::size_t idx = 0;
+    for (const std::size_t n : {1000u, 4000u}) {
+      const auto pts = generate<2>(dist, n, 21);
+      const Box<2> box = derive_box<2>(pts);
+      const detail::CellRefineOptions log{.log_steps = true};
+      const auto base = detail::cell_refine(box, pts, 20.7, log).steps;
+      std::mt19937_64 rng(5);
+      constexpr int kUpdates = 6;
+      for (int u = 0; u < kUpdates; ++u) {
+        auto less = pts;
+        less.erase(less.begin() + static_cast<std::ptrdiff_t>(rng() % less.size()));
+        const auto [steps, leaves] = changed_steps(base, detail::cell_refine(box, less, 20.7, log).steps);
+        mean_steps[idx] += static_cast<double>(steps) / kUpdates;
+        mean_leaves[idx] += static_cast<double>(leaves) / kUpdates;
+      }
+      std::printf("%s n=%zu: %.0f changed steps reading %.0f leaves per deletion (of %zu steps)\n",
+                  std::string(distribution_name(dist)).c_str(), n, mean_steps[idx], mean_leaves[idx], base.size());
+      ++idx;
+    }
+    EXPECT_LT(mean_steps[1], 1.6 * mean_steps[0]) << distribution_name(dist) << ": changed steps grow with n";
+    EXPECT_LT(mean_leaves[1], 1.7 * mean_leaves[0]) << distribution_name(dist) << ": changed reads grow with n";
+  }
+}
+
 }  // namespace

@@ -331,12 +331,14 @@ class CellRefiner {
     };
     star_.assign(1, q0);
     bool whole = true;
+    gap_ends_ = 0;
     for (Vid q = q0;;) {
       if (outside_left(v, q)) break;  // a box side: the fan ends
       const double h = h_cap(v, q);
       const Vid t = h < 0 ? kNone : left_search(v, q, h);
       if (t == kNone) {
         whole = false;
+        ++gap_ends_;
         break;
       }
       if (t == q0) return true;
@@ -350,6 +352,7 @@ class CellRefiner {
       const Vid t = h < 0 ? kNone : left_search(q, v, h);
       if (t == kNone) {
         whole = false;
+        ++gap_ends_;
         break;
       }
       if (!whole && std::find(star_.begin(), star_.end(), t) != star_.end()) break;  // met the other run
@@ -432,11 +435,48 @@ class CellRefiner {
       // Edges inside the gap have both triangles beyond 2^(j+1); those of class ≤ j end
       // within 2^(j+1) of v, and a loose one is an edge (its leaf is empty): ask each vertex
       // there that the walk did not reach.
+      // When both walks stopped at the gap, it is the angle from the counter-clockwise run's
+      // last vertex a to the clockwise run's last vertex b (counter-clockwise), and only the
+      // cells that meet that angle are read.
       near_.clear();
-      tree_.visit_disc(pts_[v], std::ldexp(1.0 + 0x1p-20, j + 1) + ulp_room(pts_[v]), [&](Vid w) {
-        if (w != v && std::find(star_.begin(), star_.end(), w) == star_.end()) near_.push_back(w);
-        return false;
-      });
+      const Point<2>& c = pts_[v];
+      const double reach = std::ldexp(1.0 + 0x1p-20, j + 1) + ulp_room(c);
+      const bool angle = gap_ends_ == 2;
+      const Point<2>&a = pts_[star_.back()], &b = pts_[star_.front()];
+      const bool reflex = angle && orient2d(c, a, b) <= 0;
+      // The sign of the cross product (u − c) × (w − c) in doubles, 0 when within rounding.
+      const auto side = [&](const Point<2>& u, double wx, double wy) {
+        const double ux = u[0] - c[0], uy = u[1] - c[1], vx = wx - c[0], vy = wy - c[1];
+        const double cr = ux * vy - uy * vx;
+        const double err = 0x1p-40 * (std::abs(ux * vy) + std::abs(uy * vx)) + 0x1p-1000;
+        return cr > err ? 1 : cr < -err ? -1 : 0;
+      };
+      tree_.search(
+          c, tree_.margin_for(c, reach),
+          [&](double x0, double y0, double x1, double y1) {
+            const double ex = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
+            const double ey = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
+            if (ex * ex + ey * ey > reach * reach) return false;
+            if (!angle) return true;
+            // Outside the angle for certain: every corner right of ca, or every corner left
+            // of cb (a reflex angle: both at once).
+            bool right_of_a = true, left_of_b = true;
+            for (const auto& [x, y] : {std::pair{x0, y0}, std::pair{x1, y0}, std::pair{x0, y1}, std::pair{x1, y1}}) {
+              right_of_a = right_of_a && side(a, x, y) < 0;
+              left_of_b = left_of_b && side(b, x, y) > 0;
+            }
+            return reflex ? !(right_of_a && left_of_b) : !(right_of_a || left_of_b);
+          },
+          [&](Vid w) {
+            if (w == v || std::find(star_.begin(), star_.end(), w) != star_.end()) return false;
+            if (angle) {
+              const int oa = orient2d(c, a, pts_[w]), ob = orient2d(c, pts_[w], b);
+              if (reflex ? (oa < 0 && ob < 0) : (oa < 0 || ob < 0)) return false;
+            }
+            near_.push_back(w);
+            return false;
+          });
+      std::sort(near_.begin(), near_.end());
       for (const Vid q : near_) take(q);
     }
     std::sort(local_pairs_.begin(), local_pairs_.end(), [&](const auto& a, const auto& b) {
@@ -568,6 +608,7 @@ class CellRefiner {
   std::map<int, std::vector<Entry>> queues_;
   std::vector<Entry> batch_;
   std::vector<Vid> star_, back_, near_;
+  int gap_ends_ = 0;  // star_of's walks that stopped at its cap (0, 1 or 2)
   std::vector<std::array<Vid, 2>> pairs_, local_pairs_, encroached_;
 };
 
