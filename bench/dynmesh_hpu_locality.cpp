@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -37,9 +38,11 @@ struct Diff {
   std::size_t leaves = 0;
   std::size_t by_kind[4] = {0, 0, 0, 0};  // changed steps: first classes, collects, processes, final
   std::size_t leaves_by_kind[4] = {0, 0, 0, 0};
+  std::map<int, std::size_t> by_class;  // changed collects and processings by size class
   void add(const detail::CellStep& s) {
     ++steps, leaves += s.leaves;
     ++by_kind[s.kind], leaves_by_kind[s.kind] += s.leaves;
+    if (s.kind == detail::CellStep::Collect || s.kind == detail::CellStep::Process) ++by_class[s.cls];
   }
 };
 
@@ -74,13 +77,14 @@ int main(int argc, char** argv) {
   std::size_t updates = 20;
   std::uint64_t seed = 1;
   double angle = 20.7;
-  bool csv = false, profile = false;
+  bool csv = false, profile = false, by_class = false;
   app.add_option("--dist", dists, "distributions")->delimiter(',');
   app.add_option("--n", sizes, "sizes")->delimiter(',');
   app.add_option("--updates", updates, "updates measured per size");
   app.add_option("--seed", seed, "seed of the points and of the updates");
   app.add_option("--angle", angle, "angle bound (degrees)");
   app.add_flag("--csv", csv, "CSV output");
+  app.add_flag("--by-class", by_class, "also print the changed collects and processings per update by size class");
   app.add_flag("--profile", profile, "also print, per step kind, the leaves one step reads (mean, median, p99, max)");
   CLI11_PARSE(app, argc, argv);
 
@@ -118,12 +122,14 @@ int main(int argc, char** argv) {
       std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
       std::vector<double> changed, reads;
       double kind[4] = {0, 0, 0, 0}, kind_leaves[4] = {0, 0, 0, 0};
+      std::map<int, double> classes;
       for (std::size_t u = 0; u < updates; ++u) {
         std::vector<Point<2>> less = pts;
         less.erase(less.begin() + static_cast<std::ptrdiff_t>(rng() % less.size()));
         const Diff d = difference(base, run(box, less, angle));
         changed.push_back(static_cast<double>(d.steps));
         reads.push_back(static_cast<double>(d.leaves));
+        for (const auto& [c, count] : d.by_class) classes[c] += static_cast<double>(count) / static_cast<double>(updates);
         for (int k = 0; k < 4; ++k) {
           kind[k] += static_cast<double>(d.by_kind[k]) / static_cast<double>(updates);
           kind_leaves[k] += static_cast<double>(d.leaves_by_kind[k]) / static_cast<double>(updates);
@@ -144,6 +150,11 @@ int main(int argc, char** argv) {
         std::printf("%-8s %7zu %8zu %9.1f %9.1f %8.0f %11.1f   %.0f (%.0f) / %.0f (%.0f) / %.0f (%.0f) / %.0f (%.0f)\n",
                     name.c_str(), n, base.size(), mean(changed), med, mx, mean(reads), kind[0], kind_leaves[0], kind[1],
                     kind_leaves[1], kind[2], kind_leaves[2], kind[3], kind_leaves[3]);
+      if (by_class) {
+        std::printf("# %s n=%zu changed collects+processings by class:", name.c_str(), n);
+        for (const auto& [c, x] : classes) std::printf(" %d:%.0f", c, x);
+        std::printf("\n");
+      }
       std::fflush(stdout);
     }
   }

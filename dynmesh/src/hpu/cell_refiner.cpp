@@ -138,13 +138,14 @@ class CellRefiner {
     step_leaf_ids_.clear();
     tree_.watch(&seen_, &vertex_digest, this, &step_leaf_ids_);
   }
-  void step_end(CellStep::Kind kind, std::uint64_t key, std::uint64_t answer) {
+  void step_end(CellStep::Kind kind, std::uint64_t key, std::uint64_t answer, int cls = 0) {
     if (!log_steps_) return;
     tree_.watch(nullptr, nullptr, nullptr);
     // A step reads a leaf once (a self-adjusting step keeps what it read): distinct leaves.
     std::sort(step_leaf_ids_.begin(), step_leaf_ids_.end());
     const auto distinct = std::unique(step_leaf_ids_.begin(), step_leaf_ids_.end()) - step_leaf_ids_.begin();
-    out_.steps.push_back(CellStep{mix(mix(mix(key, kind), answer), seen_), static_cast<std::uint32_t>(distinct), kind});
+    out_.steps.push_back(CellStep{mix(mix(mix(key, kind), answer), seen_), static_cast<std::uint32_t>(distinct), kind,
+                                  static_cast<std::int16_t>(std::clamp(cls, -30000, 30000))});
   }
 
   Vid add(const Point<2>& p) {
@@ -487,7 +488,7 @@ class CellRefiner {
     if (go_on) queues_[j + 1].push_back({v, false});
     std::uint64_t answer = go_on;
     for (const auto& [a, b] : local_pairs_) answer = mix(mix(answer, pts_[a]), pts_[b]);
-    step_end(CellStep::Collect, mix(mix(mix(1, pts_[v]), static_cast<std::uint64_t>(j)), birth), answer);
+    step_end(CellStep::Collect, mix(mix(mix(1, pts_[v]), static_cast<std::uint64_t>(j)), birth), answer, j);
     out_.questions.leaves_collect += out_.questions.leaves_read - before;
   }
 
@@ -496,7 +497,7 @@ class CellRefiner {
     step_begin();
     std::uint64_t answer = 0;
     process_steps(p, q, j, answer);
-    step_end(CellStep::Process, mix(mix(mix(2, pts_[p]), pts_[q]), static_cast<std::uint64_t>(j)), answer);
+    step_end(CellStep::Process, mix(mix(mix(2, pts_[p]), pts_[q]), static_cast<std::uint64_t>(j)), answer, j);
   }
 
   void process_steps(Vid p, Vid q, int j, std::uint64_t& answer) {

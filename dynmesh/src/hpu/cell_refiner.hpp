@@ -63,6 +63,7 @@ struct CellStep {
   std::uint64_t digest;
   std::uint32_t leaves;  // distinct leaves read
   Kind kind;
+  std::int16_t cls;      // the size class of a collect or a pair's processing; 0 otherwise
   friend bool operator<(const CellStep& a, const CellStep& b) noexcept { return a.digest < b.digest; }
 };
 
