@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -82,6 +84,62 @@ TEST(BucketTree, CheckerRejectsAVertexOutsideItsLeaf) {
   tree.check_invariants(pts);
   pts[2] = Point<2>{0.9, 0.9};
   EXPECT_THROW(tree.check_invariants(pts), InvariantError);
+}
+
+TEST(BucketTree, PrunedSearchesFindWhatAScanFinds) {
+  // search() with a narrowing test (nearest-first, keep only cells nearer than the best so
+  // far) must find the nearest point that a scan of all points finds; visit_disc() must hand
+  // out every point of its disc.
+  const Box<2> box{{3, -2}, 0.5};
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<Point<2>> pts;
+  detail::BucketTree tree(box);
+  for (int i = 0; i < 2000; ++i) {
+    const double s = std::ldexp(1.0, -static_cast<int>(u(rng) * 25));
+    const Point<2> p{box.origin[0] + box.side * (0.3 + 0.4 * u(rng)) + s * u(rng),
+                     box.origin[1] + box.side * (0.3 + 0.4 * u(rng)) + s * u(rng)};
+    if (std::find(pts.begin(), pts.end(), p) != pts.end()) continue;
+    pts.push_back(p);
+    tree.insert(static_cast<std::uint32_t>(pts.size() - 1), p, pts);
+  }
+  tree.check_invariants(pts);
+  for (int k = 0; k < 300; ++k) {
+    const Point<2> c{box.origin[0] + box.side * u(rng), box.origin[1] + box.side * u(rng)};
+    double scan = std::numeric_limits<double>::infinity();
+    for (const auto& p : pts) scan = std::min(scan, std::hypot(p[0] - c[0], p[1] - c[1]));
+    double best = std::numeric_limits<double>::infinity();
+    tree.search(
+        c, tree.margin_for(c, 0.0),
+        [&](double x0, double y0, double x1, double y1) {
+          const double ex = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
+          const double ey = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
+          return std::hypot(ex, ey) <= best;
+        },
+        [&](std::uint32_t v) {
+          best = std::min(best, std::hypot(pts[v][0] - c[0], pts[v][1] - c[1]));
+          return false;
+        });
+    EXPECT_EQ(best, scan) << "query " << k;
+    const double r = scan * (1 + u(rng));
+    std::size_t in_disc = 0, handed = 0;
+    for (const auto& p : pts) in_disc += std::hypot(p[0] - c[0], p[1] - c[1]) <= r;
+    tree.visit_disc(c, r, [&](std::uint32_t v) {
+      handed += std::hypot(pts[v][0] - c[0], pts[v][1] - c[1]) <= r;
+      return false;
+    });
+    EXPECT_EQ(handed, in_disc) << "query " << k;
+  }
+}
+
+TEST(CellRefiner, TreeCheckedAfterEveryInsertion) {
+  // The bucket tree's checker after every vertex the refinement adds (inputs, side
+  // midpoints, off-centers), on inputs that split leaves at many depths.
+  for (const auto dist : {Distribution::Clusters, Distribution::Shrinking, Distribution::Boundary}) {
+    const auto pts = generate<2>(dist, kSanitized ? 40 : 150, 13, 0x1p24);
+    const auto r = detail::cell_refine(derive_box<2>(pts), pts, 25.0, detail::CellRefineOptions{.check_tree = true});
+    EXPECT_GT(r.triangles.size(), pts.size()) << distribution_name(dist);
+  }
 }
 
 struct Case {

@@ -5,7 +5,8 @@
 // Properties: HpuMesh either refuses the input with InputError (never another exception,
 // never a hang: libFuzzer's -timeout) or returns a mesh that passes check_mesh at the angle
 // bound with the Delaunay test, every point a vertex; the same points in reverse order give
-// the same triangles, bit for bit; check_invariants() holds.
+// the same triangles, bit for bit; check_invariants() holds; the cell refiner
+// (src/hpu/cell_refiner.hpp, the same rules answered from the cells) makes the same mesh.
 // Complexity: O(m log m) per input for m output vertices (mesh, checker, second mesh).
 #include "fuzz_support.hpp"
 
@@ -21,6 +22,7 @@
 #include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/mesh_check.hpp"
+#include "hpu/cell_refiner.hpp"
 
 using namespace dynmesh_fuzz;
 
@@ -59,6 +61,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       mesh.check_invariants();
     } catch (const std::exception& e) {
       fail(std::string("check_invariants: ") + e.what());
+    }
+    try {
+      const auto cells = dynmesh::detail::cell_refine(box, points, angle);
+      check(cells.triangles == triangles, "the cell refiner's mesh differs from the twin's");
+    } catch (const std::exception& e) {
+      fail(std::string("the cell refiner threw where the twin did not: ") + e.what());
     }
   } catch (const InputError&) {
     return 0;  // refused: the contract only asks for a clear error
