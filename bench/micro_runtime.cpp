@@ -5,7 +5,10 @@
 //   StampQueue: push n elements in random order, then pop them all.
 //   Engine:     from-scratch run of n reads that each write (per element), a run of n writes,
 //               and change propagation of a memoized map over a list (one remove or reinsert
-//               per propagate; memo_read hits reuse the rest of the list).
+//               per propagate; memo_read hits reuse the rest of the list); k = 4
+//               modifiables per step read by one read_many vs 4 nested reads, from scratch
+//               and propagating one changed input (4 steps affected), with trace bytes and
+//               events per step.
 // Items processed = primitive operations, so the reported items/s invert to ns per operation.
 // Setup (building lists, engines, inputs) is excluded from timing; fixed seeds.
 #include <benchmark/benchmark.h>
@@ -14,6 +17,7 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <span>
 #include <random>
 #include <vector>
 
@@ -249,5 +253,97 @@ void BM_EngineMemoMapPropagate(benchmark::State& state) {
   state.counters["live_events"] = static_cast<double>(e.live_events());
 }
 BENCHMARK(BM_EngineMemoMapPropagate)->Arg(1 << 10)->Arg(1 << 16);
+
+// Steps that each read k = 4 modifiables (step i: in[i..i+3] cyclically, overlapping as the
+// mesh's neighbouring cells do) and write their sum: one read_many, or 4 nested reads.
+constexpr int kManyK = 4;
+
+struct SumMany {
+  Mod<int>* out;
+  void operator()(Engine& e, std::span<const int* const> v) const {
+    int s = 0;
+    for (const int* x : v) s += *x;
+    e.write(*out, s);
+  }
+};
+
+struct SumNested {
+  const std::vector<Mod<int>>* in;
+  Mod<int>* out;
+  std::uint32_t step, j;
+  int acc;
+  void operator()(Engine& e, int v) const {
+    if (j + 1 == kManyK) {
+      e.write(*out, acc + v);
+      return;
+    }
+    const std::size_t n = in->size();
+    e.read((*in)[(step + j + 1) % n], SumNested{in, out, step, j + 1, acc + v});
+  }
+};
+
+template <bool kMany>
+void run_steps(Engine& en, Flat& f) {
+  const std::size_t n = f.in.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if constexpr (kMany) {
+      en.read_many({&f.in[i], &f.in[(i + 1) % n], &f.in[(i + 2) % n], &f.in[(i + 3) % n]},
+                   SumMany{&f.out[i]});
+    } else {
+      en.read(f.in[i], SumNested{&f.in, &f.out[i], static_cast<std::uint32_t>(i), 0, 0});
+    }
+  }
+}
+
+template <bool kMany>
+void BM_EngineRead4FromScratch(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  double bytes = 0, events = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto e = std::make_unique<Engine>();
+    auto f = std::make_unique<Flat>(n);
+    for (std::size_t i = 0; i < n; ++i) e->set(f->in[i], static_cast<int>(i));
+    state.ResumeTiming();
+    e->run([&](Engine& en) { run_steps<kMany>(en, *f); });
+    benchmark::DoNotOptimize(f->out[n - 1].get());
+    state.PauseTiming();
+    bytes = static_cast<double>(e->record_bytes()) / static_cast<double>(n);
+    events = static_cast<double>(e->live_events()) / static_cast<double>(n);
+    e.reset();
+    f.reset();
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * static_cast<std::int64_t>(n));
+  state.counters["record_bytes_per_step"] = bytes;
+  state.counters["events_per_step"] = events;
+}
+BENCHMARK_TEMPLATE(BM_EngineRead4FromScratch, true)->Arg(1 << 10)->Arg(1 << 18);
+BENCHMARK_TEMPLATE(BM_EngineRead4FromScratch, false)->Arg(1 << 10)->Arg(1 << 18);
+
+template <bool kMany>
+void BM_EngineRead4Propagate(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  Engine e;
+  Flat f(n);
+  for (std::size_t i = 0; i < n; ++i) e.set(f.in[i], static_cast<int>(i));
+  e.run([&](Engine& en) { run_steps<kMany>(en, f); });
+  std::mt19937_64 rng(7);
+  std::uint64_t propagations = 0, reexecuted = 0;
+  for (auto _ : state) {
+    const std::size_t i = static_cast<std::size_t>(rng() % n);
+    e.set(f.in[i], f.in[i].get() + 1);  // always a change: 4 steps read it
+    e.propagate();
+    ++propagations;
+    reexecuted += e.stats().last_reexecuted;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(propagations));
+  state.counters["reexecuted_per_propagate"] =
+      propagations ? static_cast<double>(reexecuted) / static_cast<double>(propagations) : 0.0;
+  state.counters["trace_bytes_per_step"] = static_cast<double>(e.trace_bytes()) / static_cast<double>(n);
+  state.counters["record_bytes_per_step"] = static_cast<double>(e.record_bytes()) / static_cast<double>(n);
+}
+BENCHMARK_TEMPLATE(BM_EngineRead4Propagate, true)->Arg(1 << 10)->Arg(1 << 16);
+BENCHMARK_TEMPLATE(BM_EngineRead4Propagate, false)->Arg(1 << 10)->Arg(1 << 16);
 
 }  // namespace

@@ -18,8 +18,11 @@ namespace sac {
 
 using detail::AllocNode;
 using detail::MemoNode;
+using detail::ReaderLink;
 using detail::ReadNode;
+using detail::ReadSlot;
 using detail::VersionBase;
+using detail::owner_of;
 
 namespace {
 
@@ -176,7 +179,7 @@ VersionBase* Engine::default_base(ModBase& m, bool defaulted, const detail::Vers
   if (!defaulted || !ops->make_default) return nullptr;
   // What init(m, T{}) would have made before the first run; the reads that hung on m's
   // default hang on it now.
-  ReadNode* readers = m.default_readers();
+  ReaderLink* readers = m.default_readers();
   VersionBase* base = ops->make_default(allocate(ops->size));
   set_base(m, base, nullptr);
   if (readers) {
@@ -208,9 +211,9 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
   // the whole trace (every from-scratch write) none can.
   if (older && older->readers && v->stamp.next() != nullptr) {
     const bool same = v->ops->equal(v, older);
-    for (ReadNode* r = older->readers; r;) {
-      ReadNode* nx = r->rnext;
-      if (order_.less(&v->stamp, &r->start)) {
+    for (ReaderLink* r = older->readers; r;) {
+      ReaderLink* nx = r->rnext;
+      if (order_.less(&v->stamp, &owner_of(r)->start)) {  // a slot's time is its multi-read's
         detach(r);
         attach(r, v);
         if (!same) enqueue(r, m);
@@ -230,7 +233,7 @@ void Engine::set_base(ModBase& m, VersionBase* fresh,
     const bool changed = assign_if_changed(base, fresh);
     destroy(fresh);
     if (changed)
-      for (ReadNode* r = base->readers; r; r = r->rnext) enqueue(r, m);
+      for (ReaderLink* r = base->readers; r; r = r->rnext) enqueue(r, m);
     return;
   }
   // A new base version: it precedes every computation write, so nobody saw "nothing" here
@@ -300,12 +303,39 @@ void Engine::exec_read(ReadNode* r) {
   now_ = &r->start;
   ++stats_.events_created;
   ++stats_.live_events;
-  const ModBase& m = *r->issued_mod;
+  const ModBase& m = *r->link.issued_mod;
   const VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
-  attach_seen(r, m, v);
+  attach_seen(&r->link, m, v);
   push_close(&r->end, TaskKind::CloseRead, r);
   exec_body([&] { r->ops()->invoke(*this, r, v); });
+}
+
+void Engine::exec_read_many(ReadNode* r) {
+  order_.insert_after(now_, &r->start, StampKind::ReadStart);
+  now_ = &r->start;
+  ++stats_.events_created;  // one event for all k modifiables
+  ++stats_.live_events;
+  push_close(&r->end, TaskKind::CloseRead, r);
+  attach_and_invoke_many(r);
+}
+
+void Engine::attach_and_invoke_many(ReadNode* r) {
+  detail::ReadManyHeader* h = detail::many_of(r);
+  const detail::VersionOps* ops = r->ops()->value;
+  const VersionBase* vs[detail::kMaxReadMany];
+  ReadSlot* slots = h->slots();
+  for (std::uint32_t i = 0; i < h->k; ++i) {
+    const VersionBase* v = visible_or_default(*slots[i].mod, &r->start, ops);
+    if (!v) throw UsageError("sac::Engine::read_many: a modifiable has no value at the time of this read");
+    attach_seen(&slots[i].link, *slots[i].mod, v);
+    vs[i] = v;
+  }
+  exec_body([&] { r->ops()->invoke_many(*this, r, vs); });
+}
+
+void Engine::throw_read_many_size() {
+  throw UsageError("sac::Engine::read_many: reads 1 to 16 modifiables");
 }
 
 void Engine::push_close(Stamp* end, TaskKind kind, void* node) {
@@ -341,10 +371,13 @@ void Engine::execute(const Task& t) {
     case TaskKind::ExecRead:
       exec_read(static_cast<ReadNode*>(t.node));
       break;
+    case TaskKind::ExecReadMany:
+      exec_read_many(static_cast<ReadNode*>(t.node));
+      break;
     case TaskKind::ExecMemoRead: {
       auto* r = static_cast<ReadNode*>(t.node);
       if (window_end_) {
-        if (ReadNode* hit = find_read_match(*r->issued_mod, r->ops_id, closure_of(r))) {
+        if (ReadNode* hit = find_read_match(*r->link.issued_mod, r->link.ops_id, closure_of(r))) {
           destroy(r);
           memo_hit(&hit->start, &hit->end);
           break;
@@ -391,7 +424,7 @@ void Engine::execute(const Task& t) {
         ReadNode* r = queue_.pop(&m);
         ++stats_.queue_pops;
         tasks_.push_back(t);  // drain on after this re-execution
-        rerun(r, *m);
+        rerun(r, m);
       } else {
         now_ = end;
       }
@@ -403,7 +436,8 @@ void Engine::execute(const Task& t) {
 void Engine::discard_pending() noexcept {
   // Nodes of calls that were issued but never executed are not in the trace: free them here.
   auto discard = [this](const Task& t) {
-    if (t.kind == TaskKind::ExecRead || t.kind == TaskKind::ExecMemoRead) {
+    if (t.kind == TaskKind::ExecRead || t.kind == TaskKind::ExecMemoRead ||
+        t.kind == TaskKind::ExecReadMany) {
       auto* r = static_cast<ReadNode*>(t.node);
       destroy(r);
     } else if (t.kind == TaskKind::ExecMemo) {
@@ -421,23 +455,31 @@ void Engine::discard_pending() noexcept {
   pending_.clear();  // the allocations are in the trace; destroy_all frees them there
 }
 
-void Engine::enqueue(ReadNode* r, const ModBase& m) {
-  if (r->qpos != kNotQueued) return;
-  queue_.push(r, &m);
+void Engine::enqueue(ReaderLink* l, const ModBase& m) {
+  ReadNode* r = owner_of(l);
+  if (r->link.qpos != kNotQueued) return;  // a multi-read with several changed slots: once
+  queue_.push(r, detail::is_slot(l) ? nullptr : &m);
   ++stats_.queue_pushes;
 }
 
-void Engine::rerun(ReadNode* r, const ModBase& m) {
+void Engine::rerun(ReadNode* r, const ModBase* mp) {
   reruns_.push_back(RerunContext{now_, window_end_});
   tasks_.push_back(Task{TaskKind::FinishRerun, r});
   now_ = &r->start;
   window_end_ = &r->end;
   ++stats_.reads_reexecuted;
   ++stats_.last_reexecuted;
-  detach(r);
+  if (!mp) {  // a multi-read: every slot re-hangs on what its modifiable shows now
+    detail::ReadManyHeader* h = detail::many_of(r);
+    for (std::uint32_t i = 0; i < h->k; ++i) detach(&h->slots()[i].link);
+    attach_and_invoke_many(r);
+    return;
+  }
+  const ModBase& m = *mp;
+  detach(&r->link);
   const VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
-  attach_seen(r, m, v);
+  attach_seen(&r->link, m, v);
   exec_body([&] { r->ops()->invoke(*this, r, v); });
 }
 
@@ -453,7 +495,7 @@ void Engine::propagate() {
       const ModBase* m = nullptr;
       ReadNode* r = queue_.pop(&m);
       ++stats_.queue_pops;
-      rerun(r, *m);
+      rerun(r, m);
       drain(0);
     }
   } catch (...) {
@@ -500,11 +542,15 @@ ReadNode* Engine::find_read_match(const ModBase& m, std::uint32_t ops_id,
   const detail::ReadOps* ops = detail::read_ops_table[ops_id];
   return earliest_match<ReadNode>(
       [&](auto&& offer) {
-        for (VersionBase* v = m.newest(); v; v = v->older())
-          for (ReadNode* r = v->readers; r; r = r->rnext) offer(r);
-        for (ReadNode* r = m.default_readers(); r; r = r->rnext) offer(r);
+        // Slots are offered no match: a multi-read is never memoized.
+        auto offer_all = [&](ReaderLink* l) {
+          for (; l; l = l->rnext)
+            if (!detail::is_slot(l)) offer(owner_of(l));
+        };
+        for (VersionBase* v = m.newest(); v; v = v->older()) offer_all(v->readers);
+        offer_all(m.default_readers());
       },
-      [&](const ReadNode* r) { return r->ops_id == ops_id && ops->equal(r, closure); });
+      [&](const ReadNode* r) { return r->link.ops_id == ops_id && ops->equal(r, closure); });
 }
 
 AllocNode* Engine::find_alloc_match(const detail::AllocOps* ops, std::size_t h,
@@ -579,8 +625,13 @@ void Engine::undo(Stamp* s) {
       ReadNode* r = rec;
       ++stats_.events_undone;
       --stats_.live_events;
-      detach(r);
-      if (r->qpos != kNotQueued) {
+      if (r->many()) {
+        detail::ReadManyHeader* h = detail::many_of(r);
+        for (std::uint32_t i = 0; i < h->k; ++i) detach(&h->slots()[i].link);
+      } else {
+        detach(&r->link);
+      }
+      if (r->link.qpos != kNotQueued) {
         queue_.remove(r);
         ++stats_.queue_removes;
       }
@@ -602,8 +653,8 @@ void Engine::undo(Stamp* s) {
         if (defaulted)
           seen = m->default_only() ? v->ops->shared_default() : (older = default_base(*m, true, v->ops));
         const bool same = seen && v->ops->equal(v, seen);
-        for (ReadNode* r = v->readers; r;) {
-          ReadNode* nx = r->rnext;
+        for (ReaderLink* r = v->readers; r;) {
+          ReaderLink* nx = r->rnext;
           r->rpprev = nullptr;
           r->rnext = nullptr;
           if (older) attach(r, older);
@@ -700,8 +751,11 @@ MemoryBreakdown Engine::memory_breakdown() const {
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
       if constexpr (K == StampKind::ReadStart) {
-        add(b.reads, rec->ops()->size, sizeof(ReadNode), 0);
-        ++read_sizes[block_of(rec->ops()->size)];
+        const std::size_t size = read_size(rec);
+        const std::size_t header =
+            rec->many() ? detail::ReadManyHeader::closure_offset(detail::many_of(rec)->k) : sizeof(ReadNode);
+        add(b.reads, size, header, 0);
+        ++read_sizes[block_of(size)];
       } else if constexpr (K == StampKind::Write) {
         add(b.versions, rec->ops->size, sizeof(VersionBase), 0);
       } else if constexpr (K == StampKind::Alloc) {
@@ -748,7 +802,7 @@ void Engine::check_invariants() const {
   std::uint64_t events = 0;
   std::size_t nkeyed = 0, nmemo = 0;
   AddressSet mods(stats_.live_events / 2);  // the modifiables written (then: or read)
-  AddressSet reads(stats_.live_events / 2);
+  AddressSet reads(stats_.live_events / 2);  // the reader list entries: links and slots
   std::vector<const ModBase*> default_mods;  // one per modifiable whose default reads hang on it
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
@@ -760,9 +814,23 @@ void Engine::check_invariants() const {
         // Attachment to the version visible at its start is checked below, from the
         // version side (a read record does not name its modifiable; scanning the visible
         // version's readers here would also be quadratic in a modifiable's fan-out).
-        reads.insert(r);
-        if (const ModBase* m = default_head(r)) default_mods.push_back(m);
-        if (r->qpos != kNotQueued) fail("read still queued");
+        if (r->link.qpos != kNotQueued) fail("read still queued");
+        if (r->many()) {
+          // A multi-read hangs on versions through its slots only; each slot is checked
+          // below, with its modifiable, like a read.
+          const detail::ReadManyHeader* h = detail::many_of(r);
+          if (r->link.rpprev) fail("a multi-read's own link is attached");
+          if (h->k == 0 || h->k > detail::kMaxReadMany) fail("a multi-read with a bad slot count");
+          for (std::uint32_t i = 0; i < h->k; ++i) {
+            const ReaderLink* l = &h->slots()[i].link;
+            if (!detail::is_slot(l) || l->qpos != i || owner_of(l) != r) fail("a multi-read's slot is malformed");
+            reads.insert(l);
+            if (const ModBase* m = default_head(l)) default_mods.push_back(m);
+          }
+        } else {
+          reads.insert(&r->link);
+          if (const ModBase* m = default_head(&r->link)) default_mods.push_back(m);
+        }
         stack.push_back({&r->end, false});
       } else if constexpr (K == StampKind::ReadEnd) {
         if (stack.empty() || stack.back().close != s || stack.back().is_memo)
@@ -819,12 +887,16 @@ void Engine::check_invariants() const {
         if (!v->stamp.linked()) fail("version with unlinked stamp");
         if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("versions out of order");
       }
-      const ReadNode* const* back = &v->readers;
-      for (const ReadNode* r = v->readers; r; back = &r->rnext, r = r->rnext) {
+      const ReaderLink* const* back = &v->readers;
+      for (const ReaderLink* r = v->readers; r; back = &r->rnext, r = r->rnext) {
         if (r->rpprev != back) fail("a version's reader list has a broken back link");
-        if (!v->is_base() && !order_.less(&v->stamp, &r->start)) fail("reader before its version");
-        if (newer && !order_.less(&r->start, &newer->stamp)) fail("reader after the next version");
+        // Membership first: only then may r be decoded (a slot's owner from its index).
         if (!reads.contains(r)) fail("a version's reader is not a live read of the trace");
+        if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
+          fail("a multi-read's slot hangs on another modifiable's version");
+        const Stamp* t = &owner_of(r)->start;
+        if (!v->is_base() && !order_.less(&v->stamp, t)) fail("reader before its version");
+        if (newer && !order_.less(t, &newer->stamp)) fail("reader after the next version");
         ++attached;
       }
       newer = v;
@@ -833,11 +905,13 @@ void Engine::check_invariants() const {
   // Reads of a default with no version hang on the modifiable; it has no version then.
   for (const ModBase* m : default_mods) {
     if (!m->default_only()) fail("a read hangs on the default of a modifiable that has versions");
-    const ReadNode* first = m->default_readers();
+    const ReaderLink* first = m->default_readers();
     if (!first || default_head(first) != m) fail("a modifiable's default readers do not start at its head");
-    for (const ReadNode* r = first; r; r = r->rnext) {
+    for (const ReaderLink* r = first; r; r = r->rnext) {
       if (r->rnext && r->rnext->rpprev != &r->rnext) fail("a default reader list has a broken back link");
       if (!reads.contains(r)) fail("a default reader is not a live read of the trace");
+      if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
+        fail("a multi-read's slot hangs on another modifiable's default");
       ++attached;
     }
   }
@@ -866,16 +940,24 @@ void Engine::dump_dot(std::ostream& os) const {
     return n;
   };
   // A read does not name its modifiable: find it from the versions' reader lists.
-  std::unordered_map<const ReadNode*, const ModBase*> read_mod;
-  const auto note_readers = [&](const VersionBase* v) {
-    for (const ReadNode* r = v->readers; r; r = r->rnext) read_mod[r] = v->mod();
+  std::unordered_multimap<const ReadNode*, const ModBase*> read_mod;  // a multi-read: k
+  const auto note_list = [&](const ReaderLink* l, const ModBase* m) {
+    for (; l; l = l->rnext) read_mod.emplace(owner_of(l), m);
   };
+  const auto note_readers = [&](const VersionBase* v) { note_list(v->readers, v->mod()); };
   for (const VersionBase* b : bases_) note_readers(b);
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     if (s->kind() == StampKind::Write) note_readers(detail::version_of(const_cast<Stamp*>(s)));
-    if (s->kind() == StampKind::ReadStart)
-      if (const ModBase* m = default_head(detail::read_of_start(const_cast<Stamp*>(s))))
-        for (const ReadNode* r = m->default_readers(); r; r = r->rnext) read_mod[r] = m;
+    if (s->kind() == StampKind::ReadStart) {
+      ReadNode* r = detail::read_of_start(const_cast<Stamp*>(s));
+      const auto note_default = [&](const ReaderLink* l) {
+        if (const ModBase* m = default_head(l)) note_list(m->default_readers(), m);
+      };
+      if (r->many())
+        for (std::uint32_t i = 0; i < detail::many_of(r)->k; ++i) note_default(&detail::many_of(r)->slots()[i].link);
+      else
+        note_default(&r->link);
+    }
   }
   std::size_t id = 0;
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
@@ -884,7 +966,8 @@ void Engine::dump_dot(std::ostream& os) const {
     visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
       if constexpr (K == StampKind::ReadStart) {
         os << "  " << name << " [label=\"read\"];\n  " << parent << " -> " << name << ";\n";
-        if (const auto it = read_mod.find(rec); it != read_mod.end())
+        const auto [lo, hi] = read_mod.equal_range(rec);
+        for (auto it = lo; it != hi; ++it)
           os << "  " << mod_name(it->second) << " -> " << name << " [style=dashed];\n";
         stack.push_back({name, &rec->end});
       } else if constexpr (K == StampKind::Write) {

@@ -17,10 +17,12 @@
 #include <algorithm>
 #include <climits>
 #include <concepts>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <random>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -42,9 +44,11 @@ struct EngineTestAccess {
   static auto& queue(Engine& e) { return e.queue_; }
   static auto& allocs(Engine& e) { return e.allocs_; }
   static auto& memos(Engine& e) { return e.memos_; }
-  static void attach(detail::ReadNode* r, detail::VersionBase* v) { Engine::attach(r, v); }
-  static void detach(detail::ReadNode* r) { Engine::detach(r); }
-  static void attach_default(detail::ReadNode* r, const ModBase& m) { Engine::attach_default(r, m); }
+  static void attach(detail::ReadNode* r, detail::VersionBase* v) { Engine::attach(&r->link, v); }
+  static void detach(detail::ReadNode* r) { Engine::detach(&r->link); }
+  static void attach_default(detail::ReadNode* r, const ModBase& m) { Engine::attach_default(&r->link, m); }
+  static void attach(detail::ReaderLink* l, detail::VersionBase* v) { Engine::attach(l, v); }
+  static void detach(detail::ReaderLink* l) { Engine::detach(l); }
 };
 
 }  // namespace sac
@@ -1802,7 +1806,7 @@ TEST(EngineChecker, ReadDetachedFromItsVersion) {
   ASSERT_NO_THROW(t.e.check_invariants());
   ReadNode* r = t.inner_read();
   VersionBase* v = t.acc_versions().at(2);
-  ASSERT_EQ(v->readers, r);
+  ASSERT_EQ(v->readers, &r->link);
   EngineTestAccess::detach(r);
   EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
   EXPECT_THAT(invariant_message(t.e), HasSubstr("not attached"));
@@ -1814,10 +1818,10 @@ TEST(EngineChecker, ReaderListWithABrokenBackLink) {
   SmallTrace t;
   ASSERT_NO_THROW(t.e.check_invariants());
   ReadNode* r = t.inner_read();
-  ReadNode** saved = r->rpprev;
-  r->rpprev = &r->rnext;
+  sac::detail::ReaderLink** saved = r->link.rpprev;
+  r->link.rpprev = &r->link.rnext;
   EXPECT_THAT(invariant_message(t.e), HasSubstr("broken back link"));
-  r->rpprev = saved;
+  r->link.rpprev = saved;
   EXPECT_NO_THROW(t.e.check_invariants());
 }
 
@@ -1845,11 +1849,11 @@ TEST(EngineChecker, DefaultReaderDetachedOrWithABrokenBackLink) {
   ASSERT_NO_THROW(t.e.check_invariants());
   ReadNode* first = t.read(1);  // the later read was attached last: it heads the list
   ReadNode* second = t.read(0);
-  ASSERT_EQ(first->rnext, second);
-  ReadNode** saved = second->rpprev;
-  second->rpprev = &second->rnext;
+  ASSERT_EQ(first->link.rnext, &second->link);
+  sac::detail::ReaderLink** saved = second->link.rpprev;
+  second->link.rpprev = &second->link.rnext;
   EXPECT_THAT(invariant_message(t.e), HasSubstr("default reader list has a broken back link"));
-  second->rpprev = saved;
+  second->link.rpprev = saved;
   ASSERT_NO_THROW(t.e.check_invariants());
   EngineTestAccess::detach(second);
   EXPECT_THAT(invariant_message(t.e), HasSubstr("not attached"));
@@ -2050,6 +2054,45 @@ TEST(EngineDifferential, TinyListsIncludingEmpty) {
     differential<AccProgram>(seed, 2, 60);
     differential<MapProgram>(seed, 1, 30);
   }
+}
+
+}  // namespace
+
+namespace {
+
+TEST(EngineChecker, MultiReadSlotDetachedOrOnAnotherModifiable) {
+  Mod<int> a, b, out;
+  Engine e;
+  e.set(a, 1);
+  e.set(b, 2);
+  e.run([&](Engine& en) {
+    en.read_many({&a, &b}, [&out](Engine& x, std::span<const int* const> v) { x.write(out, *v[0] + *v[1]); });
+  });
+  ASSERT_NO_THROW(e.check_invariants());
+  Stamp* s = EngineTestAccess::order(e).base()->next();
+  ASSERT_EQ(s->kind(), StampKind::ReadStart);
+  sac::detail::ReadManyHeader* h = sac::detail::many_of(sac::detail::read_of_start(s));
+  ASSERT_EQ(h->k, 2u);
+  // Each slot is the only reader of its modifiable's base version: rpprev is &v->readers.
+  auto version_of_slot = [](sac::detail::ReaderLink* l) {
+    return reinterpret_cast<VersionBase*>(reinterpret_cast<char*>(l->rpprev) - offsetof(VersionBase, readers));
+  };
+  sac::detail::ReaderLink* slot = &h->slots()[1].link;
+  VersionBase* va = version_of_slot(&h->slots()[0].link);
+  VersionBase* vbv = version_of_slot(slot);
+  ASSERT_EQ(va->readers, &h->slots()[0].link);
+  ASSERT_EQ(vbv->readers, slot);
+  EngineTestAccess::detach(slot);
+  EXPECT_THAT(invariant_message(e), HasSubstr("not attached"));
+  EngineTestAccess::attach(slot, va);
+  EXPECT_THAT(invariant_message(e), HasSubstr("another modifiable"));
+  EngineTestAccess::detach(slot);
+  EngineTestAccess::attach(slot, vbv);
+  EXPECT_NO_THROW(e.check_invariants());
+  h->read.link.qpos = 0;
+  EXPECT_THAT(invariant_message(e), HasSubstr("still queued"));
+  h->read.link.qpos = sac::kNotQueued;
+  EXPECT_NO_THROW(e.check_invariants());
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 //                           reused (trace between is undone, affected reads inside it are
 //                           propagated, execution jumps to its end).
 //   rt.memo_read(m, fn)     read(m, fn) memoized on (m, fn) with no extra record.
+//   rt.read_many(ms, body)  k nested reads as one record and one interval: body(values).
 //
 // Execution is trampolined, so deep recursion (a read chain a million long) never grows the
 // C++ stack: read/memo_read/memo calls are recorded when issued and run after the issuing
@@ -30,7 +31,8 @@
 //
 // Invariants (check_invariants()): the order list, queue and tables are valid; the trace is
 // well nested (every read's interval contains exactly the events its body created); every
-// live read is attached to the version visible at its start time; versions of a modifiable
+// live read (each slot of a multi-read) is attached to the version visible at its start
+// time, and a multi-read's own link to none; versions of a modifiable
 // are ordered by time; every memo entry and keyed allocation is in its table; outside
 // propagate() the queue is empty. Built with the CMake option SAC_DEBUG_CHECKS, propagate()
 // runs the check at its end and throws InvariantError on a violation.
@@ -42,8 +44,10 @@
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
+#include <initializer_list>
 #include <iosfwd>
 #include <new>
+#include <span>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -126,6 +130,21 @@ class Engine {
   /// must be equality comparable: use sac::fn<f>(args...).
   template <class T, class F>
   void memo_read(const Mod<T>& m, F&& body);
+
+  /// Reads the k modifiables mods (1 <= k <= 16; repeats allowed) as one event: runs
+  /// body(vals) (or body(Engine&, vals)) with vals a std::span<const T* const> of the k
+  /// values visible now, vals[i] that of mods[i]. The same as k nested reads of mods in
+  /// order with body innermost, but one record (64 + 32k bytes + closure), one interval
+  /// and one event in the statistics: when any of the k visible values changes (cut-off
+  /// writes excepted), propagate() re-runs body once, seeing all k current values. The
+  /// pointers to vals are valid during the call only. Not memoized (no memo_read analogue).
+  /// UsageError for k outside [1, 16]. O(k) plus the version walks of the k modifiables.
+  template <class T, class F>
+  void read_many(std::span<const Mod<T>* const> mods, F&& body);
+  template <class T, class F>
+  void read_many(std::initializer_list<const Mod<T>*> mods, F&& body) {
+    read_many(std::span<const Mod<T>* const>(mods.begin(), mods.size()), std::forward<F>(body));
+  }
 
   /// Adds a version of m holding value at the current time; readers later in the trace see
   /// it. A write equal to the value it replaces is cut off: its readers are not affected.
@@ -231,12 +250,20 @@ class Engine {
   /// Destroys a record through its ops table and returns its memory.
   template <class Rec>
   void destroy(Rec* r) noexcept {
-    const auto* ops = [r] {
-      if constexpr (std::is_base_of_v<detail::ReadNode, Rec>) return r->ops();
-      else return r->ops;
-    }();
-    ops->destroy(r);
-    deallocate(r, ops->size);
+    if constexpr (std::is_base_of_v<detail::ReadNode, Rec>) {
+      const std::size_t n = read_size(r);
+      r->ops()->destroy(r);
+      deallocate(r, n);
+    } else {
+      const auto* ops = r->ops;
+      ops->destroy(r);
+      deallocate(r, ops->size);
+    }
+  }
+  /// The bytes of a read record: a multi-read's grow with its slots.
+  static std::size_t read_size(const detail::ReadNode* r) {
+    const detail::ReadOps* ops = r->ops();
+    return ops->size + (ops->invoke_many ? detail::many_of(r)->k * sizeof(detail::ReadSlot) : 0);
   }
 
   // Trace machinery (engine.cpp).
@@ -251,6 +278,11 @@ class Engine {
   void drain(std::size_t floor);
   void execute(const Task& t);
   void exec_read(detail::ReadNode* r);
+  void exec_read_many(detail::ReadNode* r);
+  /// Hangs each slot of the multi-read r on what its modifiable shows at r's start and
+  /// runs r's body on those values (first execution and re-execution alike).
+  void attach_and_invoke_many(detail::ReadNode* r);
+  [[noreturn]] static void throw_read_many_size();
   void push_close(Stamp* end, TaskKind kind, void* node);
   void close_chain(TaskKind kind, void* node);
   void discard_pending() noexcept;
@@ -275,10 +307,12 @@ class Engine {
   static void* closure_of(detail::ReadNode* r) { return static_cast<detail::ReadNode*>(r) + 1; }
   void undo_between(Stamp* a, Stamp* b);
   void undo(Stamp* s);
-  /// Queues r, a read of m, for re-execution (no-op if queued).
-  void enqueue(detail::ReadNode* r, const ModBase& m);
-  /// Re-executes r, a read of m, inside its own interval (an affected read just popped).
-  void rerun(detail::ReadNode* r, const ModBase& m);
+  /// Queues the read of l, which reads m through l, for re-execution (no-op if queued).
+  /// A multi-read waits with no modifiable: its slots name theirs.
+  void enqueue(detail::ReaderLink* l, const ModBase& m);
+  /// Re-executes r, a read of m (null for a multi-read), inside its own interval (an
+  /// affected read just popped).
+  void rerun(detail::ReadNode* r, const ModBase* m);
   void free_deferred() noexcept;
   void index_pending_allocs();
   void destroy_all() noexcept;
@@ -290,7 +324,7 @@ class Engine {
   /// version type.
   const detail::VersionBase* visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops);
   /// Hangs r on what it sees, v (from visible_or_default).
-  static void attach_seen(detail::ReadNode* r, const ModBase& m, const detail::VersionBase* v) {
+  static void attach_seen(detail::ReaderLink* r, const ModBase& m, const detail::VersionBase* v) {
     if (m.default_only()) attach_default(r, m);
     else attach(r, const_cast<detail::VersionBase*>(v));
   }
@@ -306,7 +340,7 @@ class Engine {
   bool in_window(const Stamp* start, const Stamp* end) const {
     return order_.less(now_, start) && order_.less(end, window_end_);
   }
-  static void attach(detail::ReadNode* r, detail::VersionBase* v) {
+  static void attach(detail::ReaderLink* r, detail::VersionBase* v) {
     r->rnext = v->readers;
     if (v->readers) v->readers->rpprev = &r->rnext;
     v->readers = r;
@@ -316,20 +350,20 @@ class Engine {
   /// points at the modifiable's head_ (whose kDefaultOnly mark a plain store would lose).
   static constexpr std::uintptr_t kHeadLink = 1;
   /// Hangs r on m's default (m has a default and no version).
-  static void attach_default(detail::ReadNode* r, const ModBase& m) {
+  static void attach_default(detail::ReaderLink* r, const ModBase& m) {
     ModBase& w = const_cast<ModBase&>(m);
-    detail::ReadNode* first = w.default_readers();
+    detail::ReaderLink* first = w.default_readers();
     r->rnext = first;
     if (first) first->rpprev = &r->rnext;
     w.head_ = reinterpret_cast<std::uintptr_t>(r) | ModBase::kDefaultOnly;
-    r->rpprev = reinterpret_cast<detail::ReadNode**>(reinterpret_cast<std::uintptr_t>(&w.head_) | kHeadLink);
+    r->rpprev = reinterpret_cast<detail::ReaderLink**>(reinterpret_cast<std::uintptr_t>(&w.head_) | kHeadLink);
   }
   /// The modifiable whose default r hangs on, if r is the first of its default readers.
-  static const ModBase* default_head(const detail::ReadNode* r) {
+  static const ModBase* default_head(const detail::ReaderLink* r) {
     const auto pp = reinterpret_cast<std::uintptr_t>(r->rpprev);
     return (pp & kHeadLink) ? reinterpret_cast<const ModBase*>(pp & ~kHeadLink) : nullptr;
   }
-  static void detach(detail::ReadNode* r) {
+  static void detach(detail::ReaderLink* r) {
     if (!r->rpprev) return;
     const auto pp = reinterpret_cast<std::uintptr_t>(r->rpprev);
     if (pp & kHeadLink)
@@ -441,10 +475,41 @@ void Engine::read(const Mod<T>& m, F&& body) {
   using N = detail::ReadNodeT<Fn>;
   require_computation("read");
   N* r = construct<N>(std::forward<F>(body));
-  r->issued_mod = &m;
-  r->ops_id = detail::ReadOpsFor<T, Fn>::id();
-  r->qpos = kNotQueued;
+  r->link.issued_mod = &m;
+  r->link.ops_id = detail::ReadOpsFor<T, Fn>::id();
+  r->link.qpos = kNotQueued;
   issue(TaskKind::ExecRead, r);
+}
+
+template <class T, class F>
+void Engine::read_many(std::span<const Mod<T>* const> mods, F&& body) {
+  using Fn = std::decay_t<F>;
+  using H = detail::ReadManyHeader;
+  static_assert(alignof(Fn) <= detail::Pool::kGrain, "closure over-aligned");
+  require_computation("read_many");
+  const std::size_t k = mods.size();
+  if (k == 0 || k > detail::kMaxReadMany) [[unlikely]]
+    throw_read_many_size();
+  const std::size_t bytes = H::closure_offset(k) + sizeof(Fn);
+  char* mem = static_cast<char*>(allocate(bytes));
+  try {
+    new (mem + H::closure_offset(k)) Fn(std::forward<F>(body));
+  } catch (...) {
+    deallocate(mem, bytes);
+    throw;
+  }
+  H* h = new (mem) H{};
+  h->k = static_cast<std::uint32_t>(k);
+  h->read.link.ops_id = detail::ReadManyOpsFor<T, Fn>::id();
+  h->read.link.qpos = kNotQueued;
+  detail::ReadSlot* slots = h->slots();
+  for (std::size_t i = 0; i < k; ++i) {
+    detail::ReadSlot* sl = new (&slots[i]) detail::ReadSlot{};
+    sl->link.ops_id = detail::kSlotOps;
+    sl->link.qpos = static_cast<std::uint32_t>(i);
+    sl->mod = mods[i];
+  }
+  issue(TaskKind::ExecReadMany, &h->read);
 }
 
 template <class T, class F>

@@ -46,8 +46,8 @@ class ModBase {
     return default_only() ? nullptr : reinterpret_cast<detail::VersionBase*>(head_);
   }
   /// The reads that see the default while m has no version, linked as a version's readers.
-  detail::ReadNode* default_readers() const {
-    return default_only() ? reinterpret_cast<detail::ReadNode*>(head_ & ~std::uintptr_t{7}) : nullptr;
+  detail::ReaderLink* default_readers() const {
+    return default_only() ? reinterpret_cast<detail::ReaderLink*>(head_ & ~std::uintptr_t{7}) : nullptr;
   }
   void set_newest(detail::VersionBase* v) { head_ = reinterpret_cast<std::uintptr_t>(v); }
   // The newest version; or kDefaultOnly | the first default reader; or 0 (never written).

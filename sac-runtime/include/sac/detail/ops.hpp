@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <new>
+#include <span>
 #include <type_traits>
 
 #include "sac/detail/order_list.hpp"
@@ -22,14 +23,17 @@
 
 namespace sac::detail {
 
+/// The most modifiables one Engine::read_many may read.
+inline constexpr std::size_t kMaxReadMany = 16;
+
 /// A per-type object whose address names the type (Engine::context's check).
 template <class T>
 inline char kTypeTag = 0;  // not const: distinct objects, never merged
 
 struct ReadQueueTraits {
   static const Stamp* stamp(const ReadNode* r) { return &r->start; }
-  static std::uint32_t& pos(ReadNode* r) { return r->qpos; }
-  static std::uint32_t pos(const ReadNode* r) { return r->qpos; }
+  static std::uint32_t& pos(ReadNode* r) { return r->link.qpos; }
+  static std::uint32_t pos(const ReadNode* r) { return r->link.qpos; }
 };
 
 template <class F, class T>
@@ -103,6 +107,38 @@ struct ReadOpsFor {
                                &VersionOpsFor<T>::ops, sizeof(ReadNodeT<F>)};
   /// ops' number in read_ops_table (numbered on first use: a function-local static, so no
   /// read made during static initialisation can see it unnumbered).
+  static std::uint32_t id() {
+    static const std::uint32_t i = register_read_ops(&ops);
+    return i;
+  }
+};
+
+/// A multi-read of k modifiables of type T with closure F (ReadManyHeader): the body gets
+/// (Engine&,) std::span<const T* const> of the k values, in the order of the modifiables.
+template <class T, class F>
+struct ReadManyOpsFor {
+  static F* closure(ReadNode* r) {
+    return std::launder(reinterpret_cast<F*>(reinterpret_cast<char*>(r) +
+                                             ReadManyHeader::closure_offset(many_of(r)->k)));
+  }
+  static void invoke_many(Engine& e, ReadNode* r, const VersionBase* const* vs) {
+    const std::uint32_t k = many_of(r)->k;
+    const T* vals[kMaxReadMany];
+    for (std::uint32_t i = 0; i < k; ++i) vals[i] = &static_cast<const Version<T>*>(vs[i])->value;
+    const std::span<const T* const> span(vals, k);
+    F& f = *closure(r);
+    if constexpr (std::is_invocable_v<F&, Engine&, std::span<const T* const>>) f(e, span);
+    else f(span);
+  }
+  static void destroy(ReadNode* r) noexcept {
+    closure(r)->~F();
+    ReadSlot* s = many_of(r)->slots();
+    for (std::uint32_t i = 0; i < many_of(r)->k; ++i) s[i].~ReadSlot();
+    many_of(r)->~ReadManyHeader();
+  }
+  static constexpr ReadOps ops{nullptr, &destroy, nullptr, &VersionOpsFor<T>::ops,
+                               static_cast<std::uint32_t>(sizeof(ReadManyHeader) + sizeof(F)),
+                               &invoke_many};
   static std::uint32_t id() {
     static const std::uint32_t i = register_read_ops(&ops);
     return i;

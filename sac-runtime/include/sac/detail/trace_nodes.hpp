@@ -6,8 +6,9 @@
 // table per instantiated type, so a record costs one pointer for it and no vtable — a read,
 // the commonest record, only a 32-bit number (read_ops_table).
 //
-// Layout (bytes, 64-bit): VersionBase 40 + value; ReadNode 56 + closure; AllocNode 32 +
-// key + object; MemoNode 48 + closure. A read or memo entry keeps no flags: it is dead once
+// Layout (bytes, 64-bit): VersionBase 40 + value; ReadNode 56 + closure; a multi-read
+// (ReadManyHeader) 64 + 32 per modifiable + closure; AllocNode 32 + key + object; MemoNode 48
+// + closure. A read or memo entry keeps no flags: it is dead once
 // its start stamp is unlinked, and closed once its end stamp is linked.
 // Invariants: see Engine::check_invariants().
 #pragma once
@@ -25,6 +26,7 @@ class ModBase;
 namespace sac::detail {
 
 struct VersionBase;
+struct ReaderLink;
 struct ReadNode;
 struct AllocNode;
 struct MemoNode;
@@ -51,7 +53,7 @@ struct VersionBase {
   // The next older version; after the oldest, the modifiable | kEnd (| kDefaulted when
   // Engine::init_default() gave it a default).
   std::uintptr_t link;
-  ReadNode* readers;     // the reads that see this version
+  ReaderLink* readers;   // the reads (or multi-read slots) that see this version
 
   static constexpr std::uintptr_t kEnd = 1;
   static constexpr std::uintptr_t kDefaulted = 2;
@@ -80,11 +82,15 @@ struct Version : VersionBase {
 };
 
 struct ReadOps {
-  void (*invoke)(Engine&, ReadNode*, const VersionBase*);
+  void (*invoke)(Engine&, ReadNode*, const VersionBase*);  // null for a multi-read
   void (*destroy)(ReadNode*) noexcept;
   bool (*equal)(const ReadNode*, const void* closure);  // null: not memoizable
   const VersionOps* value;  // the ops of the versions it reads
+  /// A plain read: sizeof the record. A multi-read: the record without its slots, which
+  /// add sizeof(ReadSlot) each (Engine::read_size).
   std::uint32_t size;
+  /// A multi-read's body, given the k versions it sees in slot order; null for a plain read.
+  void (*invoke_many)(Engine&, ReadNode*, const VersionBase* const*) = nullptr;
 };
 
 /// The read ops tables by number, so that a read stores 4 bytes for its ops instead of 8.
@@ -95,24 +101,71 @@ extern const ReadOps* read_ops_table[kMaxReadTypes];
 /// Gives `ops` the next free number. Throws sac::UsageError beyond kMaxReadTypes − 1 types.
 std::uint32_t register_read_ops(const ReadOps* ops);
 
+/// An entry of a version's reader list (and of a modifiable's default readers): a plain
+/// read's `link`, or one slot of a multi-read. ops_id tells which: a read's ops number is
+/// never 0 (read_ops_table), a slot's ops_id is kSlotOps and its qpos field its index.
+struct ReaderLink {
+  union {
+    ReaderLink* rnext;           // attached: the next reader of the same version
+    const ModBase* issued_mod;   // a plain read issued, not yet run: the modifiable it will read
+  };
+  ReaderLink** rpprev;   // null when attached to no version
+  std::uint32_t ops_id;  // read: read_ops_table's index of its ops; slot: kSlotOps
+  std::uint32_t qpos;    // read: its index in the queue; slot: its index in its multi-read
+};
+inline constexpr std::uint32_t kSlotOps = 0;
+
 /// A read. It does not name its modifiable: a live read hangs on a version of it (whose
 /// chain ends at the modifiable), a queued read's modifiable waits with it in the queue, and
 /// an issued read keeps it in `issued_mod` until it runs (the union's other member). Its ops
 /// table is a number, and its state is its stamps'. This keeps the record at 56 bytes.
+/// A multi-read (Engine::read_many) is a ReadNode too, whose link is never attached: its
+/// slots are (ReadManyHeader).
 struct ReadNode {
   Stamp start;
   Stamp end;
-  union {
-    ReadNode* rnext;             // attached: the next reader of the same version
-    const ModBase* issued_mod;   // issued, not yet run: the modifiable it will read
-  };
-  ReadNode** rpprev;     // null when attached to no version
-  std::uint32_t ops_id;  // read_ops_table's index of its ops
-  std::uint32_t qpos;
+  ReaderLink link;
 
-  const ReadOps* ops() const { return read_ops_table[ops_id]; }
+  const ReadOps* ops() const { return read_ops_table[link.ops_id]; }
+  bool many() const { return ops()->invoke_many != nullptr; }
 };
 static_assert(sizeof(ReadNode) == 56);
+
+/// One modifiable of a multi-read: hangs on the version of `mod` the multi-read sees.
+struct ReadSlot {
+  ReaderLink link;  // first: a ReaderLink of a slot is its ReadSlot
+  const ModBase* mod;
+};
+static_assert(sizeof(ReadSlot) == 32);
+
+/// A multi-read record: this header, then `k` ReadSlots, then the closure (at
+/// closure_offset(k)). One pool block of ops->size + k * sizeof(ReadSlot) bytes; a slot
+/// finds its header from its index, so it needs no owner pointer.
+struct ReadManyHeader {
+  ReadNode read;  // first: the header is its ReadNode's address
+  std::uint32_t k;
+  std::uint32_t pad_;
+
+  ReadSlot* slots() { return reinterpret_cast<ReadSlot*>(this + 1); }
+  const ReadSlot* slots() const { return reinterpret_cast<const ReadSlot*>(this + 1); }
+  static constexpr std::size_t closure_offset(std::size_t k) {
+    return sizeof(ReadManyHeader) + k * sizeof(ReadSlot);
+  }
+};
+static_assert(sizeof(ReadManyHeader) == 64);
+
+inline ReadManyHeader* many_of(ReadNode* r) { return reinterpret_cast<ReadManyHeader*>(r); }
+inline const ReadManyHeader* many_of(const ReadNode* r) {
+  return reinterpret_cast<const ReadManyHeader*>(r);
+}
+inline bool is_slot(const ReaderLink* l) { return l->ops_id == kSlotOps; }
+/// The read a reader list entry belongs to: the plain read, or a slot's multi-read.
+inline ReadNode* owner_of(ReaderLink* l) {
+  char* p = reinterpret_cast<char*>(l);
+  if (is_slot(l)) return reinterpret_cast<ReadNode*>(p - sizeof(ReadManyHeader) - l->qpos * sizeof(ReadSlot));
+  return reinterpret_cast<ReadNode*>(p - offsetof(ReadNode, link));
+}
+inline const ReadNode* owner_of(const ReaderLink* l) { return owner_of(const_cast<ReaderLink*>(l)); }
 
 template <class F>
 struct ReadNodeT : ReadNode {

@@ -20,6 +20,7 @@ namespace sac::detail {
 enum class TaskKind : std::uint8_t {
   ExecRead,      // link a new read, attach it and run its body
   ExecMemoRead,  // ExecRead, unless an equal read in the window is reused
+  ExecReadMany,  // link a new multi-read, attach its slots and run its body
   ExecMemo,      // link a new memo entry and run it, unless an equal one is reused
   CloseRead,     // link the end stamp of a read (and of the closes chained onto it)
   CloseMemo,     // the same for a memo entry

@@ -1,0 +1,382 @@
+// Tests of Engine::read_many: k modifiables read as one trace event.
+//
+// What is checked: re-execution counts (one re-run per affected multi-read, none for cut-off
+// writes or writes inside its interval), the version it sees when a modifiable is written
+// several times or a write it saw is undone, defaults (init_default), that it is one event,
+// and random differential programs (plain and inside memoized regions) against the same
+// programs written with k nested reads: equal outputs after every propagate(), a live trace
+// of a from-scratch run's size, and check_invariants() after every update.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <span>
+#include <vector>
+
+#include "../sanitized.hpp"
+#include "sac/sac.hpp"
+
+namespace {
+
+using sac::Engine;
+using sac::Mod;
+using Vals = std::span<const int* const>;
+
+int sum(Vals v) {
+  int s = 0;
+  for (std::size_t i = 0; i < v.size(); ++i) s = s * 10 + *v[i];
+  return s;
+}
+
+TEST(ReadMany, OneEventAndOneRerunPerChange) {
+  Mod<int> a, b, c, d, out;
+  Engine e;
+  e.set(a, 1);
+  e.set(b, 2);
+  e.set(c, 3);
+  e.set(d, 4);
+  int runs = 0;
+  e.run([&](Engine& en) {
+    en.read_many({&a, &b, &c, &d}, [&out, &runs](Engine& x, Vals v) {
+      ++runs;
+      x.write(out, sum(v));
+    });
+  });
+  EXPECT_EQ(out.get(), 1234);
+  EXPECT_EQ(e.live_events(), 2u);  // the multi-read and the write
+  EXPECT_EQ(e.stats().events_created, 2u);
+  e.check_invariants();
+
+  e.set(c, 7);
+  e.propagate();
+  EXPECT_EQ(out.get(), 1274);
+  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  EXPECT_EQ(runs, 2);
+
+  e.set(a, 5);  // two of the four change: still one re-run
+  e.set(d, 9);
+  e.propagate();
+  EXPECT_EQ(out.get(), 5279);
+  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  EXPECT_EQ(runs, 3);
+
+  e.set(b, 2);  // equal: cut off
+  e.propagate();
+  EXPECT_EQ(e.stats().last_reexecuted, 0u);
+  EXPECT_EQ(runs, 3);
+  EXPECT_EQ(e.live_events(), 2u);
+  e.check_invariants();
+}
+
+TEST(ReadMany, BodyWithoutEngineAndRepeatedModifiables) {
+  Mod<int> a, b;
+  Engine e;
+  e.set(a, 1);
+  e.set(b, 2);
+  int seen = 0;
+  e.run([&](Engine& en) {
+    const std::array<const Mod<int>*, 3> ms{&a, &b, &a};
+    en.read_many(std::span<const Mod<int>* const>(ms), [&seen](Vals v) { seen = sum(v); });
+  });
+  EXPECT_EQ(seen, 121);
+  e.set(a, 3);
+  e.propagate();
+  EXPECT_EQ(seen, 323);
+  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  e.check_invariants();
+}
+
+TEST(ReadMany, SizeOutOfRangeIsAUsageError) {
+  Mod<int> a;
+  Engine e;
+  e.set(a, 1);
+  EXPECT_THROW(e.run([&](Engine& en) {
+    en.read_many(std::span<const Mod<int>* const>(), [](Vals) {});
+  }),
+               sac::UsageError);
+  Engine e2;
+  Mod<int> a2;
+  e2.set(a2, 1);
+  std::vector<const Mod<int>*> many2(17, &a2);
+  EXPECT_THROW(e2.run([&](Engine& en) {
+    en.read_many(std::span<const Mod<int>* const>(many2), [](Vals) {});
+  }),
+               sac::UsageError);
+}
+
+TEST(ReadMany, SeesTheLatestVersionBeforeItAndIgnoresWritesInsideItsInterval) {
+  // sel -> m written before the multi-read; the multi-read writes m itself (inside its
+  // interval) and a later plain read sees that write.
+  Mod<int> sel, m, y, out, out2;
+  Engine e;
+  e.set(sel, 1);
+  e.set(m, 0);
+  e.set(y, 5);
+  int runs = 0;
+  e.run([&](Engine& en) {
+    en.read(sel, [&m](Engine& x, int s) { x.write(m, s * 10); });
+    en.write(m, 7);  // a second version before the multi-read: the one it sees
+    en.read_many({&m, &y}, [&out, &m, &runs](Engine& x, Vals v) {
+      ++runs;
+      x.write(out, *v[0] + *v[1]);
+      x.write(m, 100 + *v[1]);  // inside its own interval: does not affect it
+    });
+    en.read(m, [&out2](Engine& x, int v) { x.write(out2, v); });
+  });
+  EXPECT_EQ(out.get(), 12);
+  EXPECT_EQ(out2.get(), 105);
+  EXPECT_EQ(runs, 1);
+
+  e.set(sel, 2);  // the version before 7: hidden from the multi-read
+  e.propagate();
+  EXPECT_EQ(runs, 1);
+  EXPECT_EQ(e.stats().last_reexecuted, 1u);  // only the read of sel
+
+  e.set(y, 6);  // the multi-read re-runs, its own write changes, the later read follows
+  e.propagate();
+  EXPECT_EQ(runs, 2);
+  EXPECT_EQ(out.get(), 13);
+  EXPECT_EQ(out2.get(), 106);
+  EXPECT_EQ(e.stats().last_reexecuted, 2u);
+  e.check_invariants();
+}
+
+TEST(ReadMany, AWriteInsertedBeforeItOrUndoneRerunsItOnce) {
+  Mod<int> sel, m, a, out;
+  Engine e;
+  e.set(sel, 0);
+  e.set(m, 1);
+  e.set(a, 2);
+  int runs = 0;
+  e.run([&](Engine& en) {
+    en.read(sel, [&m](Engine& x, int s) {
+      if (s) x.write(m, s);
+    });
+    en.read_many({&a, &m}, [&out, &runs](Engine& x, Vals v) {
+      ++runs;
+      x.write(out, sum(v));
+    });
+  });
+  EXPECT_EQ(out.get(), 21);
+  e.set(sel, 5);  // a new version of m before it: the split moves its slot, once
+  e.propagate();
+  EXPECT_EQ(out.get(), 25);
+  EXPECT_EQ(runs, 2);
+  e.check_invariants();
+  e.set(sel, 1);  // the version it sees is replaced by an equal-to-base value: changed (5 -> 1)
+  e.propagate();
+  EXPECT_EQ(out.get(), 21);
+  EXPECT_EQ(runs, 3);
+  e.set(sel, 0);  // the write is undone: m's base value 1 again, equal: cut off
+  e.propagate();
+  EXPECT_EQ(runs, 3);
+  EXPECT_EQ(out.get(), 21);
+  e.set(m, 4);
+  e.propagate();
+  EXPECT_EQ(out.get(), 24);
+  EXPECT_EQ(runs, 4);
+  e.check_invariants();
+}
+
+TEST(ReadMany, DefaultsAndTheirVersions) {
+  Mod<int> sel, d, a, out;
+  Engine e;
+  e.set(sel, 0);
+  e.init_default(d);
+  e.set(a, 3);
+  int runs = 0;
+  e.run([&](Engine& en) {
+    en.read_many({&d, &a}, [&out, &runs](Engine& x, Vals v) {
+      ++runs;
+      x.write(out, sum(v));
+    });
+    en.read(sel, [&d](Engine& x, int s) {
+      if (s) x.write(d, s);  // after the multi-read: a version it does not see
+    });
+  });
+  EXPECT_EQ(out.get(), 3);
+  e.set(sel, 4);
+  e.propagate();
+  EXPECT_EQ(runs, 1);
+  EXPECT_EQ(out.get(), 3);
+  e.check_invariants();
+  e.set(a, 5);
+  e.propagate();
+  EXPECT_EQ(runs, 2);
+  EXPECT_EQ(out.get(), 5);
+  e.set(sel, 0);
+  e.propagate();
+  EXPECT_EQ(runs, 2);
+  e.check_invariants();
+}
+
+TEST(ReadMany, DefaultWrittenBeforeItThenUndone) {
+  Mod<int> sel, d, out;
+  Engine e;
+  e.set(sel, 0);
+  e.init_default(d);
+  int runs = 0;
+  e.run([&](Engine& en) {
+    en.read(sel, [&d](Engine& x, int s) {
+      if (s) x.write(d, s);
+    });
+    en.read_many({&d, &d}, [&out, &runs](Engine& x, Vals v) {
+      ++runs;
+      x.write(out, sum(v));
+    });
+  });
+  EXPECT_EQ(out.get(), 0);
+  e.set(sel, 3);
+  e.propagate();
+  EXPECT_EQ(out.get(), 33);
+  EXPECT_EQ(runs, 2);
+  e.check_invariants();
+  e.set(sel, 0);  // undone: back to the default
+  e.propagate();
+  EXPECT_EQ(out.get(), 0);
+  EXPECT_EQ(runs, 3);
+  e.check_invariants();
+}
+
+// ------------------------------------------------------------------ differential
+
+/// A random program: groups of steps, each group under a read of a control input and a
+/// memoized call; a step reads k modifiables (inputs and cells, repeats allowed) and writes
+/// one or two cells. Run with read_many or with k nested reads.
+struct Step {
+  std::array<int, 16> src{};  // indices into mods(): inputs first, then cells
+  int k = 0;
+  int dst = 0, dst2 = 0;
+};
+
+struct Program {
+  static constexpr int kInputs = 8, kCells = 8, kGroups = 4;
+  std::vector<Step> steps;  // kGroups groups of equal length
+  bool many = false;
+  std::array<Mod<int>, kInputs> in;
+  std::array<Mod<int>, kCells> cell;
+  std::array<Mod<int>, kGroups> ctrl;
+  std::array<Mod<int>, kGroups> gout;
+  Engine e;
+
+  const Mod<int>* mod(int i) const { return i < kInputs ? &in[i] : &cell[i - kInputs]; }
+
+  static void finish(Engine& e, Program* p, int s, const std::array<int, 16>& vals) {
+    const Step& st = p->steps[s];
+    std::uint64_t h = 1469598103934665603ull + s;
+    for (int i = 0; i < st.k; ++i) h = (h ^ static_cast<std::uint64_t>(vals[i] + 7)) * 1099511628211ull;
+    e.write(p->cell[st.dst], static_cast<int>(h % 5));
+    if (h % 3 == 0) e.write(p->cell[st.dst2], static_cast<int>((h >> 8) % 4));
+  }
+  struct Nest {
+    Program* p;
+    int s, i;
+    std::array<int, 16> vals;
+    void operator()(Engine& e, int v) const {
+      Nest n = *this;
+      n.vals[i] = v;
+      if (++n.i == p->steps[s].k) finish(e, p, s, n.vals);
+      else e.read(*p->mod(p->steps[s].src[n.i]), n);
+    }
+  };
+  static void step(Engine& e, Program* p, int s) {
+    const Step& st = p->steps[s];
+    if (p->many) {
+      std::array<const Mod<int>*, 16> ms{};
+      for (int i = 0; i < st.k; ++i) ms[i] = p->mod(st.src[i]);
+      e.read_many(std::span<const Mod<int>* const>(ms.data(), st.k), [p, s](Engine& x, Vals v) {
+        std::array<int, 16> vals{};
+        for (std::size_t i = 0; i < v.size(); ++i) vals[i] = *v[i];
+        finish(x, p, s, vals);
+      });
+    } else {
+      e.read(*p->mod(st.src[0]), Nest{p, s, 0, {}});
+    }
+  }
+  static void group(Engine& e, Program* p, int g, int parity) {
+    const int per = static_cast<int>(p->steps.size()) / kGroups;
+    for (int s = g * per; s < (g + 1) * per; ++s) step(e, p, s);
+    e.write(p->gout[g], parity);
+  }
+  void body(Engine& en) {
+    for (int g = 0; g < kGroups; ++g)
+      en.read(ctrl[g], [this, g](Engine& x, int c) {
+        x.memo(sac::fn<&Program::group>(this, g, c % 2));  // odd changes miss, even hit
+        x.write(gout[g], c);
+      });
+  }
+  void setup(const std::vector<int>& inputs) {
+    for (int i = 0; i < kInputs; ++i) e.set(in[i], inputs[i]);
+    for (int i = 0; i < kCells; ++i) {
+      if (i % 2) e.init_default(cell[i]);
+      else e.set(cell[i], 1);
+    }
+    for (int g = 0; g < kGroups; ++g) e.set(ctrl[g], inputs[kInputs + g]);
+    e.run([this](Engine& en) { body(en); });
+  }
+  void propagate_and_check() {
+    e.propagate();
+    e.check_invariants();
+  }
+  void set(int i, int v) {
+    if (i < kInputs) e.set(in[i], v);
+    else e.set(ctrl[i - kInputs], v);
+  }
+  std::vector<int> outputs() const {
+    std::vector<int> o;
+    for (const auto& c : cell) o.push_back(c.get());
+    for (const auto& g : gout) o.push_back(g.get());
+    return o;
+  }
+};
+
+TEST(ReadManyDifferential, MatchesNestedReadsAndFromScratch) {
+  const int kSeeds = test_support::kSanitized ? 8 : 40;
+  const int kUpdates = test_support::kSanitized ? 20 : 60;
+  for (int seed = 1; seed <= kSeeds; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    std::mt19937 rng(static_cast<unsigned>(seed));
+    auto uni = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+    std::vector<Step> steps(Program::kGroups * uni(1, 4));
+    for (Step& st : steps) {
+      st.k = uni(1, seed % 3 == 0 ? 16 : 5);
+      for (int i = 0; i < st.k; ++i) st.src[i] = uni(0, Program::kInputs + Program::kCells - 1);
+      st.dst = uni(0, Program::kCells - 1);
+      st.dst2 = uni(0, Program::kCells - 1);
+    }
+    std::vector<int> inputs(Program::kInputs + Program::kGroups);
+    for (int& v : inputs) v = uni(0, 3);
+    auto many = std::make_unique<Program>();
+    auto nested = std::make_unique<Program>();
+    many->steps = nested->steps = steps;
+    many->many = true;
+    many->setup(inputs);
+    nested->setup(inputs);
+    ASSERT_EQ(many->outputs(), nested->outputs());
+    for (int u = 0; u < kUpdates; ++u) {
+      const int n = uni(1, 3);
+      for (int j = 0; j < n; ++j) {
+        const int i = uni(0, static_cast<int>(inputs.size()) - 1);
+        inputs[i] = uni(0, 3);
+        many->set(i, inputs[i]);
+        nested->set(i, inputs[i]);
+      }
+      many->propagate_and_check();
+      nested->e.propagate();
+      ASSERT_EQ(many->outputs(), nested->outputs()) << "update " << u;
+      // From scratch on the same inputs: same outputs, same live trace.
+      auto scratch = std::make_unique<Program>();
+      scratch->steps = steps;
+      scratch->many = true;
+      scratch->setup(inputs);
+      ASSERT_EQ(many->outputs(), scratch->outputs()) << "update " << u;
+      ASSERT_EQ(many->e.live_events(), scratch->e.live_events()) << "update " << u;
+      ASSERT_EQ(many->e.record_bytes(), scratch->e.record_bytes()) << "update " << u;
+      ASSERT_LE(many->e.live_events(), nested->e.live_events());
+    }
+  }
+}
+
+}  // namespace
