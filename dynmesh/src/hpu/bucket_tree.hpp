@@ -1,10 +1,11 @@
 // bucket_tree.hpp (private) — the mesh vertices by cell: a point-region quadtree whose leaves
 // hold at most kCapacity vertices each.
 //
-// Purpose: the store that the hpu mesh's questions are answered from (cell_questions.hpp).
+// Purpose: the store that the hpu mesh's questions are answered from (cell_refiner.cpp).
 // A question of size class j is a disc of radius O(2^j) around a pair; it reads the leaves
-// that meet the disc's bounding box and runs exact predicates on their vertices, so the
-// vertices far from the question are never looked at, however they are triangulated.
+// that meet the disc (or, for a search that narrows, those that can still improve its
+// answer) and runs exact predicates on their vertices, so the vertices far from the
+// question are never looked at, however they are triangulated.
 // Cells are the quadtree's dyadic cells of the box, located by the exact integer position
 // of the mesh contract (q = ⌊(x − o)·2^52/L⌋, clamped to the grid so that the box's far
 // sides fall in the last cells).
@@ -13,7 +14,7 @@
 // the finest level; a split cell holds more than kCapacity vertices in its subtree, so the
 // tree is a function of the vertex set (not of the insertion order); every vertex lies in
 // the leaf whose cell contains its position, exactly once.
-// Complexity: insert O(depth + kCapacity); a box query O(cells met + depth).
+// Complexity: insert O(depth + kCapacity); a query O(cells met + depth).
 #pragma once
 
 #include <algorithm>
@@ -48,7 +49,8 @@ class BucketTree {
     return q;
   }
 
-  /// Adds vertex v at p (the caller keeps the points; p is not stored yet).
+  /// Adds vertex v at p. The caller keeps the points: pts[v] must already be p (a split
+  /// re-locates every vertex of the leaf, v included).
   void insert(Vid v, const Point<2>& p, std::span<const Point<2>> pts) {
     const auto q = position(p);
     std::uint32_t n = 0;

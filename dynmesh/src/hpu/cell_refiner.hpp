@@ -3,23 +3,29 @@
 //
 // Purpose: the blueprint of the cell-based self-adjusting hpu program. It takes the static
 // twin's decisions (hpu_mesh.cpp, rules 1-6 of dynmesh/hpu_mesh.hpp) in the twin's order and
-// must reach the twin's mesh bit for bit; what differs is only where each answer comes from:
-//   - a vertex's first class and its entry's collect: the star of v in the Delaunay
-//     triangulation of the vertices within a radius of v (a local triangulation, same
-//     predicates and perturbation as the twin's). A local triangle whose circumdisc lies
-//     inside the gathered disc is a true one; the true star shows in full once every local
-//     star triangle is such, and otherwise it holds a triangle with circumradius above half
-//     the radius (the continuation rule needs no more: the radius is 2^(j+2) for class j);
-//   - looseness: no vertex strictly inside the leaf, asked of the cells the leaf meets (an
-//     empty leaf makes pq a Delaunay edge, so no triangulation is needed to say "edge");
-//   - an off-center's Delaunay neighbour t: the local triangulation of the disc around pq's
-//     midpoint that holds every circle through p and q centred no farther than the apex
-//     (when t lies beyond it, the off-center is the apex whatever t is);
+// must reach the twin's mesh bit for bit; what differs is only where each answer comes from,
+// exact searches of the cells (docs/HPU_ON_CELLS.md has the arguments):
+//   - the left search: the Delaunay neighbour of p→q on its left (the twin's perturbation
+//     breaks ties) is the vertex whose circle through p and q is lowest in their pencil;
+//     the cells are asked for the circles at heights 1/4, 1/2, 1, ... up to a cap, and
+//     within the first that holds a vertex the search narrows to the best circle found;
+//   - a star: walked by left searches from a sure neighbour (empty closed diametral
+//     disc). A collect of class j caps the circles at radius 2^(j+1): a step beyond the
+//     cap is a triangle that makes the entry go on, and the edges of class ≤ j inside such
+//     a gap are found among the vertices within 2^(j+1) in its angle (a loose one is an
+//     edge: its leaf is empty);
+//   - a first class: the nearest vertices only (ties), unless rounding at a power of two
+//     makes the star decide;
+//   - looseness: no vertex strictly inside the leaf, asked of the cells the leaf meets;
+//   - an off-center's neighbour: the left search capped at the apex (beyond it the
+//     off-center is the apex, whatever the neighbour is);
 //   - encroached box edges: only the box edge holding r's projection on a side can have r
-//     in its diametral disc; it is in r's cavity unless a vertex inside that disc makes its
-//     triangle's circle miss r, which the local triangulation of the disc decides;
-//   - the final mesh: each vertex's local star, each triangle emitted by its (x, y)-smallest
+//     in its diametral disc; it is in r's cavity unless its triangle's third corner lies
+//     strictly inside that disc and its circle misses r;
+//   - the final mesh: each vertex's star, each triangle emitted by its (x, y)-smallest
 //     corner.
+// With CellRefineOptions::log_steps it also logs each step (CellStep) for the locality
+// experiment (bench/dynmesh_hpu_locality.cpp).
 // Invariants: those of BucketTree after every insertion; the output equals HpuMesh's
 // (tests/dynmesh/hpu_cells_test.cpp checks it on every distribution and angle bound).
 // Complexity: the twin's steps, each on the vertices of the cells its disc meets: O(1)
@@ -45,7 +51,7 @@ struct CellQuestionStats {
   std::size_t stars = 0;           // stars walked (first classes, collects, final mesh)
   std::size_t leaf_tests = 0;      // loose tests asked of the cells
   std::size_t neighbour_asks = 0;  // left searches (star steps, off-centers, box edges)
-  std::size_t leaves_read = 0;     // bucket-tree leaves met by all questions
+  std::size_t leaves_read = 0;     // bucket-tree leaves met by left searches and loose tests
   std::size_t gathered_first = 0;  // vertices looked at for first classes
   // Leaves read by the collects, by the pairs' processing and by the final mesh.
   std::size_t leaves_collect = 0, leaves_process = 0, leaves_final = 0;
