@@ -31,6 +31,14 @@
 
 namespace dynmesh::detail {
 
+/// One non-empty leaf: its cell and its vertices (sorted), to compare trees.
+struct BucketLeaf {
+  int level;
+  std::uint64_t ix, iy;
+  std::vector<std::uint32_t> items;
+  friend bool operator==(const BucketLeaf&, const BucketLeaf&) = default;
+};
+
 class BucketTree {
  public:
   using Vid = std::uint32_t;
@@ -133,6 +141,17 @@ class BucketTree {
   }
 
   std::size_t size() const noexcept { return size_; }
+
+  /// The non-empty leaves, in (level, x, y) order, each with its vertices sorted.
+  std::vector<BucketLeaf> leaves() const {
+    std::vector<BucketLeaf> out;
+    leaves_of(0, 0, 0, 0, out);
+    std::sort(out.begin(), out.end(), [](const BucketLeaf& a, const BucketLeaf& b) {
+      if (a.level != b.level) return a.level < b.level;
+      return a.ix != b.ix ? a.ix < b.ix : a.iy < b.iy;
+    });
+    return out;
+  }
   /// While set, every vertex a query hands out adds digest(v) to *sum (an order-free record
   /// of what a step looked at, for the locality experiment of cell_refiner.hpp).
   /// `leaves`, when given, receives the id of every leaf read (repeats included).
@@ -217,6 +236,17 @@ class BucketTree {
     }
     for (unsigned k = 0; k < 4 && !stop; ++k)
       visit_disc_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), c, r2, margin, f, stop);
+  }
+
+  void leaves_of(std::uint32_t n, int level, std::uint64_t ix, std::uint64_t iy, std::vector<BucketLeaf>& out) const {
+    const Node& N = nodes_[n];
+    if (N.count == 0) return;
+    if (N.child == kLeaf) {
+      out.push_back(BucketLeaf{level, ix, iy, N.items});
+      std::sort(out.back().items.begin(), out.back().items.end());
+      return;
+    }
+    for (unsigned k = 0; k < 4; ++k) leaves_of(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), out);
   }
 
   template <class Keep, class F>
