@@ -695,11 +695,13 @@ GNUPLOT
     cmp out.txt progress_out.txt || fail "the progress lines changed stdout"
     cmp p.cells q.cells || fail "the progress lines changed the output"
     # The live line, printed by the background thread while a build runs longer than the delay
-    # (10000 points: 0.5-1 s here, far more than 100 ms), then the final line.
-    DYNMESH_PROGRESS_DELAY_MS=100 run "$dynmesh" stability --dim 2 --dist uniform --n 10000 --updates 2 --csv live.csv
-    grep -qF $'\r[dynmesh] building the quadtree of 10000 points: 0 s' err.txt ||
+    # (40000 points: 0.6-0.8 s in the test build, far more than 100 ms; 10000 points took about
+    # 0.1 s once the quadtree got faster, and the line came or not by chance), then the final
+    # line.
+    DYNMESH_PROGRESS_DELAY_MS=100 run "$dynmesh" stability --dim 2 --dist uniform --n 40000 --updates 2 --csv live.csv
+    grep -qF $'\r[dynmesh] building the quadtree of 40000 points: 0 s' err.txt ||
       fail "no live line during the build: $(tr '\r' '|' <err.txt)"
-    grep -qF $'\r[dynmesh] building the quadtree of 10000 points: done in ' err.txt || fail "no final line"
+    grep -qF $'\r[dynmesh] building the quadtree of 40000 points: done in ' err.txt || fail "no final line"
     ;;
 
   memory_guard) # a build that cannot fit in memory stops at once, before reading; --force goes on
