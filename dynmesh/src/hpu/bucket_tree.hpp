@@ -102,12 +102,17 @@ class BucketTree {
   /// f returns true.
   template <class F>
   void visit_disc(const Point<2>& c, double r, F&& f) const {
-    ++queries_;
     // Point location rounds (x − o)·2^52/L: allow for a few ulps of the coordinates.
     const double margin = margin_for(c, r);
-    const double rr = r + margin;
-    bool stop = false;
-    visit_disc_node(0, 0, 0, 0, c, rr * rr, margin, f, stop);
+    const double r2 = (r + margin) * (r + margin);
+    search(
+        c, margin,
+        [&](double x0, double y0, double x1, double y1) {
+          const double dx = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
+          const double dy = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
+          return dx * dx + dy * dy <= r2;
+        },
+        f);
   }
 
   /// A pruned search: visits the leaves whose cell (widened by `margin`) `keep(x0, y0, x1, y1)`
@@ -208,34 +213,6 @@ class BucketTree {
     }
     for (unsigned k = 0; k < 4; ++k)
       visit_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), a, b, f);
-  }
-
-  template <class F>
-  void visit_disc_node(std::uint32_t n, int level, std::uint64_t ix, std::uint64_t iy, const Point<2>& c, double r2,
-                       double margin, F& f, bool& stop) const {
-    const Node& N = nodes_[n];
-    if (N.count == 0 || stop) return;
-    // The cell's box, widened by the margin: [o + i·L/2^level, o + (i + 1)·L/2^level].
-    const double w = std::ldexp(box_.side, -level);
-    const double x0 = box_.origin[0] + static_cast<double>(ix) * w - margin, x1 = x0 + w + 2 * margin;
-    const double y0 = box_.origin[1] + static_cast<double>(iy) * w - margin, y1 = y0 + w + 2 * margin;
-    const double dx = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
-    const double dy = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
-    if (dx * dx + dy * dy > r2) return;
-    if (N.child == kLeaf) {
-      ++leaves_read_;
-      if (watch_leaves_) watch_leaves_->push_back(n);
-      for (const Vid v : N.items) {
-        if (watch_sum_) *watch_sum_ += watch_digest_(watch_ctx_, v);
-        if (f(v)) {
-          stop = true;
-          return;
-        }
-      }
-      return;
-    }
-    for (unsigned k = 0; k < 4 && !stop; ++k)
-      visit_disc_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), c, r2, margin, f, stop);
   }
 
   void leaves_of(std::uint32_t n, int level, std::uint64_t ix, std::uint64_t iy, std::vector<BucketLeaf>& out) const {
