@@ -1,4 +1,4 @@
-// sac_suite — the classic self-adjusting benchmark suite (shared/FORMATS.md, "sac_suite").
+// sac_suite — the classic self-adjusting benchmark suite (docs/FORMATS.md, "sac_suite").
 //
 // For each app: time the conventional twin and the self-adjusting from-scratch run on the
 // same input, each the median of three runs (the latter after one untimed warm-up run on a

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # stability_experiments.sh — the trace-distance experiments of docs/EXPERIMENTS.md.
 #
-# Runs `dynmesh stability` (shared/FORMATS.md) over
+# Runs `dynmesh stability` (docs/FORMATS.md) over
 #   1. spread: `shrinking` at n = 4096 with L/s = 2^8 ... 2^40, 2D and 3D;
 #   2. the other distributions (uniform, clusters, spiral), whose spread grows with n,
 #      at n = 1000 ... 64000, 2D;

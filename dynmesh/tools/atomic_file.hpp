@@ -1,7 +1,7 @@
 // dynmesh/tools/atomic_file.hpp — output files written completely or not at all (private
 // to the tool).
 //
-// Purpose: `dynmesh mesh` promises (shared/FORMATS.md) that a failed run leaves the files of
+// Purpose: `dynmesh mesh` promises (docs/FORMATS.md) that a failed run leaves the files of
 // an earlier run as they were. AtomicOutputs collects every output of a run: add() writes
 // the text to a temporary file beside its target (same directory, so rename() cannot cross
 // file systems), flushes it to disk and closes it, checking every step; commit() then

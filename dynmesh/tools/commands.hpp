@@ -2,7 +2,7 @@
 //
 // Purpose: one options struct and one entry point per subcommand; main.cpp parses the
 // command line into these with CLI11 and calls the entry point. The contracts are
-// shared/FORMATS.md's `dynmesh quadtree`, `dynmesh mesh` (2D) and `dynmesh stability` (on a
+// docs/FORMATS.md's `dynmesh quadtree`, `dynmesh mesh` (2D) and `dynmesh stability` (on a
 // distribution, or on a point file and an edit file); `demo` is the README's main job.
 // Invariants: an entry point returns the exit status (0 success, 1 failure) or throws; every
 // exception becomes one line `dynmesh: <message>` on stderr in main.cpp, so the commands

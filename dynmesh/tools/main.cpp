@@ -1,4 +1,4 @@
-// dynmesh — the command-line tool of the dynmesh library (shared/FORMATS.md):
+// dynmesh — the command-line tool of the dynmesh library (docs/FORMATS.md):
 //   dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--duplicates error|skip]
 //                   [--edits FILE] [--batch K] --cells OUT [--check] [--svg OUT.svg]
 //                   [--svg-point-radius PX] [--svg-max-points N] [--force]
@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
   add_svg_density(quadtree, quadtree_svg, q.svg_point_radius, q.svg_max_points);
   quadtree->add_flag("--force", q.force, force_help);
   quadtree->footer(
-      "\nSynopsis (shared/FORMATS.md):\n"
+      "\nSynopsis (docs/FORMATS.md):\n"
       "  dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--duplicates error|skip]\n"
       "                   [--edits FILE] [--batch K] --cells OUT [--check]\n"
       "                   [--svg OUT.svg [--svg-point-radius PX] [--svg-max-points N]] [--force]\n\n" +
@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
   mesh->add_flag("--stats", me.stats, "print a quality report on stderr");
   mesh->add_flag("--force", me.force, force_help);
   mesh->footer(
-      "\nSynopsis (shared/FORMATS.md):\n"
+      "\nSynopsis (docs/FORMATS.md):\n"
       "  dynmesh mesh POINTS [--box o1 o2 L] [--duplicates error|skip] [--postprocess hpu|quadtree]\n"
       "               [--min-angle DEG] [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F]\n"
       "               [--msh F] [--svg F [--svg-point-radius PX] [--svg-max-points N]] [--check]\n"
@@ -193,7 +193,7 @@ int main(int argc, char** argv) {
   stability->add_option("--plot", s.plot, "also plot every row of the CSV with gnuplot (SVG)");
   stability->add_flag("--force", s.force, force_help);
   stability->footer(
-      "\nSynopsis (shared/FORMATS.md):\n"
+      "\nSynopsis (docs/FORMATS.md):\n"
       "  dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]\n"
       "                    [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv\n"
       "                    [--plot OUT.svg] [--force]\n"

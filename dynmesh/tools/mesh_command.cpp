@@ -1,5 +1,5 @@
 // `dynmesh mesh` (2D): mesh a point file in its box, apply an edit script dynamically, write
-// the final mesh as .node/.ele (and optionally the change feed, VTK, MSH, SVG), shared/
+// the final mesh as .node/.ele (and optionally the change feed, VTK, MSH, SVG), docs/
 // FORMATS.md "dynmesh mesh (2D)". `--postprocess hpu` (the default) is DynHPU's off-center
 // Delaunay mesh: without --edits, its static twin HpuMesh (no trace: a fraction of the
 // memory); with --edits, the self-adjusting DynamicMesh, whose output is the same bytes as a

@@ -1,5 +1,5 @@
 // dynmesh/tools/postprocess_option.hpp — the `--postprocess` and `--min-angle` options of
-// `dynmesh mesh` and `dynmesh stability` (shared/FORMATS.md), checked in one place.
+// `dynmesh mesh` and `dynmesh stability` (docs/FORMATS.md), checked in one place.
 //
 // Purpose: both commands name a postprocess and may ask for an angle bound; the names, the
 // defaults and the bound each postprocess guarantees are stated once here so the two

@@ -1,5 +1,5 @@
 // `dynmesh quadtree`: build T* on a point file, apply an edit script dynamically, write the
-// final leaves as `.cells` (shared/FORMATS.md). Every error names the file and line it
+// final leaves as `.cells` (docs/FORMATS.md). Every error names the file and line it
 // comes from; the tree's own errors (which name point indices or nothing) are re-labelled
 // here with the line of the point file or of the edit script. The point file is read,
 // stripped of later copies on request (--duplicates skip) and located by initial_points.hpp,

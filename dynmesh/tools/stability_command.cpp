@@ -1,4 +1,4 @@
-// `dynmesh stability`: the trace-distance experiment of shared/FORMATS.md, on a distribution
+// `dynmesh stability`: the trace-distance experiment of docs/FORMATS.md, on a distribution
 // or on the user's own data. With `--dist`, builds the tree on N points of a distribution,
 // then measures U single-point updates (alternating deletions of a present point and
 // insertions of a new point of the same distribution, one propagation each). With

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # tests/cli/cli_test.sh CASE DYNMESH DATA_DIR WORK_DIR — end-to-end tests of the `dynmesh`
-# command (shared/FORMATS.md contracts), one ctest per CASE (see tests/cli/CMakeLists.txt).
+# command (docs/FORMATS.md contracts), one ctest per CASE (see tests/cli/CMakeLists.txt).
 # Exit 0 pass, 1 fail, 77 skipped (ctest SKIP_RETURN_CODE).
 set -uo pipefail
 
