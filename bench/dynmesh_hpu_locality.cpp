@@ -27,6 +27,7 @@
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/distributions.hpp"
+#include "dynmesh/hpu_mesh.hpp"
 #include "hpu/cell_refiner.hpp"
 
 namespace {
@@ -77,13 +78,14 @@ int main(int argc, char** argv) {
   std::size_t updates = 20;
   std::uint64_t seed = 1;
   double angle = 20.7;
-  bool csv = false, profile = false, by_class = false;
+  bool csv = false, profile = false, by_class = false, time = false;
   app.add_option("--dist", dists, "distributions")->delimiter(',');
   app.add_option("--n", sizes, "sizes")->delimiter(',');
   app.add_option("--updates", updates, "updates measured per size");
   app.add_option("--seed", seed, "seed of the points and of the updates");
   app.add_option("--angle", angle, "angle bound (degrees)");
   app.add_flag("--csv", csv, "CSV output");
+  app.add_flag("--time", time, "also time HpuMesh (the twin) and the cell refiner on the same points (one run each)");
   app.add_flag("--by-class", by_class, "also print the changed collects and processings per update by size class");
   app.add_flag("--profile", profile, "also print, per step kind, the leaves one step reads (mean, median, p99, max)");
   CLI11_PARSE(app, argc, argv);
@@ -104,6 +106,13 @@ int main(int argc, char** argv) {
       const auto pts = generate<2>(*dist, n, seed);
       const Box<2> box = derive_box<2>(pts);
       const auto base = run(box, pts, angle);
+      if (time) {
+        std::vector<Triangle> twin_mesh, cell_mesh;
+        const double twin_s = bench::seconds([&] { twin_mesh = HpuMesh(box, pts, angle).triangles(); });
+        const double cell_s = bench::seconds([&] { cell_mesh = detail::cell_refine(box, pts, angle).triangles; });
+        std::printf("# %s n=%zu time: twin %.3f s, cell refiner %.3f s (%.1fx), same mesh %d\n", name.c_str(), n, twin_s,
+                    cell_s, cell_s / twin_s, static_cast<int>(twin_mesh == cell_mesh));
+      }
       if (profile) {
         static const char* const kKind[] = {"first class", "collect", "process", "final"};
         for (int k = 0; k < 4; ++k) {

@@ -60,7 +60,10 @@ TEST(BucketTree, HoldsEveryPointOnceAndAnswersBoxQueries) {
     const Point<2> c{box.origin[0] + box.side * u(rng), box.origin[1] + box.side * u(rng)};
     const double r = box.side * std::ldexp(u(rng), -static_cast<int>(u(rng) * 20));
     std::vector<std::uint32_t> got;
-    tree.gather(c, r, pts, got);
+    tree.visit_disc(c, r, [&](std::uint32_t v) {
+      got.push_back(v);
+      return false;
+    });
     std::sort(got.begin(), got.end());
     for (std::uint32_t v = 0; v < pts.size(); ++v) {
       const double d = std::hypot(pts[v][0] - c[0], pts[v][1] - c[1]);
@@ -112,9 +115,7 @@ TEST(BucketTree, PrunedSearchesFindWhatAScanFinds) {
     tree.search(
         c, tree.margin_for(c, 0.0),
         [&](double x0, double y0, double x1, double y1) {
-          const double ex = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
-          const double ey = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
-          return std::hypot(ex, ey) <= best;
+          return std::sqrt(detail::BucketTree::box_distance2(c, x0, y0, x1, y1)) <= best;
         },
         [&](std::uint32_t v) {
           best = std::min(best, std::hypot(pts[v][0] - c[0], pts[v][1] - c[1]));

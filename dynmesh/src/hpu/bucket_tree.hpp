@@ -47,6 +47,14 @@ class BucketTree {
 
   explicit BucketTree(const Box<2>& box) : box_(box), scale_(box.scale()) { nodes_.emplace_back(); }
 
+  /// The squared distance from c to the box [x0, x1] × [y0, y1] (0 inside): what every
+  /// search's keep() test of a cell against a disc needs.
+  static double box_distance2(const Point<2>& c, double x0, double y0, double x1, double y1) noexcept {
+    const double dx = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
+    const double dy = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
+    return dx * dx + dy * dy;
+  }
+
   /// The clamped grid position of x (monotone in each coordinate).
   std::array<std::uint64_t, 2> position(const Point<2>& x) const noexcept {
     std::array<std::uint64_t, 2> q{};
@@ -94,7 +102,6 @@ class BucketTree {
   void visit(const Point<2>& lo, const Point<2>& hi, F&& f) const {
     const auto a = position(lo), b = position(hi);
     visit_node(0, 0, 0, 0, a, b, f);
-    ++queries_;
   }
 
   /// Calls stop = f(v) for the vertices of every leaf whose cell meets the disc (c, r) (cells
@@ -107,11 +114,7 @@ class BucketTree {
     const double r2 = (r + margin) * (r + margin);
     search(
         c, margin,
-        [&](double x0, double y0, double x1, double y1) {
-          const double dx = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
-          const double dy = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
-          return dx * dx + dy * dy <= r2;
-        },
+        [&](double x0, double y0, double x1, double y1) { return box_distance2(c, x0, y0, x1, y1) <= r2; },
         f);
   }
 
@@ -121,7 +124,6 @@ class BucketTree {
   /// lowest-circle search) reads only the cells that can still improve its answer.
   template <class Keep, class F>
   void search(const Point<2>& focus, double margin, Keep&& keep, F&& f) const {
-    ++queries_;
     bool stop = false;
     search_node(0, 0, 0, 0, focus, margin, keep, f, stop);
   }
@@ -131,18 +133,6 @@ class BucketTree {
   double margin_for(const Point<2>& c, double r) const noexcept {
     const double mag = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(box_.origin[0]), std::abs(box_.origin[1])});
     return r * 0x1p-30 + (mag + box_.side) * 0x1p-40;
-  }
-
-  /// Every vertex within distance r of c (tested in doubles with a relative margin, so that
-  /// no vertex at distance ≤ r is missed), in no particular order.
-  void gather(const Point<2>& c, double r, std::span<const Point<2>> pts, std::vector<Vid>& out) const {
-    out.clear();
-    const double rr = r * (1 + 0x1p-20);
-    const double r2 = rr * rr;
-    visit(Point<2>{c[0] - rr, c[1] - rr}, Point<2>{c[0] + rr, c[1] + rr}, [&](Vid v) {
-      const double dx = pts[v][0] - c[0], dy = pts[v][1] - c[1];
-      if (dx * dx + dy * dy <= r2) out.push_back(v);
-    });
   }
 
   std::size_t size() const noexcept { return size_; }
@@ -169,7 +159,6 @@ class BucketTree {
   }
   /// Leaves met by all queries so far (the events a self-adjusting version would read).
   std::size_t leaves_read() const noexcept { return leaves_read_; }
-  std::size_t queries() const noexcept { return queries_; }
 
   /// Throws InvariantError naming the first broken rule (see the header).
   void check_invariants(std::span<const Point<2>> pts) const {
@@ -292,7 +281,7 @@ class BucketTree {
   double scale_;
   std::vector<Node> nodes_;
   std::size_t size_ = 0;
-  mutable std::size_t leaves_read_ = 0, queries_ = 0;
+  mutable std::size_t leaves_read_ = 0;
   mutable std::uint64_t* watch_sum_ = nullptr;
   mutable std::vector<std::uint32_t>* watch_leaves_ = nullptr;
   mutable std::uint64_t (*watch_digest_)(const void*, Vid) = nullptr;

@@ -81,17 +81,8 @@ class CellRefiner {
       step_end(CellStep::FirstClass, mix(0, pts_[v]), static_cast<std::uint64_t>(c));
       queues_[c].push_back({v, true});
     }
-    while (!queues_.empty()) {
-      const auto it = queues_.begin();
-      const int j = it->first;
-      batch_.swap(it->second);
-      queues_.erase(it);
-      ++out_.stats.rounds;
-      pairs_.clear();
-      for (const Entry& e : batch_) collect(e.v, j, e.birth);
-      for (const auto& [p, q] : pairs_) process(p, q, j);
-      batch_.clear();
-    }
+    run_rounds(queues_, batch_, pairs_, out_.stats.rounds, [&](const Entry& e, int j) { collect(e.v, j, e.birth); },
+               [&](Vid p, Vid q, int j) { process(p, q, j); });
   }
 
   /// The Delaunay triangulation of all vertices, each triangle found from the local star of
@@ -215,9 +206,7 @@ class CellRefiner {
     tree_.search(
         p, tree_.margin_for(p, 0.0),
         [&](double x0, double y0, double x1, double y1) {
-          const double ex = p[0] < x0 ? x0 - p[0] : p[0] > x1 ? p[0] - x1 : 0.0;
-          const double ey = p[1] < y0 ? y0 - p[1] : p[1] > y1 ? p[1] - y1 : 0.0;
-          return std::hypot(ex, ey) <= best;
+          return std::sqrt(BucketTree::box_distance2(p, x0, y0, x1, y1)) <= best;
         },
         [&](Vid w) {
           if (w != v) best = std::min(best, std::hypot(pts_[w][0] - p[0], pts_[w][1] - p[1]));
@@ -239,16 +228,23 @@ class CellRefiner {
       return false;
     });
     for (;;) {
-      const Point<2>&p = pts_[v], &q = pts_[a];
-      const Point<2> m{0.5 * p[0] + 0.5 * q[0], 0.5 * p[1] + 0.5 * q[1]};
-      Vid inside = kNone;
-      tree_.visit_disc(m, 0.5 * std::hypot(q[0] - p[0], q[1] - p[1]) * (1 + kSlack) + ulp_room(m), [&](Vid w) {
-        if (w != v && w != a && pencil(p, q, 0.0, pts_[w]) <= 0) inside = w;
-        return inside != kNone;
-      });
+      const Vid inside = diametral_intruder(v, a);
       if (inside == kNone) return a;
       a = inside;
     }
+  }
+
+  /// A vertex other than v and q inside or on the closed diametral disc of v and q (one is
+  /// strictly nearer to v than q is), or kNone.
+  Vid diametral_intruder(Vid v, Vid q) const {
+    const Point<2>&a = pts_[v], &b = pts_[q];
+    const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
+    Vid inside = kNone;
+    tree_.visit_disc(m, 0.5 * std::hypot(b[0] - a[0], b[1] - a[1]) * (1 + kSlack) + ulp_room(m), [&](Vid w) {
+      if (w != v && w != q && pencil(a, b, 0.0, pts_[w]) <= 0) inside = w;
+      return inside != kNone;
+    });
+    return inside;
   }
 
   /// The Delaunay neighbour of p→q on its left (the third corner of the triangle on its
@@ -267,9 +263,7 @@ class CellRefiner {
     const std::size_t before = tree_.leaves_read();
     // Does the box [x0, x1] × [y0, y1] meet the disc (c, r)?
     const auto meets = [](double x0, double y0, double x1, double y1, const Point<2>& c, double r) {
-      const double ex = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
-      const double ey = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
-      return ex * ex + ey * ey <= r * r;
+      return BucketTree::box_distance2(c, x0, y0, x1, y1) <= r * r;
     };
     // The disc of the circle through p and q at height h, widened for rounding.
     const auto disc = [&](double h, Point<2>& c, double& r) {
@@ -330,52 +324,38 @@ class CellRefiner {
       const double half = 0.5 * std::hypot(pts_[b][0] - pts_[a][0], pts_[b][1] - pts_[a][1]);
       return R > half ? std::sqrt((R / (2 * half)) * (R / (2 * half)) - 0.25) : -1.0;
     };
-    star_.assign(1, q0);
-    bool whole = true;
-    gap_ends_ = 0;
-    for (Vid q = q0;;) {
-      if (outside_left(v, q)) break;  // a box side: the fan ends
-      const double h = h_cap(v, q);
-      const Vid t = h < 0 ? kNone : left_search(v, q, h);
-      if (t == kNone) {
-        whole = false;
-        ++gap_ends_;
-        break;
+    // One walk from q0 around v, counter-clockwise (the left of v→q) or clockwise (the left
+    // of q→v), and why it ended.
+    enum class End { Closed, Side, Gap, Met };
+    const auto walk = [&](bool ccw, bool stop_at_star, std::vector<Vid>& out) {
+      for (Vid q = q0;;) {
+        const Vid a = ccw ? v : q, b = ccw ? q : v;
+        if (outside_left(a, b)) return End::Side;  // a box side: the fan ends
+        const double h = h_cap(a, b);
+        const Vid t = h < 0 ? kNone : left_search(a, b, h);
+        if (t == kNone) return End::Gap;
+        if (t == q0) return End::Closed;
+        if (stop_at_star && std::find(star_.begin(), star_.end(), t) != star_.end()) return End::Met;
+        out.push_back(t);
+        q = t;
       }
-      if (t == q0) return true;
-      star_.push_back(t);
-      q = t;
+    };
+    star_.assign(1, q0);
+    const End ccw = walk(true, false, star_);
+    if (ccw == End::Closed) {
+      gap_ends_ = 0;
+      return true;
     }
     back_.clear();
-    for (Vid q = q0;;) {
-      if (outside_left(q, v)) break;
-      const double h = h_cap(q, v);
-      const Vid t = h < 0 ? kNone : left_search(q, v, h);
-      if (t == kNone) {
-        whole = false;
-        ++gap_ends_;
-        break;
-      }
-      if (!whole && std::find(star_.begin(), star_.end(), t) != star_.end()) break;  // met the other run
-      back_.push_back(t);
-      q = t;
-    }
+    const End cw = walk(false, ccw == End::Gap, back_);  // stops where it meets the other run
+    gap_ends_ = (ccw == End::Gap) + (cw == End::Gap);
     star_.insert(star_.begin(), back_.rbegin(), back_.rend());
-    return whole;
+    return gap_ends_ == 0;
   }
 
   /// Does the closed diametral disc of v and q hold no other vertex? (Then vq is an edge
   /// of every Delaunay triangulation.)
-  bool diametral_empty(Vid v, Vid q) const {
-    const Point<2>&a = pts_[v], &b = pts_[q];
-    const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
-    bool empty = true;
-    tree_.visit_disc(m, 0.5 * std::hypot(b[0] - a[0], b[1] - a[1]) * (1 + kSlack) + ulp_room(m), [&](Vid w) {
-      if (w != v && w != q && pencil(a, b, 0.0, pts_[w]) <= 0) empty = false;
-      return !empty;
-    });
-    return empty;
-  }
+  bool diametral_empty(Vid v, Vid q) const { return diametral_intruder(v, q) == kNone; }
 
   /// The class of v's shortest Delaunay edge. edge_class is ⌊log2 |pq|⌋ but where rounding
   /// moves |pq|² across a power of four, so an edge longer than the nearest one by more
@@ -455,9 +435,7 @@ class CellRefiner {
       tree_.search(
           c, tree_.margin_for(c, reach),
           [&](double x0, double y0, double x1, double y1) {
-            const double ex = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
-            const double ey = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
-            if (ex * ex + ey * ey > reach * reach) return false;
+            if (BucketTree::box_distance2(c, x0, y0, x1, y1) > reach * reach) return false;
             if (!angle) return true;
             // Outside the angle for certain: every corner right of ca, or every corner left
             // of cb (a reflex angle: both at once).
@@ -477,8 +455,7 @@ class CellRefiner {
             near_.push_back(w);
             return false;
           });
-      std::sort(near_.begin(), near_.end());
-      for (const Vid q : near_) take(q);
+      for (const Vid q : near_) take(q);  // local_pairs_ is sorted below
     }
     std::sort(local_pairs_.begin(), local_pairs_.end(), [&](const auto& a, const auto& b) {
       if (pts_[a[0]] != pts_[b[0]]) return xy_less(pts_[a[0]], pts_[b[0]]);

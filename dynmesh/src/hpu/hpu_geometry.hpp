@@ -324,6 +324,26 @@ class BoxSides {
   std::map<double, Vid> line_[4];
 };
 
+/// Figure 5's loop, one for every refiner: while a queue is left, a round takes the whole
+/// queue of the smallest class, collects every entry's loose pairs (collect(entry, j)
+/// appends to `pairs`), then processes the pairs in that order (process(p, q, j)); entries
+/// made meanwhile wait in their queues for later rounds.
+template <class Entry, class Vid, class Collect, class Process>
+void run_rounds(std::map<int, std::vector<Entry>>& queues, std::vector<Entry>& batch,
+                std::vector<std::array<Vid, 2>>& pairs, std::size_t& rounds, Collect&& collect, Process&& process) {
+  while (!queues.empty()) {
+    const auto it = queues.begin();
+    const int j = it->first;
+    batch.swap(it->second);
+    queues.erase(it);
+    ++rounds;
+    pairs.clear();
+    for (const Entry& e : batch) collect(e, j);
+    for (const auto& [p, q] : pairs) process(p, q, j);
+    batch.clear();
+  }
+}
+
 /// The order of the first queue entries: the four box corners (vertices 0-3) first in
 /// (Morton, x, y) order, then the other vertices in insertion_less order. Returns indices.
 inline std::vector<std::uint32_t> first_entry_order(const Box<2>& box, std::span<const Point<2>> pts) {

@@ -77,17 +77,9 @@ class Refiner {
       for (const Vid q : star_) c = std::min(c, edge_class(v, q));
       queues_[c].push_back({v, true});
     }
-    while (!queues_.empty()) {
-      const auto it = queues_.begin();
-      const int j = it->first;
-      batch_.swap(it->second);
-      queues_.erase(it);
-      ++stats_.rounds;
-      pairs_.clear();
-      for (const Entry& e : batch_) collect(e.v, j, e.birth);
-      for (const auto& [p, q] : pairs_) process(p, q, j);
-      batch_.clear();
-    }
+    detail::run_rounds(queues_, batch_, pairs_, stats_.rounds,
+                       [&](const Entry& e, int j) { collect(e.v, j, e.birth); },
+                       [&](Vid p, Vid q, int j) { process(p, q, j); });
   }
 
   std::vector<Triangle> triangles() const { return dt_.triangles(); }
