@@ -128,6 +128,15 @@ class BucketTree {
     search_node(0, 0, 0, 0, focus, margin, keep, f, stop);
   }
 
+  /// search() with the cell-store interface of cell_questions.hpp (a static tree needs no
+  /// scale: it reads from the root).
+  template <class Keep, class F>
+  void search(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f) const {
+    search(focus, margin, keep, f);
+  }
+  /// A static tree holds every cell: a question on it never fails.
+  static constexpr bool failed() noexcept { return false; }
+
   /// The widening of cells that keeps every vertex of a cell inside it despite the rounding
   /// of point location, for a query of radius r around c.
   double margin_for(const Point<2>& c, double r) const noexcept {

@@ -43,19 +43,9 @@
 #include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
+#include "hpu/cell_questions.hpp"
 
 namespace dynmesh::detail {
-
-/// What the cell questions cost: the figures a self-adjusting version pays in reads.
-struct CellQuestionStats {
-  std::size_t stars = 0;           // stars walked (first classes, collects, final mesh)
-  std::size_t leaf_tests = 0;      // loose tests asked of the cells
-  std::size_t neighbour_asks = 0;  // left searches (star steps, off-centers, box edges)
-  std::size_t leaves_read = 0;     // bucket-tree leaves met by left searches and loose tests
-  std::size_t gathered_first = 0;  // vertices looked at for first classes
-  // Leaves read by the collects, by the pairs' processing and by the final mesh.
-  std::size_t leaves_collect = 0, leaves_process = 0, leaves_final = 0;
-};
 
 /// One step of the refinement as a self-adjusting version would record it: a digest of its
 /// key (what it is: a vertex's first class, an entry's collect, a pair's processing, a
