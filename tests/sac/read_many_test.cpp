@@ -380,3 +380,68 @@ TEST(ReadManyDifferential, MatchesNestedReadsAndFromScratch) {
 }
 
 }  // namespace
+
+namespace {
+
+// A nested read_many that extends the outer one's set: the inner body looks the outer
+// values up with Engine::current. A change to any of them re-runs the outer read, and so
+// the whole nest; a change to an inner one re-runs only the inner read.
+struct Extend {
+  std::array<const Mod<int>*, 2> outer;
+  Mod<int>* out;
+  int* inner_runs;
+  void operator()(Engine& e, Vals v) const {
+    ++*inner_runs;
+    e.write(*out, e.current(*outer[0]) * 100 + e.current(*outer[1]) * 10 + *v[0]);
+  }
+};
+
+}  // namespace
+
+TEST(ReadMany, CurrentLooksUpTheValuesOfAnEnclosingRead) {
+  Mod<int> a, b, c, d, out;
+  Engine e;
+  e.set(a, 1);
+  e.set(b, 2);
+  e.set(c, 3);
+  e.set(d, 4);
+  int outer_runs = 0, inner_runs = 0;
+  e.run([&](Engine& en) {
+    en.read_many({&a, &b}, [&](Engine& x, Vals v) {
+      ++outer_runs;
+      // Which inner modifiable depends on the outer values, as a search's next cell does.
+      const Mod<int>* next = *v[0] + *v[1] > 5 ? &d : &c;
+      x.read_many({next}, Extend{{&a, &b}, &out, &inner_runs});
+    });
+  });
+  EXPECT_EQ(out.get(), 123);
+  e.check_invariants();
+
+  e.set(c, 8);  // inner only
+  e.propagate();
+  EXPECT_EQ(out.get(), 128);
+  EXPECT_EQ(outer_runs, 1);
+  EXPECT_EQ(inner_runs, 2);
+
+  e.set(b, 7);  // outer: the nest re-runs and now reads d
+  e.propagate();
+  EXPECT_EQ(out.get(), 174);
+  EXPECT_EQ(outer_runs, 2);
+  EXPECT_EQ(inner_runs, 3);
+  e.check_invariants();
+
+  e.set(c, 9);  // no longer read
+  e.propagate();
+  EXPECT_EQ(inner_runs, 3);
+  e.set(a, 2);  // an outer value the inner body looks up
+  e.propagate();
+  EXPECT_EQ(out.get(), 274);
+  e.check_invariants();
+}
+
+TEST(ReadMany, CurrentOutsideTheComputationIsAUsageError) {
+  Mod<int> a;
+  Engine e;
+  e.set(a, 1);
+  EXPECT_THROW((void)e.current(a), sac::UsageError);
+}

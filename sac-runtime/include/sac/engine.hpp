@@ -146,6 +146,15 @@ class Engine {
     read_many(std::span<const Mod<T>* const>(mods.begin(), mods.size()), std::forward<F>(body));
   }
 
+  /// The value of m visible now, recording nothing. Only for a value the running body
+  /// already depends on: m was read by an enclosing read (plain or multi) of this body, and
+  /// nothing wrote m since. The use is a nested read_many that extends an outer one's set
+  /// (a search that finds it needs more cells): the outer values are looked up again, not
+  /// copied into every closure. Any other use is a read change propagation cannot see.
+  /// UsageError if m has no value now.
+  template <class T>
+  const T& current(const Mod<T>& m);
+
   /// Adds a version of m holding value at the current time; readers later in the trace see
   /// it. A write equal to the value it replaces is cut off: its readers are not affected.
   template <class T, class U>
@@ -510,6 +519,15 @@ void Engine::read_many(std::span<const Mod<T>* const> mods, F&& body) {
     sl->mod = mods[i];
   }
   issue(TaskKind::ExecReadMany, &h->read);
+}
+
+template <class T>
+const T& Engine::current(const Mod<T>& m) {
+  require_computation("current");
+  flush_if_pending();  // calls issued earlier in this body come first in program order
+  const detail::VersionBase* v = visible_or_default(m, now_, &detail::VersionOpsFor<T>::ops);
+  if (!v) throw UsageError("sac::Engine::current: the modifiable has no value now");
+  return static_cast<const detail::Version<T>*>(v)->value;
 }
 
 template <class T, class F>
