@@ -128,24 +128,28 @@ class CellQuestions {
     return false;
   }
 
-  /// Calls stop = f(v) for the vertices of every cell that meets the disc (c, r).
+  /// Calls stop = f(v) for the vertices of every cell that meets the disc (c, r). `scale`:
+  /// the size of the cells expected there (r when 0).
   template <class F>
-  void visit_disc(const Point<2>& c, double r, F&& f) const {
+  void visit_disc(const Point<2>& c, double r, F&& f, double scale = 0) const {
     const double margin = store_->margin_for(c, r);
     const double r2 = (r + margin) * (r + margin);
     store_->search(
-        c, r, margin,
+        c, std::max(r, scale), margin,
         [&](double x0, double y0, double x1, double y1) { return cellq::box_distance2(c, x0, y0, x1, y1) <= r2; },
         f);
   }
 
-  /// The vertex at p, if any.
-  std::optional<V> find(const Point<2>& p) const {
+  /// The vertex at p, if any. `scale`: the size of the cells expected there.
+  std::optional<V> find(const Point<2>& p, double scale = 0) const {
     std::optional<V> hit;
-    visit_disc(p, 0.0, [&](V v) {
-      if (P_(v) == p) hit = v;
-      return hit.has_value();
-    });
+    visit_disc(
+        p, 0.0,
+        [&](V v) {
+          if (P_(v) == p) hit = v;
+          return hit.has_value();
+        },
+        scale);
     return hit;
   }
 
@@ -468,7 +472,7 @@ class CellQuestions {
       out.splits.push_back(*e);
       return out;
     }
-    const bool taken = find(r).has_value();
+    const bool taken = find(r, scale).has_value();
     if (failed()) return out;
     if (taken)
       throw InputError(InputError::Kind::Resolution, "an off-center falls on the vertex " + format_exact(r[0]) + " " +

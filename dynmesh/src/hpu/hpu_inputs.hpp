@@ -49,9 +49,16 @@
 #include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
 #include "hpu/hpu_geometry.hpp"
-#include "hpu/sa_delaunay.hpp"
+#include "hpu/cell_store.hpp"
 
 namespace dynmesh::detail {
+
+/// A node of the input list: an input or a side midpoint, and the rest of the list. It is
+/// the point's vertex too (the cell store's base values hold it).
+struct HpuInputNode : CellVertex {
+  explicit HpuInputNode(const Point<2>& x) : CellVertex(x) {}
+  sac::Mod<HpuInputNode*> next;
+};
 
 class HpuInputs {
  public:
@@ -64,8 +71,12 @@ class HpuInputs {
   HpuInputs(const HpuInputs&) = delete;
   HpuInputs& operator=(const HpuInputs&) = delete;
 
-  /// The list's head: HpuProgram's `input`.
-  sac::Mod<SaInputNode*>& head() noexcept { return head_; }
+  /// Keeps `cells`' base values the bucket tree of the box's corners (already inserted) and
+  /// the list's nodes from now on. Call before the first commit.
+  void attach(InputCells* cells) noexcept { cells_ = cells; }
+
+  /// The list's head: the program's `input`.
+  sac::Mod<HpuInputNode*>& head() noexcept { return head_; }
 
   /// What a batch of edits changes; computed by plan(), applied by commit().
   struct Plan {
@@ -181,11 +192,11 @@ class HpuInputs {
     std::vector<Point<2>> order(want.begin(), want.end());
     std::sort(order.begin(), order.end(), InsertionOrder{box_});
     std::size_t i = 0;
-    for (const SaInputNode* n = head_.get(); n; n = n->next.get(), ++i) {
+    for (const HpuInputNode* n = head_.get(); n; n = n->next.get(), ++i) {
       if (i >= order.size()) fail("the list has more points than the inputs and their side midpoints");
-      if (n->point != order[i]) fail("the list's point " + std::to_string(i) + " is " + to_string(n->point) +
+      if (n->p != order[i]) fail("the list's point " + std::to_string(i) + " is " + to_string(n->p) +
                                      ", its definition says " + to_string(order[i]));
-      const auto it = list_.find(n->point);
+      const auto it = list_.find(n->p);
       if (it == list_.end() || it->second.node.get() != n) fail("a listed node is not in the map");
     }
     if (i != order.size()) fail("the list misses points (" + std::to_string(i) + " of " + std::to_string(order.size()) + ")");
@@ -201,7 +212,7 @@ class HpuInputs {
   std::size_t bytes() const noexcept {
     std::size_t mids = 0;
     for (const auto& m : mids_) mids += m.size();
-    return list_.size() * (sizeof(Point<2>) + sizeof(Entry) + 4 * sizeof(void*) + sizeof(SaInputNode)) +
+    return list_.size() * (sizeof(Point<2>) + sizeof(Entry) + 4 * sizeof(void*) + sizeof(HpuInputNode)) +
            mids * (sizeof(double) + sizeof(int) + 4 * sizeof(void*));
   }
 
@@ -211,7 +222,7 @@ class HpuInputs {
     bool operator()(const Point<2>& a, const Point<2>& b) const noexcept { return insertion_less(box, a, b); }
   };
   struct Entry {
-    std::unique_ptr<SaInputNode> node;
+    std::unique_ptr<HpuInputNode> node;
     bool input = false;
   };
   /// Side k: 0 bottom, 1 top (along x), 2 left, 3 right (along y); u the axis along it,
@@ -255,8 +266,9 @@ class HpuInputs {
     return false;
   }
   void link(sac::Engine& e, const Point<2>& p, bool input) {
-    auto [it, fresh] = list_.emplace(p, Entry{std::make_unique<SaInputNode>(p), input});
-    SaInputNode* n = it->second.node.get();
+    auto [it, fresh] = list_.emplace(p, Entry{std::make_unique<HpuInputNode>(p), input});
+    HpuInputNode* n = it->second.node.get();
+    if (cells_) cells_->insert(e, n);
     const auto after = std::next(it);
     e.set(n->next, after == list_.end() ? nullptr : after->second.node.get());
     e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next, n);
@@ -265,6 +277,7 @@ class HpuInputs {
     const auto after = std::next(it);
     e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next,
           after == list_.end() ? nullptr : after->second.node.get());
+    if (cells_) cells_->erase(e, it->second.node.get());
     gone_.push_back(std::move(it->second.node));
     list_.erase(it);
   }
@@ -273,8 +286,9 @@ class HpuInputs {
   std::map<Point<2>, Entry, InsertionOrder> list_;
   std::array<std::set<double>, 4> side_;       // per side: the along coordinates of its vertices
   std::array<std::map<double, int>, 4> mids_;  // per side: midpoint (along coordinate) → paths
-  std::vector<std::unique_ptr<SaInputNode>> gone_;
-  sac::Mod<SaInputNode*> head_;
+  std::vector<std::unique_ptr<HpuInputNode>> gone_;
+  sac::Mod<HpuInputNode*> head_;
+  InputCells* cells_ = nullptr;
 };
 
 }  // namespace dynmesh::detail

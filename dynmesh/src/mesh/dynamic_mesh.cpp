@@ -13,12 +13,13 @@
 
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/mesh_check.hpp"
+#include "hpu/cell_store.hpp"
+#include "hpu/hpu_cells_program.hpp"
 #include "hpu/hpu_geometry.hpp"
 #include "hpu/hpu_inputs.hpp"
-#include "hpu/hpu_program.hpp"
+#include "hpu/hpu_mesh_feed.hpp"
 #include "quadtree/quadtree_core.hpp"
 #include "quadtree_mesh/quadtree_mesh_program.hpp"
-#include "hpu/sa_delaunay.hpp"
 
 namespace dynmesh {
 namespace detail {
@@ -63,15 +64,25 @@ MeshOptions validated(MeshOptions o) {
 
 struct MeshState {
   MeshState(const Box<2>& box, MeshOptions opts)
-      : options(validated(opts)), log(MeshGrid(validated(box))), hpu_inputs(box), core(box),
-        dt{&registry, box}, hpu(&dt, &hpu_inputs.head(), options.min_angle) {
+      : options(validated(opts)), log(MeshGrid(validated(box))), hpu_inputs(box), cells(box), input_cells(cells),
+        corners{std::make_unique<CellVertex>(Point<2>{box.origin[0], box.origin[1]}),
+                std::make_unique<CellVertex>(Point<2>{box.origin[0] + box.side, box.origin[1]}),
+                std::make_unique<CellVertex>(Point<2>{box.origin[0] + box.side, box.origin[1] + box.side}),
+                std::make_unique<CellVertex>(Point<2>{box.origin[0], box.origin[1] + box.side})},
+        core(box),
+        hpu(core.rt, cells, hpu_inputs.head(),
+            {corners[0].get(), corners[1].get(), corners[2].get(), corners[3].get()}, options.min_angle, feed) {
     program.dir = &core.dir;
     program.input = &core.head;
     program.log = &log;
+    if (is_hpu()) {
+      for (const auto& c : corners) input_cells.insert(core.rt, c.get());
+      hpu_inputs.attach(&input_cells);
+    }
   }
   ~MeshState() {  // before core (and its engine) goes
     log.closing = true;
-    registry.close();
+    feed.close();
   }
 
   bool is_hpu() const noexcept { return options.postprocess == Postprocess::Hpu; }
@@ -81,12 +92,14 @@ struct MeshState {
   CellCounts counts;
   MeshChange change;
   QuadtreeMeshProgram program{};
-  // The hpu mesh: its triangles' registry and its input list outlive the engine.
-  SaTriRegistry registry;
+  // The hpu mesh: its feed, its input list and its cell store outlive the engine.
+  HpuMeshFeed feed;
   HpuInputs hpu_inputs;
+  CellDirectory cells;
+  InputCells input_cells;
+  std::array<std::unique_ptr<CellVertex>, 4> corners;  // the box's, in the store from the start
   QuadtreeCore<2> core;
-  SaDelaunay dt;
-  HpuProgram hpu;
+  HpuCellsProgram hpu;
 
   /// The whole batch against the quadtree's and the mesh's input rules; with hpu, also its
   /// side midpoints (returned as the plan to commit). Changes nothing.
@@ -108,7 +121,7 @@ struct MeshState {
       auto ids = core.update(edits, [&](sac::Engine& e) { hpu_inputs.commit(e, plan); });
       hpu_inputs.release(core.rt);
       count(edits);
-      change = registry.take_change();
+      change = feed.take_change();
       return ids;
     }
     log.created.clear();
@@ -164,11 +177,12 @@ void check_trees_of(const DynamicMesh& mesh, const MeshState& s) {
   if (!s.is_hpu()) require_refined_tree(mesh.refined_leaves(), mesh.size());
 }
 
-/// The hpu mesh's own structures: the triangulation (Delaunay links, tiling, the feed's
-/// count) and the input list. O(n lg n).
+/// The hpu mesh's own structures: the feed's blocks, the input list and the cell store's
+/// base values. O(n lg n).
 void check_hpu_structures(const MeshState& s) {
-  s.registry.check_invariants(s.core.box);
+  s.feed.check_invariants();
   s.hpu_inputs.check_invariants(s.present());
+  s.input_cells.check_invariants();
 }
 
 /// Applies validated edits with one propagation. Built with the CMake option
@@ -203,8 +217,8 @@ DynamicMesh::DynamicMesh(const Box<2>& box, std::span<const Point<2>> points, Me
   if (s_->is_hpu()) {
     s_->hpu_inputs.commit(s_->core.rt, plan);
     auto* hpu = &s_->hpu;
-    s_->core.build(points, [hpu](sac::Engine& rt) { detail::HpuProgram::main(rt, hpu); });
-    s_->registry.clear_change();
+    s_->core.build(points, [hpu](sac::Engine& rt) { detail::HpuCellsProgram::main(rt, hpu); });
+    s_->feed.clear_change();
   } else {
     auto* program = &s_->program;
     s_->core.build(points, [program](sac::Engine& rt) { detail::QuadtreeMeshProgram::main(rt, program); });
@@ -250,7 +264,7 @@ const Point<2>& DynamicMesh::point(PointId id) const { return s_->core.point(id)
 std::vector<std::pair<PointId, Point<2>>> DynamicMesh::points() const { return s_->core.points(); }
 
 std::vector<Triangle> DynamicMesh::triangles() const {
-  if (s_->is_hpu()) return s_->registry.triangles();
+  if (s_->is_hpu()) return s_->feed.triangles();
   std::vector<Triangle> out;
   out.reserve(s_->log.live_count * 2);
   for (const detail::LeafBlock* b = s_->log.live; b; b = b->next) detail::triangulate_leaf(s_->log.grid, b->shape, out);
@@ -259,7 +273,7 @@ std::vector<Triangle> DynamicMesh::triangles() const {
 }
 
 std::size_t DynamicMesh::num_triangles() const noexcept {
-  if (s_->is_hpu()) return s_->registry.live_count();
+  if (s_->is_hpu()) return s_->feed.live_count();
   std::size_t k = 0;
   std::vector<Triangle> scratch;
   for (const detail::LeafBlock* b = s_->log.live; b; b = b->next) {
@@ -292,7 +306,8 @@ const UpdateStats& DynamicMesh::last_update() const noexcept { return s_->core.l
 const sac::Stats& DynamicMesh::engine_stats() const noexcept { return s_->core.rt.stats(); }
 std::size_t DynamicMesh::trace_bytes() const {
   std::size_t hpu = 0;
-  if (s_->is_hpu()) hpu = s_->hpu_inputs.bytes() + s_->registry.all().size() * sizeof(void*);
+  if (s_->is_hpu())
+    hpu = s_->hpu_inputs.bytes() + s_->feed.bytes() + s_->cells.bytes() + s_->input_cells.bytes();
   return s_->core.bytes() + hpu + s_->counts.size() * (sizeof(CellId<2>) + 2 * sizeof(void*) + sizeof(std::int64_t));
 }
 std::size_t DynamicMesh::record_bytes() const { return s_->core.rt.record_bytes(); }

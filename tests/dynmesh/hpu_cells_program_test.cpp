@@ -1,19 +1,20 @@
-// hpu_program_test.cpp — src/hpu/hpu_program.hpp, DynHPU's off-center refinement as a
-// self-adjusting program: from scratch (uniform, clustered, points near and on the box
-// sides, a grid) and after every update of a dynamic run, its triangles equal the static
-// twin HpuMesh's on the current points at 20.7°, 25° and 30°; the engine's and the
-// triangulation's invariants hold; the per-update trace distance is printed against the
-// from-scratch trace, and bounded to catch a program that re-runs everything.
-#include "hpu/hpu_program.hpp"
+// hpu_cells_program_test.cpp — src/hpu/hpu_cells_program.hpp, DynHPU's off-center refinement
+// as a self-adjusting program on the cell store: from scratch (uniform, clustered, curves,
+// points near and on the box sides, grids) and after every update of a dynamic run, its
+// triangles equal the static twin HpuMesh's on the current points at 20.7°, 25° and 30°;
+// the change feed replays; the engine's, the feed's, the input list's and the store's
+// invariants hold, and the store's newest cells are the static bucket tree of the mesh's
+// vertices; the per-update trace distance is printed against the from-scratch trace.
+#include "hpu/hpu_cells_program.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
-#include <deque>
 #include <iterator>
 #include <map>
 #include <memory>
@@ -26,37 +27,46 @@
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/distributions.hpp"
+#include "dynmesh/edit.hpp"
 #include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
-#include "dynmesh/edit.hpp"
+#include "hpu/bucket_tree.hpp"
+#include "hpu/cell_store.hpp"
 #include "hpu/hpu_geometry.hpp"
 #include "hpu/hpu_inputs.hpp"
-#include "hpu/sa_delaunay.hpp"
+#include "hpu/hpu_mesh_feed.hpp"
 #include "../sanitized.hpp"
 #include "same_triangles.hpp"
 
 namespace {
 
 using namespace dynmesh;
-using detail::HpuProgram;
-using detail::SaInputNode;
+using detail::HpuCellsProgram;
 using test_support::kSanitized;
 
 using dynmesh_test::same_triangles;
 
-/// The program on the mutator's input list (HpuInputs: the inputs and their side
-/// midpoints in insertion order). set_points() turns the new point set into edits, relinks
-/// the list, propagates, and frees the nodes that left.
+/// The program on the mutator's input list and cell store. set_points() turns the new point
+/// set into edits, relinks the list and sets the store's base values, propagates, and frees
+/// the nodes that left.
 class HpuHarness {
  public:
   HpuHarness(const Box<2>& box, const std::vector<Point<2>>& pts, double angle)
-      : box_(box), inputs_(box), dt_{&registry_, box}, program_(&dt_, &inputs_.head(), angle) {
+      : box_(box), inputs_(box), dir_(box), cells_(dir_),
+        corners_{std::make_unique<detail::CellVertex>(Point<2>{box.origin[0], box.origin[1]}),
+                 std::make_unique<detail::CellVertex>(Point<2>{box.origin[0] + box.side, box.origin[1]}),
+                 std::make_unique<detail::CellVertex>(Point<2>{box.origin[0] + box.side, box.origin[1] + box.side}),
+                 std::make_unique<detail::CellVertex>(Point<2>{box.origin[0], box.origin[1] + box.side})},
+        program_(engine_, dir_, inputs_.head(), {corners_[0].get(), corners_[1].get(), corners_[2].get(), corners_[3].get()},
+                 angle, feed_) {
+    for (const auto& c : corners_) cells_.insert(engine_, c.get());
+    inputs_.attach(&cells_);
     set_list(pts);
-    engine_.run([this](sac::Engine& e) { HpuProgram::main(e, &program_); });
-    registry_.clear_change();
+    engine_.run([this](sac::Engine& e) { HpuCellsProgram::main(e, &program_); });
+    feed_.clear_change();
   }
-  ~HpuHarness() { registry_.close(); }
+  ~HpuHarness() { feed_.close(); }
 
   void set_points(const std::vector<Point<2>>& pts) {
     set_list(pts);
@@ -64,17 +74,31 @@ class HpuHarness {
     inputs_.release(engine_);
   }
 
-  std::vector<Triangle> triangles() const { return registry_.triangles(); }
-  MeshChange take_change() { return registry_.take_change(); }
+  std::vector<Triangle> triangles() const { return feed_.triangles(); }
+  MeshChange take_change() { return feed_.take_change(); }
   void check() const {
     engine_.check_invariants();
-    registry_.check_invariants(box_);
+    feed_.check_invariants();
     const std::vector<Point<2>> now(points_.begin(), points_.end());
     inputs_.check_invariants(now);
+    cells_.check_invariants();
+    // The store's newest cells: the bucket tree of every vertex of the mesh.
+    std::set<Point<2>> vs;
+    for (const Triangle& t : feed_.triangles())
+      for (const Point<2>& p : t.v) vs.insert(p);
+    const std::vector<Point<2>> pts(vs.begin(), vs.end());
+    detail::BucketTree tree(box_);
+    for (std::uint32_t i = 0; i < pts.size(); ++i) tree.insert(i, pts[i], pts);
+    const auto index_of = [&](const detail::CellVertex* v) {
+      return static_cast<std::uint32_t>(std::lower_bound(pts.begin(), pts.end(), v->p) - pts.begin());
+    };
+    EXPECT_EQ(dir_.leaves(index_of), tree.leaves()) << "the store's newest cells are not the vertices' bucket tree";
   }
   const sac::Stats& stats() const { return engine_.stats(); }
-  /// For the checker's negative test: the feed counts one live triangle too many.
-  void corrupt_live_count() { registry_.corrupt_live_count_for_testing(); }
+  std::size_t record_bytes() const { return engine_.record_bytes(); }
+  const detail::CellQuestionStats& questions() const { return program_.stats; }
+  /// For the checker's negative test.
+  detail::HpuMeshFeed& feed() { return feed_; }
 
  private:
   void set_list(const std::vector<Point<2>>& pts) {
@@ -90,16 +114,18 @@ class HpuHarness {
 
   // Declared before the engine, so destroyed after it.
   Box<2> box_;
-  detail::SaTriRegistry registry_;
+  detail::HpuMeshFeed feed_;
   detail::HpuInputs inputs_;
+  detail::CellDirectory dir_;
+  detail::InputCells cells_;
+  std::array<std::unique_ptr<detail::CellVertex>, 4> corners_;
   std::set<Point<2>> points_;
   sac::Engine engine_;
-  detail::SaDelaunay dt_;
-  HpuProgram program_;
+  HpuCellsProgram program_;
 };
 
 std::string seed_note(std::uint64_t seed) {
-  std::printf("[ HpuProgram ] seed %llu\n", static_cast<unsigned long long>(seed));
+  std::printf("[ HpuCells ] seed %llu\n", static_cast<unsigned long long>(seed));
   return "seed " + std::to_string(seed);
 }
 
@@ -110,7 +136,7 @@ void expect_from_scratch(const Box<2>& box, const std::vector<Point<2>>& pts) {
     SCOPED_TRACE("angle " + std::to_string(angle));
     const HpuMesh twin(box, pts, angle);
     HpuHarness h(box, pts, angle);
-    std::printf("[ HpuProgram ] n = %zu, %.1f°: %zu triangles, %zu off-centers, %zu side splits\n", pts.size(), angle,
+    std::printf("[ HpuCells ] n = %zu, %.1f°: %zu triangles, %zu off-centers, %zu side splits\n", pts.size(), angle,
                 twin.triangles().size(), twin.stats().off_centers, twin.stats().side_splits);
     EXPECT_TRUE(same_triangles(h.triangles(), twin.triangles()));
     EXPECT_NO_THROW(h.check());
@@ -119,7 +145,7 @@ void expect_from_scratch(const Box<2>& box, const std::vector<Point<2>>& pts) {
 
 // ------------------------------------------------------------------ from scratch
 
-TEST(HpuProgram, FromScratchUniform) {
+TEST(HpuCellsProgram, FromScratchUniform) {
   const std::uint64_t seed = 101;
   SCOPED_TRACE(seed_note(seed));
   const Box<2> box{{0, 0}, 1};
@@ -130,14 +156,23 @@ TEST(HpuProgram, FromScratchUniform) {
   expect_from_scratch(box, pts);
 }
 
-TEST(HpuProgram, FromScratchClustered) {
+TEST(HpuCellsProgram, FromScratchClustered) {
   const std::uint64_t seed = 103;
   SCOPED_TRACE(seed_note(seed));
   const auto pts = generate<2>(Distribution::Clusters, kSanitized ? 80 : 300, seed);
   expect_from_scratch(derive_box<2>(pts), pts);
 }
 
-TEST(HpuProgram, FromScratchPointsNearAndOnTheSides) {
+TEST(HpuCellsProgram, FromScratchCurvesAndSpiral) {
+  for (const Distribution d : {Distribution::Curves, Distribution::Spiral}) {
+    const std::uint64_t seed = 105;
+    SCOPED_TRACE(seed_note(seed));
+    const auto pts = generate<2>(d, kSanitized ? 80 : 400, seed);
+    expect_from_scratch(derive_box<2>(pts), pts);
+  }
+}
+
+TEST(HpuCellsProgram, FromScratchPointsNearAndOnTheSides) {
   const std::uint64_t seed = 107;
   SCOPED_TRACE(seed_note(seed));
   const Box<2> box{{0, 0}, 4};
@@ -160,7 +195,7 @@ TEST(HpuProgram, FromScratchPointsNearAndOnTheSides) {
   expect_from_scratch(box, std::vector<Point<2>>(s.begin(), s.end()));
 }
 
-TEST(HpuProgram, FromScratchSmallGrids) {
+TEST(HpuCellsProgram, FromScratchSmallGrids) {
   const std::uint64_t seed = 109;
   SCOPED_TRACE(seed_note(seed));
   const Box<2> box{{0, 0}, 8};
@@ -208,7 +243,7 @@ std::vector<std::uint64_t> run_updates(const Box<2>& box, std::vector<Point<2>> 
   return distance;
 }
 
-TEST(HpuProgram, EveryUpdateMatchesAFromScratchTwin) {
+TEST(HpuCellsProgram, EveryUpdateMatchesAFromScratchTwin) {
   const std::uint64_t seed = 20261123;
   SCOPED_TRACE(seed_note(seed));
   const Box<2> box{{0, 0}, 1};
@@ -235,7 +270,7 @@ TEST(HpuProgram, EveryUpdateMatchesAFromScratchTwin) {
   mean /= double(distance.size());
   const auto pct = [&](double x) { return 100.0 * x / double(scratch); };
   // Trace distance: events created + undone by the propagation (sac/stats.hpp).
-  std::printf("[ HpuProgram ] n = %zu, %d updates: from scratch %llu events; per update trace distance mean %.1f "
+  std::printf("[ HpuCells ] n = %zu, %d updates: from scratch %llu events; per update trace distance mean %.1f "
               "(%.2f%%) median %llu (%.2f%%) max %llu (%.2f%%)\n",
               n, updates, static_cast<unsigned long long>(scratch), mean, pct(mean),
               static_cast<unsigned long long>(sorted[sorted.size() / 2]), pct(double(sorted[sorted.size() / 2])),
@@ -247,7 +282,7 @@ TEST(HpuProgram, EveryUpdateMatchesAFromScratchTwin) {
 /// Updates next to and on the box's near sides at 30°: side midpoints come and go with
 /// them (the mutator's list changes by more than one point), and the refinement splits
 /// sides.
-TEST(HpuProgram, UpdatesNearTheSidesAt30Degrees) {
+TEST(HpuCellsProgram, UpdatesNearTheSidesAt30Degrees) {
   const std::uint64_t seed = 127;
   SCOPED_TRACE(seed_note(seed));
   const Box<2> box{{0, 0}, 4};
@@ -269,98 +304,8 @@ TEST(HpuProgram, UpdatesNearTheSidesAt30Degrees) {
   const auto distance = run_updates(box, pts, fresh, 30.0, kSanitized ? 10 : 40, rng, scratch);
   double mean = 0;
   for (auto x : distance) mean += double(x);
-  std::printf("[ HpuProgram ] near the sides, 30°: from scratch %llu events; per update trace distance mean %.1f\n",
+  std::printf("[ HpuCells ] near the sides, 30°: from scratch %llu events; per update trace distance mean %.1f\n",
               static_cast<unsigned long long>(scratch), mean / double(std::max<std::size_t>(1, distance.size())));
-}
-
-}  // namespace
-
-namespace {
-
-// ------------------------------------------------------------------ the side crossed
-
-/// Sink of side_edge_at: the edge's end points, written to a modifiable the test reads.
-struct EdgeSink {
-  sac::Mod<std::pair<Point<2>, Point<2>>>* out;
-  friend bool operator==(const EdgeSink&, const EdgeSink&) = default;
-  std::size_t hash() const noexcept { return sac::Hash<void*>{}(out); }
-  void operator()(sac::Engine& e, detail::SaVertex* a, detail::SaVertex* b) const { e.write(*out, std::pair{a->p, b->p}); }
-};
-
-/// The refinement's side rule (never reached on the inputs above: no vertex encroaches a box
-/// edge, so an empty leaf crosses a side only in degenerate cases), tested on its own:
-/// side_edge_at on a triangulation with many side vertices equals the twin's
-/// std::map::upper_bound rule, for X at every side vertex, between them, and at both ends.
-TEST(HpuProgram, SideEdgeAtFollowsTheTwinsUpperBoundRule) {
-  const std::uint64_t seed = 113;
-  SCOPED_TRACE(seed_note(seed));
-  const Box<2> box{{0, 0}, 8};
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 8.0);
-  std::set<Point<2>> s;
-  for (int i = 0; i < 40; ++i) s.insert({u(rng), u(rng)});
-  for (int i = 0; i < 6; ++i) s.insert({u(rng), 0.0}), s.insert({0.0, u(rng)});
-  s.insert({0.0, 4.0});
-  std::vector<Point<2>> inputs(s.begin(), s.end());
-  for (const auto& m : detail::side_midpoints(box, inputs)) s.insert(m);
-  // The triangulation of the points, then queries in a second run.
-  detail::SaTriRegistry registry;
-  std::vector<std::unique_ptr<SaInputNode>> nodes;
-  std::deque<sac::Mod<std::pair<Point<2>, Point<2>>>> outs;
-  sac::Mod<SaInputNode*> head;
-  sac::Engine engine;
-  detail::SaDelaunay dt{&registry, box};
-  detail::SaDelaunayProgram program{&dt, &head};
-  for (const auto& p : s) nodes.push_back(std::make_unique<SaInputNode>(p));
-  for (std::size_t i = 0; i < nodes.size(); ++i)
-    engine.set(nodes[i]->next, i + 1 < nodes.size() ? nodes[i + 1].get() : nullptr);
-  engine.set(head, nodes.front().get());
-  engine.run([&](sac::Engine& e) { detail::SaDelaunayProgram::main(e, &program); });
-  detail::SaTri* start = nullptr;
-  std::set<Point<2>> verts;
-  for (detail::SaTri* t : registry.all())
-    if (t->alive()) {
-      start = t;
-      for (const auto* v : t->v) verts.insert(v->p);
-    }
-  ASSERT_NE(start, nullptr);
-  struct Query {
-    int side;
-    Point<2> x;
-    std::pair<Point<2>, Point<2>> want;
-  };
-  std::vector<Query> queries;
-  for (int side = 0; side < 4; ++side) {
-    const unsigned along = side % 2 == 0 ? 0 : 1;
-    const double across = side == 0 || side == 3 ? 0.0 : 8.0;
-    std::map<double, Point<2>> line;
-    for (const auto& p : verts)
-      if (p[1 - along] == across) line[p[along]] = p;
-    std::vector<double> xs{0.0, 8.0};
-    for (auto it = line.begin(); it != line.end(); ++it) {
-      xs.push_back(it->first);
-      if (std::next(it) != line.end()) xs.push_back(0.5 * (it->first + std::next(it)->first));
-    }
-    for (const double x : xs) {
-      auto it = line.upper_bound(x);
-      if (it == line.end()) --it;
-      if (it == line.begin()) ++it;
-      Point<2> p;
-      p[along] = x;
-      p[1 - along] = across;
-      queries.push_back({side, p, {std::prev(it)->second, it->second}});
-      outs.emplace_back();
-    }
-  }
-  engine.run([&](sac::Engine& e) {
-    for (std::size_t i = 0; i < queries.size(); ++i)
-      HpuProgram::side_edge_at(e, queries[i].side, queries[i].x, start, EdgeSink{&outs[i]});
-  });
-  for (std::size_t i = 0; i < queries.size(); ++i) {
-    auto got = outs[i].get();
-    if (xy_less(got.second, got.first)) std::swap(got.first, got.second);
-    EXPECT_EQ(got, queries[i].want) << "side " << queries[i].side << " at " << to_string(queries[i].x);
-  }
 }
 
 }  // namespace
@@ -409,10 +354,10 @@ TEST(HpuInputs, CheckerCatchesABrokenList) {
   EXPECT_THROW(inputs.check_invariants(more), InvariantError);
   EXPECT_THROW(inputs.check_invariants(std::vector<Point<2>>(pts.begin(), pts.end() - 1)), InvariantError);
   // The list cut after its first node, then two nodes swapped.
-  detail::SaInputNode* first = inputs.head().get();
-  detail::SaInputNode* second = first->next.get();
-  detail::SaInputNode* third = second->next.get();
-  engine.set(first->next, static_cast<detail::SaInputNode*>(nullptr));
+  detail::HpuInputNode* first = inputs.head().get();
+  detail::HpuInputNode* second = first->next.get();
+  detail::HpuInputNode* third = second->next.get();
+  engine.set(first->next, static_cast<detail::HpuInputNode*>(nullptr));
   EXPECT_THROW(inputs.check_invariants(pts), InvariantError);
   engine.set(inputs.head(), second);
   engine.set(second->next, first);
@@ -424,12 +369,12 @@ TEST(HpuInputs, CheckerCatchesABrokenList) {
   EXPECT_NO_THROW(inputs.check_invariants(pts));
 }
 
-/// SaTriRegistry's checker catches a feed whose live count disagrees with the triangles.
-TEST(SaTriRegistry, CheckerCatchesAWrongLiveCount) {
+/// HpuMeshFeed's checker catches a live count that disagrees with its blocks.
+TEST(HpuMeshFeed, CheckerCatchesAWrongLiveCount) {
   const Box<2> box{{0, 0}, 1};
   HpuHarness h(box, {{0.25, 0.5}, {0.75, 0.5}, {0.5, 0.25}}, kHpuDefaultMinAngle);
   ASSERT_NO_THROW(h.check());
-  h.corrupt_live_count();
+  h.feed().corrupt_live_count_for_testing();
   EXPECT_THROW(h.check(), InvariantError);
 }
 

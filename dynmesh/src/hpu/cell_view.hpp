@@ -1,0 +1,425 @@
+// cell_view.hpp (private) — how a step of the self-adjusting hpu program reads the cells:
+// its view of the cell store, the rounds of reads that fill it, and the insertion step.
+//
+// Purpose: a step (a vertex's first class, an entry's collect, one try of a pair, a leaf's
+// final triangles) runs the static questions of cell_questions.hpp on a CellView. The view
+// holds the cells the step has read and answers searches from them; a search that needs a
+// cell the step has not read records it as missing and fails, and every later question of
+// the step then returns at once. run_step() then reads the missing cells, as one
+// Engine::read_many (one trace event, up to 16 cells), nested in the reads before, and runs
+// the step again on the larger view; the round that fails nothing does the step's writes.
+// So a step costs a few events, whatever the number of vertices it looks at, and it re-runs
+// only when a cell it read changes (cut-off: a write of an equal vertex set is no change).
+// Which cells a search asks for: the view walks the tree from the root, like BucketTree's
+// search. An ancestor of a cell read as a leaf or split is split (the tree grows only), so
+// the step never reads the coarse cells above its region. An unread cell below the level
+// that suits the search's scale is read itself; above it, its descendants at that level
+// near the focus are read instead (at most 3 × 3), and a cell read as absent (an ancestor
+// is a leaf) makes its next ancestors be read.
+// Invariants: a view's cells are read by the step's enclosing reads, and their values are
+// looked up with Engine::current (no write between: a step writes only in its last round);
+// a failed run writes, allocates and issues nothing but the next round; the answers of a
+// run that did not fail are those of the static tree on the same vertices.
+// Complexity: a round O(cells read × depth) to build the view, plus the step's questions.
+// Paper: Acar & Hudson, Section 4; Hammer, Acar & Chen (CEAL, 2009) for reads as the unit of
+// re-execution.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <sac/engine.hpp>
+#include <sac/mod.hpp>
+
+#include "dynmesh/errors.hpp"
+#include "dynmesh/point.hpp"
+#include "hpu/cell_questions.hpp"
+#include "hpu/cell_store.hpp"
+
+namespace dynmesh::detail {
+
+inline constexpr std::size_t kCellsPerRead = 16;  // Engine::read_many's most
+
+class CellView {
+ public:
+  using V = const CellVertex*;
+
+  CellView(sac::Engine& e, CellDirectory& dir) : e_(&e), dir_(&dir), box_(dir.box()) {
+    table_.resize(1024);
+    mask_ = table_.size() - 1;
+  }
+  CellView(const CellView&) = delete;
+  CellView& operator=(const CellView&) = delete;
+
+  // ---------------------------------------------------------------- filling
+
+  /// Forgets every cell (a new round of some step).
+  void reset() {
+    if (++gen_ == 0) {
+      for (Slot& s : table_) s.gen = 0;
+      gen_ = 1;
+    }
+    used_ = 0;
+    read_.clear();
+    misses_.clear();
+    failed_ = false;
+  }
+
+  /// A cell the step has read, with its value now.
+  void add(CellNode* n, const CellState* s) { read_.push_back({n, s}); }
+
+  /// After the adds: marks the ancestors of the cells read as leaves or splits as split, and
+  /// those of cells read as absent as "absent below".
+  void settle() {
+    for (const auto& [n, s] : read_) {
+      Slot& x = slot(n->key);
+      x.tag = s->kind == CellState::Leaf ? Tag::Leaf : s->kind == CellState::Split ? Tag::Split : Tag::Absent;
+      x.state = s;
+      x.node = n;
+    }
+    for (const auto& [n, s] : read_) {
+      if (s->kind == CellState::Absent || n->key.level == 0) continue;
+      for (CellKey k = n->key.parent();; k = k.parent()) {
+        Slot& x = slot(k);
+        if (x.tag == Tag::Split) break;
+        if (x.tag == Tag::Leaf || x.tag == Tag::Absent)
+          throw InvariantError("dynmesh: CellView: a cell read below a leaf or an absent cell");
+        x.tag = Tag::Split;
+        if (k.level == 0) break;
+      }
+    }
+    for (const auto& [n, s] : read_) {
+      if (s->kind != CellState::Absent) continue;
+      if (n->key.level == 0) throw InvariantError("dynmesh: CellView: the root cell is absent");
+      for (CellKey k = n->key.parent();; k = k.parent()) {
+        Slot& x = slot(k);
+        if (x.tag != Tag::Unknown && x.tag != Tag::AbsentBelow) break;
+        if (x.tag == Tag::Unknown) {
+          x.tag = Tag::AbsentBelow;
+          x.below = n->key;
+        }
+        if (k.level == 0) break;
+      }
+    }
+  }
+
+  // ---------------------------------------------------------------- the store interface
+
+  bool failed() const noexcept { return failed_; }
+  std::span<CellNode* const> misses() const noexcept { return misses_; }
+  std::size_t leaves_read() const noexcept { return leaves_read_; }
+  std::size_t cells_read() const noexcept { return read_.size(); }
+
+  double margin_for(const Point<2>& c, double r) const noexcept {
+    const double mag = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(box_.origin[0]), std::abs(box_.origin[1])});
+    return r * 0x1p-30 + (mag + box_.side) * 0x1p-40;
+  }
+
+  /// BucketTree::search on the cells read; `scale` (the search's radius, or the distance it
+  /// expects) chooses which cells to ask for when it needs unread ones.
+  template <class Keep, class F>
+  void search(const Point<2>& focus, double scale, double margin, Keep&& keep, F&& f) const {
+    if (failed_) return;
+    bool stop = false;
+    auto* self = const_cast<CellView*>(this);
+    self->search_node(CellKey{}, focus, scale, margin, keep, f, stop);
+  }
+
+  /// The leaf that holds grid position q, and its value; null when a cell is missing.
+  std::pair<CellNode*, const CellState*> locate(const std::array<std::uint64_t, 2>& q, double scale) {
+    CellKey k{};
+    for (;;) {
+      Slot& x = slot(k);
+      if (x.tag == Tag::Leaf) return {x.node, x.state};
+      if (x.tag == Tag::Split) {
+        k = CellDirectory::cell_at(q, k.level + 1);
+        continue;
+      }
+      if (x.tag == Tag::Absent) throw InvariantError("dynmesh: CellView: located into an absent cell");
+      failed_ = true;
+      if (x.tag == Tag::AbsentBelow) {
+        ask_above(k, x.below);
+      } else {
+        const int g = level_for(scale);
+        ask(g <= k.level ? k : CellDirectory::cell_at(q, g));
+      }
+      return {nullptr, nullptr};
+    }
+  }
+
+  // ---------------------------------------------------------------- helpers
+
+  /// The level whose cells are at least 2·scale wide (so a disc of radius scale meets at
+  /// most 2 × 2 of them).
+  int level_for(double scale) const noexcept {
+    if (!(scale > 0)) return BucketTree::kMaxLevel;
+    const double ratio = box_.side / (2 * scale);
+    if (!(ratio >= 1)) return 0;
+    return std::min(BucketTree::kMaxLevel, std::ilogb(ratio));
+  }
+
+  /// A cell's box, widened by margin.
+  void cell_box(const CellKey& k, double margin, double& x0, double& y0, double& x1, double& y1) const noexcept {
+    const double w = std::ldexp(box_.side, -k.level);
+    x0 = box_.origin[0] + static_cast<double>(k.ix) * w - margin, x1 = x0 + w + 2 * margin;
+    y0 = box_.origin[1] + static_cast<double>(k.iy) * w - margin, y1 = y0 + w + 2 * margin;
+  }
+
+ private:
+  enum class Tag : std::uint8_t { Unknown, Leaf, Split, Absent, AbsentBelow, Asked };
+  struct Slot {
+    std::uint32_t gen = 0;
+    Tag tag = Tag::Unknown;
+    CellKey key;
+    CellKey below;  // AbsentBelow: a cell read as absent under this one
+    const CellState* state = nullptr;
+    CellNode* node = nullptr;
+  };
+
+  Slot& slot(const CellKey& k) {
+    if (2 * (used_ + 1) > table_.size()) grow();
+    for (std::size_t i = k.hash() & mask_;; i = (i + 1) & mask_) {
+      Slot& s = table_[i];
+      if (s.gen != gen_) {
+        s.gen = gen_;
+        s.tag = Tag::Unknown;
+        s.key = k;
+        s.state = nullptr;
+        s.node = nullptr;
+        ++used_;
+        return s;
+      }
+      if (s.key == k) return s;
+    }
+  }
+
+  void grow() {
+    std::vector<Slot> old(table_.size() * 2);
+    old.swap(table_);
+    mask_ = table_.size() - 1;
+    used_ = 0;
+    for (const Slot& s : old) {
+      if (s.gen != gen_) continue;
+      Slot& n = slot(s.key);
+      n = s;
+    }
+  }
+
+  void ask(const CellKey& k) {
+    failed_ = true;
+    Slot& x = slot(k);
+    if (x.tag == Tag::Asked) return;
+    if (x.tag != Tag::Unknown && x.tag != Tag::AbsentBelow) return;  // read already
+    x.tag = Tag::Asked;
+    misses_.push_back(dir_->node(*e_, k));
+  }
+
+  /// Cells read as absent below k: ask for the next ancestors of one of them (up to three,
+  /// and not above k), where the leaf that holds it must be.
+  void ask_above(const CellKey& k, const CellKey& below) {
+    CellKey a = below.parent();
+    for (int i = 0; i < 3 && a.level >= k.level; ++i) {
+      ask(a);
+      if (a.level == 0) break;
+      a = a.parent();
+    }
+  }
+
+  template <class Keep, class F>
+  void search_node(const CellKey& k, const Point<2>& focus, double scale, double margin, Keep& keep, F& f, bool& stop) {
+    double x0, y0, x1, y1;
+    cell_box(k, margin, x0, y0, x1, y1);
+    if (!keep(x0, y0, x1, y1)) return;
+    Slot& x = slot(k);
+    switch (x.tag) {
+      case Tag::Leaf: {
+        ++leaves_read_;
+        const CellState& s = *x.state;
+        for (std::size_t i = 0; i < s.count; ++i)
+          if (f(s.items[i])) {
+            stop = true;
+            return;
+          }
+        return;
+      }
+      case Tag::Split: {
+        // Children nearest to the focus first (by their centres' distance), as BucketTree.
+        std::array<std::pair<double, unsigned>, 4> order;
+        const double w = std::ldexp(box_.side, -k.level);
+        for (unsigned c = 0; c < 4; ++c) {
+          const double cx = box_.origin[0] + (static_cast<double>(2 * k.ix + (c & 1)) + 0.5) * 0.5 * w;
+          const double cy = box_.origin[1] + (static_cast<double>(2 * k.iy + (c >> 1)) + 0.5) * 0.5 * w;
+          order[c] = {(cx - focus[0]) * (cx - focus[0]) + (cy - focus[1]) * (cy - focus[1]), c};
+        }
+        std::sort(order.begin(), order.end());
+        for (const auto& [d2, c] : order) {
+          if (stop) return;
+          search_node(k.child(c), focus, scale, margin, keep, f, stop);
+        }
+        return;
+      }
+      case Tag::Absent:
+        throw InvariantError("dynmesh: CellView: an absent cell under a split one");
+      case Tag::Asked:
+        failed_ = true;
+        return;
+      case Tag::AbsentBelow:
+        ask_above(k, x.below);
+        return;
+      case Tag::Unknown:
+        ask_for(k, focus, scale, margin, keep);
+        return;
+    }
+  }
+
+  /// k is unread and the search needs it: read it if it is at the search's level or finer;
+  /// otherwise read its cells of that level near the focus that the search keeps.
+  template <class Keep>
+  void ask_for(const CellKey& k, const Point<2>& focus, double scale, double margin, Keep& keep) {
+    failed_ = true;
+    double s = scale;
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      const int g = level_for(s);
+      if (g <= k.level) return ask(k);
+      const int shift = g - k.level;
+      const double w = std::ldexp(box_.side, -g);
+      const double R = 2 * s + margin;
+      const auto index = [&](double x, unsigned a, std::uint64_t lo, std::uint64_t hi) -> std::uint64_t {
+        const double u = std::floor((x - box_.origin[a]) / w);
+        if (!(u > static_cast<double>(lo))) return lo;
+        if (!(u < static_cast<double>(hi))) return hi;
+        return static_cast<std::uint64_t>(u);
+      };
+      const std::uint64_t lo_x = k.ix << shift, hi_x = ((k.ix + 1) << shift) - 1;
+      const std::uint64_t lo_y = k.iy << shift, hi_y = ((k.iy + 1) << shift) - 1;
+      // The focus box clamped to k: empty when k lies beyond it.
+      const double fx0 = focus[0] - R, fx1 = focus[0] + R, fy0 = focus[1] - R, fy1 = focus[1] + R;
+      double kx0, ky0, kx1, ky1;
+      cell_box(k, 0.0, kx0, ky0, kx1, ky1);
+      if (fx1 < kx0 || fx0 > kx1 || fy1 < ky0 || fy0 > ky1) {
+        // Beyond the focus box: scale up to k's distance and try again.
+        s = std::max(s, std::sqrt(cellq::box_distance2(focus, kx0, ky0, kx1, ky1)));
+        continue;
+      }
+      const std::uint64_t ax = index(fx0, 0, lo_x, hi_x), bx = index(fx1, 0, lo_x, hi_x);
+      const std::uint64_t ay = index(fy0, 1, lo_y, hi_y), by = index(fy1, 1, lo_y, hi_y);
+      bool any = false;
+      for (std::uint64_t iy = ay; iy <= by; ++iy)
+        for (std::uint64_t ix = ax; ix <= bx; ++ix) {
+          const CellKey c{g, ix, iy};
+          double c0, c1, c2, c3;
+          cell_box(c, margin, c0, c1, c2, c3);
+          if (!keep(c0, c1, c2, c3)) continue;
+          ask(c);
+          any = true;
+        }
+      if (any) return;
+      break;
+    }
+    ask(k);
+  }
+
+  sac::Engine* e_;
+  CellDirectory* dir_;
+  Box<2> box_;
+  std::vector<Slot> table_;
+  std::size_t mask_ = 0, used_ = 0;
+  std::uint32_t gen_ = 0;
+  std::vector<std::pair<CellNode*, const CellState*>> read_;
+  std::vector<CellNode*> misses_;
+  bool failed_ = false;
+  std::size_t leaves_read_ = 0;
+};
+
+// -------------------------------------------------------------------- rounds of reads
+
+/// The part of a round's closure that later rounds look through: the round before, and how
+/// many cells this one read (the cells follow it in CellRound).
+struct CellRoundHead {
+  const CellRoundHead* parent;
+  std::uint32_t n;
+};
+
+template <std::size_t N>
+struct CellRoundCells {
+  CellRoundHead head;
+  std::array<CellNode*, N> cells;
+};
+
+inline CellNode* const* cells_of(const CellRoundHead* h) {
+  // Every CellRound<Step, N> starts with a CellRoundCells<N> (standard layout), whose cells
+  // follow the head at the same offset for every N.
+  return reinterpret_cast<const CellRoundCells<1>*>(h)->cells.data();
+}
+
+/// Where the running program keeps its view (one per engine: rounds run one at a time).
+struct CellViewOwner {
+  CellView* view;
+};
+
+template <class Step>
+void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::span<CellNode* const> misses);
+
+/// One round of a step: reads its cells, then runs the step on the view of all its rounds.
+template <class Step, std::size_t N>
+struct CellRound {
+  CellRoundCells<N> c;
+  Step step;
+
+  void operator()(sac::Engine& e, std::span<const CellState* const> vals) const {
+    CellView& v = *step.view(e);
+    v.reset();
+    for (std::uint32_t i = 0; i < c.head.n; ++i) v.add(c.cells[i], vals[i]);
+    for (const CellRoundHead* r = c.head.parent; r; r = r->parent) {
+      CellNode* const* cells = cells_of(r);
+      for (std::uint32_t i = 0; i < r->n; ++i) v.add(cells[i], &e.current(cells[i]->state));
+    }
+    v.settle();
+    if (!step.run(e, v)) issue_round(e, step, &c.head, v.misses());
+  }
+};
+
+template <class Step, std::size_t N>
+void issue_round_n(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::span<CellNode* const> misses) {
+  static_assert(std::is_standard_layout_v<CellRoundCells<N>>);
+  CellRound<Step, N> r{{{parent, static_cast<std::uint32_t>(misses.size())}, {}}, step};
+  std::array<const sac::Mod<CellState>*, N> mods;
+  for (std::size_t i = 0; i < misses.size(); ++i) {
+    r.c.cells[i] = misses[i];
+    mods[i] = &misses[i]->state;
+  }
+  e.read_many(std::span<const sac::Mod<CellState>* const>(mods.data(), misses.size()), std::move(r));
+}
+
+template <class Step>
+void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::span<CellNode* const> misses) {
+  if (misses.empty()) throw InvariantError("dynmesh: a step failed without a missing cell");
+  if (misses.size() > kCellsPerRead) misses = misses.first(kCellsPerRead);  // the rest next round
+  if (misses.size() <= 2) return issue_round_n<Step, 2>(e, step, parent, misses);
+  if (misses.size() <= 4) return issue_round_n<Step, 4>(e, step, parent, misses);
+  if (misses.size() <= 8) return issue_round_n<Step, 8>(e, step, parent, misses);
+  issue_round_n<Step, kCellsPerRead>(e, step, parent, misses);
+}
+
+/// Runs a step: step.run(e, view) on an empty view (it fails at its first question), then
+/// on the cells it asked for, round after round, until a run does not fail. Step: copyable
+/// (it is each round's closure), with CellView* view(Engine&) and bool run(Engine&,
+/// CellView&). run returns false when the view failed, and has then written, allocated and
+/// issued nothing; otherwise it does the step's effects, in this order: writes and
+/// allocations first (they use the view and the program's scratch), then the reads, memo
+/// calls and run_step calls that continue the program (a write after an issued call would
+/// run that call on the spot, and it would reuse the view).
+template <class Step>
+void run_step(sac::Engine& e, const Step& step) {
+  CellView& v = *step.view(e);
+  v.reset();
+  v.settle();
+  if (!step.run(e, v)) issue_round(e, step, nullptr, v.misses());
+}
+
+}  // namespace dynmesh::detail

@@ -1,0 +1,517 @@
+// hpu_cells_program.hpp (private) — DynHPU's off-center refinement as a self-adjusting program
+// on sac-runtime, every question answered from the cells of the vertex store.
+//
+// Purpose: after run() and after every propagate(), the live triangles equal those of the
+// static twin HpuMesh (hpu_mesh.cpp) on the current input points, box and angle, bit for bit.
+// It takes the twin's decisions (rules 1-6 of dynmesh/hpu_mesh.hpp) in the twin's order,
+// asking the questions of cell_questions.hpp (the same code as the static cell refiner) on a
+// view of the cell store (cell_view.hpp):
+//   1. the initial vertices: the box's corners in (Morton, xy) order, then the input list
+//      (the inputs and their side midpoints in insertion_less order, kept by the mutator,
+//      hpu_inputs.hpp), whose vertices are also the store's base values (cell_store.hpp);
+//   2. each initial vertex's class (its shortest Delaunay edge's): a step;
+//   3. per class j, smallest first: Q_j = (initial entries of class j, in initial order) ++
+//      (continuations made during class j − 1); rounds: collect every entry of the round (a
+//      step: its loose pairs into the entry's own list, and its continuation into Q_{j+1}),
+//      then process the pairs in collection order (each try a step: not loose, split box
+//      edges, or insert the off-center; an insertion is a step that writes the store's leaf);
+//      births (off-centers and side midpoints) form the next round;
+//   4. the final mesh: a pass over the store's newest leaves; each leaf's step finds the
+//      triangles whose (x, y)-smallest corner it holds, from those vertices' stars, and makes
+//      them one block of the change feed (hpu_mesh_feed.hpp).
+// Lists by destination passing, with the memo keys that keep an update local
+// (docs/EXPERIMENTS.md, "What made the trace distance flat"): every list cell is a keyed
+// allocation (an entry by (vertex, class, birth), a pair by (its collector's entry, p, q), a
+// class by j, a round by the modifiable holding its first entry), a list step's key holds its
+// predecessor's predecessor, and phases that follow a list pass are issued after it as
+// siblings. Each step reads its cells as a few multi-reads (cell_view.hpp), so its cost is a
+// few events however many vertices it looks at, and it re-runs only when a cell it read
+// changes.
+// Invariants: those of the twin's rules; every list is terminated by its pass before a later
+// phase reads it; a vertex has at most one entry per class, so the entry keys are unique in a
+// run; a step writes, allocates and issues only in the round whose view did not fail.
+// Complexity: the twin's steps (O(n lg n + m) expected), each O(1) cells in a graded mesh. An
+// update re-runs the steps whose cells it changes, plus list steps up to the next cell
+// appended as before (bench/RESULTS.md, docs/EXPERIMENTS.md).
+// Paper: Acar & Hudson, Figure 5 and Appendix A (DynHPU), Section 4; Har-Peled & Üngör (2005);
+// Üngör, "Off-centers" (2004); Acar, Ahmed & Blume (2008) for keyed allocation and
+// destination passing.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <climits>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include <sac/engine.hpp>
+#include <sac/fn.hpp>
+#include <sac/hash.hpp>
+#include <sac/mod.hpp>
+
+#include "dynmesh/errors.hpp"
+#include "dynmesh/point.hpp"
+#include "hpu/cell_questions.hpp"
+#include "hpu/cell_store.hpp"
+#include "hpu/cell_view.hpp"
+#include "hpu/hpu_geometry.hpp"
+#include "hpu/hpu_inputs.hpp"
+#include "hpu/hpu_mesh_feed.hpp"
+
+namespace dynmesh::detail {
+
+using HV = const CellVertex*;
+
+struct HcPair;
+
+/// A queue entry (the twin's Entry), keyed by (vertex, class, birth).
+struct HcEntry {
+  HcEntry(HV x, bool b) : v(x), birth(b) {}
+  HcEntry(const HcEntry&) = delete;
+  HcEntry& operator=(const HcEntry&) = delete;
+  HV v;
+  bool birth;
+  sac::Mod<HcEntry*> next;
+  sac::Mod<HcPair*> pairs;  // the loose pairs its collect found, in order
+};
+
+/// A collected pair p→q, keyed by (its collector's entry, p, q).
+struct HcPair {
+  HcPair(HV a, HV b) : p(a), q(b) {}
+  HcPair(const HcPair&) = delete;
+  HcPair& operator=(const HcPair&) = delete;
+  HV p;
+  HV q;
+  sac::Mod<HcPair*> next;
+};
+
+/// An initial vertex, keyed by it: its class, and the rest of the list (each class's filter
+/// writes a new version: the vertices left for later classes).
+struct HcCell {
+  explicit HcCell(HV x) : v(x) {}
+  HcCell(const HcCell&) = delete;
+  HcCell& operator=(const HcCell&) = delete;
+  HV v;
+  sac::Mod<int> cls;
+  sac::Mod<HcCell*> next;
+};
+
+/// A size class, keyed by j.
+struct HcClass {
+  explicit HcClass(int c) : j(c) {}
+  HcClass(const HcClass&) = delete;
+  HcClass& operator=(const HcClass&) = delete;
+  int j;
+  sac::Mod<HcEntry*> init;  // Q_j: the initial entries of class j, then `cont`
+  sac::Mod<HcEntry*> cont;  // the continuations made during class j − 1
+  sac::Mod<HcCell*> rest;   // the initial vertices of classes above j
+};
+
+/// A round, keyed by the modifiable holding its first entry.
+struct HcRound {
+  HcRound() = default;
+  HcRound(const HcRound&) = delete;
+  HcRound& operator=(const HcRound&) = delete;
+  sac::Mod<HcEntry*> births;               // the next round
+  sac::Mod<sac::Mod<HcEntry*>*> cont_tail;  // Q_{j+1}'s tail after this round's collect
+};
+
+/// The run's fixed state (allocated once by main, which never re-runs).
+struct HcStart {
+  HcStart() = default;
+  HcStart(const HcStart&) = delete;
+  HcStart& operator=(const HcStart&) = delete;
+  sac::Mod<HcCell*> cells;  // the initial vertices, in order
+  sac::Mod<int> min_class;  // the smallest initial class
+};
+
+/// The program. The mutator keeps `input` equal to the inputs and their side midpoints in
+/// insertion_less order, and the store's base values equal to the bucket tree of those and
+/// the four corners (HpuInputs with InputCells attached), and calls propagate().
+struct HpuCellsProgram {
+  struct Coords {
+    const Point<2>& operator()(HV v) const noexcept { return v->p; }
+  };
+  using Questions = CellQuestions<CellView, HV, Coords>;
+
+  HpuCellsProgram(sac::Engine& e, CellDirectory& d, sac::Mod<HpuInputNode*>& in,
+                  const std::array<const CellVertex*, 4>& box_corners, double min_angle_deg, HpuMeshFeed& f)
+      : dir(&d), input(&in), corners(box_corners), feed(&f), view(e, d),
+        q(d.box(), min_angle_deg, view, Coords{}, nullptr, stats) {}
+  HpuCellsProgram(const HpuCellsProgram&) = delete;
+  HpuCellsProgram& operator=(const HpuCellsProgram&) = delete;
+
+  CellDirectory* dir;
+  sac::Mod<HpuInputNode*>* input;
+  std::array<const CellVertex*, 4> corners;
+  HpuMeshFeed* feed;
+  HcStart* start = nullptr;
+  CellView view;  // the running step's (steps run one at a time)
+  CellQuestionStats stats;
+  Questions q;
+  // Scratch of the running step.
+  std::vector<std::array<HV, 2>> pairs, tris;
+  std::vector<Triangle> block;
+
+  const Box<2>& box() const noexcept { return dir->box(); }
+  /// The distance scale of class j.
+  static double scale_of(int j) noexcept { return std::ldexp(1.0, std::clamp(j, -1070, 1020)); }
+
+  // ---------------------------------------------------------------- 1. initial vertices
+
+  static void main(sac::Engine& e, HpuCellsProgram* pg) {
+    pg->start = e.alloc<HcStart>(0);
+    std::array<HV, 4> order = pg->corners;
+    std::sort(order.begin(), order.end(), [pg](HV a, HV b) { return morton_less(pg->box(), a->p, b->p); });
+    sac::Mod<HcCell*>* dest = &pg->start->cells;
+    for (HV v : order) dest = append_cell(e, v, dest);
+    e.memo_read(*pg->input, sac::fn<&place>(pg, dest));
+    e.memo_read(pg->start->cells, sac::fn<&class_step>(pg, INT_MAX, INT_MAX));
+    e.memo(sac::fn<&refine_start>(pg));
+    e.memo(sac::fn<&final_start>(pg));
+  }
+
+  static sac::Mod<HcCell*>* append_cell(sac::Engine& e, HV v, sac::Mod<HcCell*>* dest) {
+    HcCell* c = e.alloc<HcCell>(v, v);
+    e.write(*dest, c);
+    return &c->next;
+  }
+
+  static void place(sac::Engine& e, HpuInputNode* n, HpuCellsProgram* pg, sac::Mod<HcCell*>* dest) {
+    if (!n) return e.write(*dest, nullptr);
+    dest = append_cell(e, n, dest);
+    e.memo_read(n->next, sac::fn<&place>(pg, dest));
+  }
+
+  // ---------------------------------------------------------------- 2. initial classes
+
+  /// The class of an initial vertex. `hint`: the class of the vertex before it (the scale
+  /// its questions start at; list order keeps neighbours near).
+  struct FirstClassStep {
+    HpuCellsProgram* pg;
+    HcCell* cell;
+    int mn, hint;
+    CellView* view(sac::Engine&) const { return &pg->view; }
+    bool run(sac::Engine& e, CellView& v) const {
+      const double scale = hint == INT_MAX ? pg->box().side / 4 : scale_of(hint);
+      const int c = pg->q.first_class(cell->v, scale);
+      if (v.failed()) return false;
+      e.write(cell->cls, c);
+      e.memo_read(cell->next, sac::fn<&class_step>(pg, std::min(mn, c), c));
+      return true;
+    }
+  };
+
+  static void class_step(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, int mn, int hint) {
+    if (!cell) return e.write(pg->start->min_class, mn);
+    run_step(e, FirstClassStep{pg, cell, mn, hint});
+  }
+
+  // ---------------------------------------------------------------- 3. classes and rounds
+
+  static void refine_start(sac::Engine& e, HpuCellsProgram* pg) {
+    e.read(pg->start->min_class, [pg](sac::Engine& e2, int j) {
+      HcClass* cs = e2.alloc<HcClass>(j, j);
+      e2.write(cs->cont, nullptr);  // nothing continues into the first class
+      e2.memo(sac::fn<&class_start>(pg, cs, &pg->start->cells));
+    });
+  }
+
+  /// Class j: filter its initial entries out of `src`, then its rounds.
+  static void class_start(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, sac::Mod<HcCell*>* src) {
+    HcClass* csn = e.alloc<HcClass>(cs->j + 1, cs->j + 1);
+    e.memo_read(*src, sac::fn<&filter_step>(pg, cs, &cs->init, &cs->rest));
+    e.memo(sac::fn<&round>(pg, cs, csn, &cs->init, &csn->cont));
+  }
+
+  static void filter_step(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, HcClass* cs, sac::Mod<HcEntry*>* qdest,
+                          sac::Mod<HcCell*>* rdest) {
+    if (!cell) {
+      e.write(*rdest, nullptr);
+      // Q_j = its initial entries ++ the continuations of class j − 1 (terminated by now).
+      e.read(cs->cont, [qdest](sac::Engine& e2, HcEntry* h) { e2.write(*qdest, h); });
+      return;
+    }
+    e.read(cell->cls, [cell, pg, cs, qdest, rdest](sac::Engine& e2, int c) {
+      sac::Mod<HcEntry*>* qd = qdest;
+      sac::Mod<HcCell*>* rd = rdest;
+      if (c == cs->j) {
+        HcEntry* ent = e2.alloc<HcEntry>(std::tuple{cell->v, cs->j, true}, cell->v, true);
+        e2.write(*qd, ent);
+        qd = &ent->next;
+      } else {
+        e2.write(*rd, cell);
+        rd = &cell->next;
+      }
+      e2.memo_read(cell->next, sac::fn<&filter_step>(pg, cs, qd, rd));
+    });
+  }
+
+  /// A round of class j on the entries from `head`: collect all, then process the pairs,
+  /// then the next round (the births) or the next class.
+  static void round(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcClass* csn, sac::Mod<HcEntry*>* head,
+                    sac::Mod<HcEntry*>* cdest) {
+    HcRound* rs = e.alloc<HcRound>(head);
+    e.memo_read(*head, sac::fn<&collect_step>(pg, cs, rs, cdest, nullptr, nullptr));
+    e.memo_read(*head, sac::fn<&process_entry>(pg, cs, rs, &rs->births, nullptr, nullptr));
+    e.memo(sac::fn<&round_end>(pg, cs, csn, rs));
+  }
+
+  static void round_end(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcClass* csn, HcRound* rs) {
+    e.read(rs->births, [pg, cs, csn, rs](sac::Engine& e2, HcEntry* b) {
+      e2.read(rs->cont_tail, [pg, cs, csn, rs, b](sac::Engine& e3, sac::Mod<HcEntry*>* tail) {
+        if (b) return e3.memo(sac::fn<&round>(pg, cs, csn, &rs->births, tail));
+        e3.write(*tail, nullptr);
+        e3.memo(sac::fn<&class_end>(pg, cs, csn));
+      });
+    });
+  }
+
+  /// The next class when anything is left: continuations, or initial vertices above j.
+  static void class_end(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcClass* csn) {
+    e.read(csn->cont, [pg, cs, csn](sac::Engine& e2, HcEntry* c) {
+      e2.read(cs->rest, [pg, cs, csn, c](sac::Engine& e3, HcCell* r) {
+        if (c || r) e3.memo(sac::fn<&class_start>(pg, csn, &cs->rest));
+      });
+    });
+  }
+
+  // ---------------------------------------------------------------- collect
+
+  /// The twin's collect(v, j, birth): loose pairs (both sides, of class j, ≤ j at a birth) in
+  /// (x, y) order, and v's continuation into Q_{j+1}.
+  struct CollectStep {
+    HpuCellsProgram* pg;
+    HcClass* cs;
+    HcRound* rs;
+    HcEntry* ent;
+    HcEntry* before;  // the entry before ent (null: ent is first)
+    sac::Mod<HcEntry*>* cdest;
+    CellView* view(sac::Engine&) const { return &pg->view; }
+    bool run(sac::Engine& e, CellView& v) const {
+      const int j = cs->j;
+      const bool go_on = pg->q.collect(ent->v, j, ent->birth, pg->pairs);
+      if (v.failed()) return false;
+      // The entry's own list: no tail threads through the round, so a change in one
+      // entry's pairs does not change the keys of the (mostly pairless) entries after it.
+      sac::Mod<HcPair*>* pd = &ent->pairs;
+      for (const auto& [p, q] : pg->pairs) {
+        HcPair* pc = e.alloc<HcPair>(std::tuple{ent, p, q}, p, q);
+        e.write(*pd, pc);
+        pd = &pc->next;
+      }
+      e.write(*pd, nullptr);
+      sac::Mod<HcEntry*>* cd = cdest;
+      if (go_on) {
+        HcEntry* c = e.alloc<HcEntry>(std::tuple{ent->v, j + 1, false}, ent->v, false);
+        e.write(*cd, c);
+        cd = &c->next;
+      }
+      e.memo_read(ent->next, sac::fn<&collect_step>(pg, cs, rs, cd, ent, before));
+      return true;
+    }
+  };
+
+  /// ent was read from owner's `next` (owner null: the round's head). owner's predecessor
+  /// is in the key: when an update moves an entry earlier in the list, its own `next` and the
+  /// destinations can be those of its old step far ahead, which would then match and discard
+  /// everything in between; with the predecessor it runs anew in place.
+  static void collect_step(sac::Engine& e, HcEntry* ent, HpuCellsProgram* pg, HcClass* cs, HcRound* rs,
+                           sac::Mod<HcEntry*>* cdest, HcEntry* owner, HcEntry* owner_pred) {
+    (void)owner_pred;
+    if (!ent) return e.write(rs->cont_tail, cdest);
+    run_step(e, CollectStep{pg, cs, rs, ent, owner, cdest});
+  }
+
+  // ---------------------------------------------------------------- process
+
+  /// Where a pair's processing stands: the pair and the births' tail.
+  struct Ctx {
+    HpuCellsProgram* pg;
+    HcClass* cs;
+    HcRound* rs;
+    HcPair* pc;
+    sac::Mod<HcEntry*>* bdest;
+    HcPair* prev;       // the pair before pc in its entry's list (null: pc is first)
+    HcEntry* ent;       // pc's entry
+    HcEntry* ent_prev;  // the entry before it (null: ent is first)
+    friend bool operator==(const Ctx&, const Ctx&) = default;
+    std::size_t hash() const noexcept {
+      std::uint64_t h = sac::Hash<HcPair*>{}(pc);
+      h = sac::hash_combine(h, sac::Hash<sac::Mod<HcEntry*>*>{}(bdest));
+      h = sac::hash_combine(h, sac::Hash<HcRound*>{}(rs));
+      return static_cast<std::size_t>(h);
+    }
+  };
+
+  static void process_entry(sac::Engine& e, HcEntry* nent, HpuCellsProgram* pg, HcClass* cs, HcRound* rs,
+                            sac::Mod<HcEntry*>* bdest, HcEntry* owner, HcEntry* owner_pred) {
+    (void)owner_pred;
+    if (!nent) return e.write(*bdest, nullptr);
+    e.memo_read(nent->pairs, sac::fn<&process_step>(pg, cs, rs, bdest, nent, owner, nullptr, nullptr));
+  }
+
+  static void process_step(sac::Engine& e, HcPair* pc, HpuCellsProgram* pg, HcClass* cs, HcRound* rs,
+                           sac::Mod<HcEntry*>* bdest, HcEntry* ent, HcEntry* ent_prev, HcPair* owner,
+                           HcPair* owner_pred) {
+    (void)owner_pred;
+    if (!pc) return e.memo_read(ent->next, sac::fn<&process_entry>(pg, cs, rs, bdest, ent, ent_prev));
+    run_step(e, TryStep{Ctx{pg, cs, rs, pc, bdest, owner, ent, ent_prev}});
+  }
+
+  /// The pair is done: the next one.
+  static void done(sac::Engine& e, const Ctx& c) {
+    e.memo_read(c.pc->next, sac::fn<&process_step>(c.pg, c.cs, c.rs, c.bdest, c.ent, c.ent_prev, c.pc, c.prev));
+  }
+
+  /// x was inserted: its birth entry joins the next round.
+  static Ctx birth(sac::Engine& e, Ctx c, HV x) {
+    HcEntry* ent = e.alloc<HcEntry>(std::tuple{x, c.cs->j, true}, x, true);
+    e.write(*c.bdest, ent);
+    c.bdest = &ent->next;
+    return c;
+  }
+
+  /// Box edges to split, in order.
+  struct Splits {
+    std::array<std::array<HV, 2>, 4> s{};
+    std::uint32_t n = 0;
+    friend bool operator==(const Splits&, const Splits&) = default;
+  };
+
+  /// One try of the twin's process(p, q, j) loop.
+  struct TryStep {
+    Ctx c;
+    CellView* view(sac::Engine&) const { return &c.pg->view; }
+    bool run(sac::Engine& e, CellView& v) const {
+      HpuCellsProgram* pg = c.pg;
+      const CellDecision<HV> d = pg->q.decide(c.pc->p, c.pc->q, c.cs->j);
+      if (v.failed()) return false;
+      switch (d.kind) {
+        case CellDecision<HV>::Done:
+          done(e, c);
+          break;
+        case CellDecision<HV>::Split: {
+          Splits sp;
+          if (d.splits.size() > sp.s.size()) throw InvariantError("dynmesh: more than four box edges to split");
+          for (const auto& s : d.splits) sp.s[sp.n++] = s;
+          split_next(e, c, sp, 0);
+          break;
+        }
+        case CellDecision<HV>::Insert: {
+          const CellVertex* x = e.alloc<CellVertex>(std::pair{d.at[0], d.at[1]}, d.at);
+          run_step(e, InsertStep<AfterOffCenter>{pg, x, c.cs->j, AfterOffCenter{c}});
+          break;
+        }
+      }
+      return true;
+    }
+  };
+
+  struct AfterOffCenter {
+    Ctx c;
+    void operator()(sac::Engine& e, HV x) const { done(e, birth(e, c, x)); }
+  };
+
+  /// Splits sp.s[i..] in order, then tries the pair again.
+  static void split_next(sac::Engine& e, const Ctx& c, const Splits& sp, std::uint32_t i) {
+    if (i == sp.n) return run_step(e, TryStep{c});
+    const Point<2> mid = side_midpoint(sp.s[i][0]->p, sp.s[i][1]->p);
+    const CellVertex* m = e.alloc<CellVertex>(std::pair{mid[0], mid[1]}, mid);
+    run_step(e, InsertStep<AfterSplit>{c.pg, m, c.cs->j, AfterSplit{c, sp, i}});
+  }
+
+  struct AfterSplit {
+    Ctx c;
+    Splits sp;
+    std::uint32_t i;
+    void operator()(sac::Engine& e, HV x) const { split_next(e, birth(e, c, x), sp, i + 1); }
+  };
+
+  /// Inserts x into the store at this time (the leaf that holds it now gets its next value,
+  /// or splits), then k(e, x).
+  template <class K>
+  struct InsertStep {
+    HpuCellsProgram* pg;
+    HV x;
+    int j;
+    K k;
+    CellView* view(sac::Engine&) const { return &pg->view; }
+    bool run(sac::Engine& e, CellView& v) const {
+      const auto q = pg->dir->position(x->p);
+      const auto [node, s] = v.locate(q, scale_of(j));
+      if (v.failed()) return false;
+      std::array<HV, CellState::kCapacity + 1> items;
+      std::size_t n = 0;
+      for (std::size_t i = 0; i < s->count; ++i) {
+        if (s->items[i]->p == x->p) throw InvariantError("dynmesh: a Steiner vertex inserted twice");
+        items[n++] = s->items[i];
+      }
+      items[n++] = x;
+      put(e, pg, node, std::span<HV>(items.data(), n));
+      k(e, x);
+      return true;
+    }
+  };
+
+  /// Writes n's value holding `items` (n's cell), splitting while they overflow: the children
+  /// first, then n (no read sees a split without its children).
+  static void put(sac::Engine& e, HpuCellsProgram* pg, CellNode* n, std::span<HV> items) {
+    if (items.size() <= CellState::kCapacity) return e.write(n->state, CellState::leaf(items.begin(), items.end()));
+    if (n->key.level >= BucketTree::kMaxLevel)
+      throw InvariantError("dynmesh: the cell store: vertices closer than the finest cell");
+    std::array<std::array<HV, CellState::kCapacity + 1>, 4> part;
+    std::array<std::size_t, 4> count{};
+    for (HV w : items) {
+      const CellKey c = CellDirectory::cell_at(pg->dir->position(w->p), n->key.level + 1);
+      const unsigned k = static_cast<unsigned>((c.ix & 1) | ((c.iy & 1) << 1));
+      part[k][count[k]++] = w;
+    }
+    for (unsigned k = 0; k < 4; ++k)
+      put(e, pg, pg->dir->node(e, n->key.child(k)), std::span<HV>(part[k].data(), count[k]));
+    e.write(n->state, CellState::split());
+  }
+
+  // ---------------------------------------------------------------- 4. the final mesh
+
+  static void final_start(sac::Engine& e, HpuCellsProgram* pg) {
+    e.memo(sac::fn<&final_node>(pg, pg->dir->node(e, CellKey{})));
+  }
+
+  static void final_node(sac::Engine& e, HpuCellsProgram* pg, CellNode* n) {
+    e.read(n->state, [pg, n](sac::Engine& e2, const CellState& s) {
+      if (s.kind == CellState::Split) {
+        for (unsigned k = 0; k < 4; ++k) e2.memo(sac::fn<&final_node>(pg, pg->dir->node(e2, n->key.child(k))));
+      } else if (s.kind == CellState::Leaf && s.count > 0) {
+        run_step(e2, FinalStep{pg, n});
+      }
+    });
+  }
+
+  /// The triangles whose (x, y)-smallest corner lies in leaf n, as one block.
+  struct FinalStep {
+    HpuCellsProgram* pg;
+    CellNode* n;
+    CellView* view(sac::Engine&) const { return &pg->view; }
+    bool run(sac::Engine& e, CellView& v) const {
+      const CellState& s = e.current(n->state);  // read by final_node, the enclosing read
+      const double scale = std::ldexp(pg->box().side, -n->key.level) / 4;
+      pg->block.clear();
+      for (std::size_t i = 0; i < s.count; ++i) {
+        HV a = s.items[i];
+        pg->q.triangles_of(a, scale, pg->tris);
+        if (v.failed()) return false;
+        for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
+      }
+      if (!pg->block.empty()) e.make<HpuTriBlock>(pg->feed, std::span<const Triangle>(pg->block));
+      return true;
+    }
+  };
+};
+
+}  // namespace dynmesh::detail
