@@ -34,6 +34,7 @@
 #include "hpu/bucket_tree.hpp"
 #include "hpu/cell_store.hpp"
 #include "hpu/hpu_geometry.hpp"
+#include "hpu/hpu_cells_state.hpp"
 #include "hpu/hpu_inputs.hpp"
 #include "hpu/hpu_mesh_feed.hpp"
 #include "../sanitized.hpp"
@@ -53,38 +54,29 @@ using dynmesh_test::same_triangles;
 class HpuHarness {
  public:
   HpuHarness(const Box<2>& box, const std::vector<Point<2>>& pts, double angle)
-      : box_(box), inputs_(box), dir_(box), cells_(dir_),
-        corners_{std::make_unique<detail::CellVertex>(Point<2>{box.origin[0], box.origin[1]}),
-                 std::make_unique<detail::CellVertex>(Point<2>{box.origin[0] + box.side, box.origin[1]}),
-                 std::make_unique<detail::CellVertex>(Point<2>{box.origin[0] + box.side, box.origin[1] + box.side}),
-                 std::make_unique<detail::CellVertex>(Point<2>{box.origin[0], box.origin[1] + box.side})},
-        program_(engine_, dir_, inputs_.head(), {corners_[0].get(), corners_[1].get(), corners_[2].get(), corners_[3].get()},
-                 angle, feed_) {
-    for (const auto& c : corners_) cells_.insert(engine_, c.get());
-    inputs_.attach(&cells_);
+      : box_(box), state_(box), program_(engine_, state_, angle) {
+    state_.start(engine_);
     set_list(pts);
     engine_.run([this](sac::Engine& e) { HpuCellsProgram::main(e, &program_); });
-    feed_.clear_change();
+    state_.feed.clear_change();
   }
-  ~HpuHarness() { feed_.close(); }
+  ~HpuHarness() { state_.feed.close(); }
 
   void set_points(const std::vector<Point<2>>& pts) {
     set_list(pts);
     engine_.propagate();
-    inputs_.release(engine_);
+    state_.release(engine_);
   }
 
-  std::vector<Triangle> triangles() const { return feed_.triangles(); }
-  MeshChange take_change() { return feed_.take_change(); }
+  std::vector<Triangle> triangles() const { return state_.feed.triangles(); }
+  MeshChange take_change() { return state_.feed.take_change(); }
   void check() const {
     engine_.check_invariants();
-    feed_.check_invariants();
     const std::vector<Point<2>> now(points_.begin(), points_.end());
-    inputs_.check_invariants(now);
-    cells_.check_invariants();
+    state_.check_invariants(now);
     // The store's newest cells: the bucket tree of every vertex of the mesh.
     std::set<Point<2>> vs;
-    for (const Triangle& t : feed_.triangles())
+    for (const Triangle& t : state_.feed.triangles())
       for (const Point<2>& p : t.v) vs.insert(p);
     const std::vector<Point<2>> pts(vs.begin(), vs.end());
     detail::BucketTree tree(box_);
@@ -92,13 +84,13 @@ class HpuHarness {
     const auto index_of = [&](const detail::CellVertex* v) {
       return static_cast<std::uint32_t>(std::lower_bound(pts.begin(), pts.end(), v->p) - pts.begin());
     };
-    EXPECT_EQ(dir_.leaves(index_of), tree.leaves()) << "the store's newest cells are not the vertices' bucket tree";
+    EXPECT_EQ(state_.cells.leaves(index_of), tree.leaves()) << "the store's newest cells are not the vertices' bucket tree";
   }
   const sac::Stats& stats() const { return engine_.stats(); }
   std::size_t record_bytes() const { return engine_.record_bytes(); }
   const detail::CellQuestionStats& questions() const { return program_.stats; }
   /// For the checker's negative test.
-  detail::HpuMeshFeed& feed() { return feed_; }
+  detail::HpuMeshFeed& feed() { return state_.feed; }
 
  private:
   void set_list(const std::vector<Point<2>>& pts) {
@@ -108,17 +100,13 @@ class HpuHarness {
       if (!next.count(p)) edits.push_back({EditOp::Delete, p});
     for (const Point<2>& p : next)
       if (!points_.count(p)) edits.push_back({EditOp::Insert, p});
-    inputs_.commit(engine_, inputs_.plan(edits));
+    state_.commit(engine_, state_.plan(edits));
     points_ = next;
   }
 
   // Declared before the engine, so destroyed after it.
   Box<2> box_;
-  detail::HpuMeshFeed feed_;
-  detail::HpuInputs inputs_;
-  detail::CellDirectory dir_;
-  detail::InputCells cells_;
-  std::array<std::unique_ptr<detail::CellVertex>, 4> corners_;
+  detail::HpuCellsState state_;
   std::set<Point<2>> points_;
   sac::Engine engine_;
   HpuCellsProgram program_;

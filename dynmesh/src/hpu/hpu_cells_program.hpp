@@ -61,6 +61,7 @@
 #include "hpu/cell_view.hpp"
 #include "hpu/hpu_geometry.hpp"
 #include "hpu/hpu_inputs.hpp"
+#include "hpu/hpu_cells_state.hpp"
 #include "hpu/hpu_mesh_feed.hpp"
 
 namespace dynmesh::detail {
@@ -143,6 +144,8 @@ struct HpuCellsProgram {
                   const std::array<const CellVertex*, 4>& box_corners, double min_angle_deg, HpuMeshFeed& f)
       : dir(&d), input(&in), corners(box_corners), feed(&f), view(e, d),
         q(d.box(), min_angle_deg, view, Coords{}, nullptr, stats) {}
+  HpuCellsProgram(sac::Engine& e, HpuCellsState& st, double min_angle_deg)
+      : HpuCellsProgram(e, st.cells, st.inputs.head(), st.corner_vertices(), min_angle_deg, st.feed) {}
   HpuCellsProgram(const HpuCellsProgram&) = delete;
   HpuCellsProgram& operator=(const HpuCellsProgram&) = delete;
 

@@ -13,8 +13,8 @@
 
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/mesh_check.hpp"
-#include "hpu/cell_store.hpp"
 #include "hpu/hpu_cells_program.hpp"
+#include "hpu/hpu_cells_state.hpp"
 #include "hpu/hpu_geometry.hpp"
 #include "hpu/hpu_inputs.hpp"
 #include "hpu/hpu_mesh_feed.hpp"
@@ -64,25 +64,16 @@ MeshOptions validated(MeshOptions o) {
 
 struct MeshState {
   MeshState(const Box<2>& box, MeshOptions opts)
-      : options(validated(opts)), log(MeshGrid(validated(box))), hpu_inputs(box), cells(box), input_cells(cells),
-        corners{std::make_unique<CellVertex>(Point<2>{box.origin[0], box.origin[1]}),
-                std::make_unique<CellVertex>(Point<2>{box.origin[0] + box.side, box.origin[1]}),
-                std::make_unique<CellVertex>(Point<2>{box.origin[0] + box.side, box.origin[1] + box.side}),
-                std::make_unique<CellVertex>(Point<2>{box.origin[0], box.origin[1] + box.side})},
-        core(box),
-        hpu(core.rt, cells, hpu_inputs.head(),
-            {corners[0].get(), corners[1].get(), corners[2].get(), corners[3].get()}, options.min_angle, feed) {
+      : options(validated(opts)), log(MeshGrid(validated(box))), hpu_state(box), core(box),
+        hpu(core.rt, hpu_state, options.min_angle) {
     program.dir = &core.dir;
     program.input = &core.head;
     program.log = &log;
-    if (is_hpu()) {
-      for (const auto& c : corners) input_cells.insert(core.rt, c.get());
-      hpu_inputs.attach(&input_cells);
-    }
+    if (is_hpu()) hpu_state.start(core.rt);
   }
   ~MeshState() {  // before core (and its engine) goes
     log.closing = true;
-    feed.close();
+    hpu_state.feed.close();
   }
 
   bool is_hpu() const noexcept { return options.postprocess == Postprocess::Hpu; }
@@ -92,12 +83,7 @@ struct MeshState {
   CellCounts counts;
   MeshChange change;
   QuadtreeMeshProgram program{};
-  // The hpu mesh: its feed, its input list and its cell store outlive the engine.
-  HpuMeshFeed feed;
-  HpuInputs hpu_inputs;
-  CellDirectory cells;
-  InputCells input_cells;
-  std::array<std::unique_ptr<CellVertex>, 4> corners;  // the box's, in the store from the start
+  HpuCellsState hpu_state;  // the hpu mesh's input list, cell store and feed outlive the engine
   QuadtreeCore<2> core;
   HpuCellsProgram hpu;
 
@@ -105,7 +91,7 @@ struct MeshState {
   /// side midpoints (returned as the plan to commit). Changes nothing.
   HpuInputs::Plan validate(std::span<const Edit<2>> edits, const std::string& noun) const {
     core.validate(edits, noun, MeshChecks{log.grid, counts});
-    return is_hpu() ? hpu_inputs.plan(edits) : HpuInputs::Plan{};
+    return is_hpu() ? hpu_state.plan(edits) : HpuInputs::Plan{};
   }
   void count(std::span<const Edit<2>> edits) {
     const int level = std::max(log.grid.level_limit, 0);
@@ -118,10 +104,10 @@ struct MeshState {
   }
   std::vector<PointId> update(std::span<const Edit<2>> edits, const HpuInputs::Plan& plan) {
     if (is_hpu()) {
-      auto ids = core.update(edits, [&](sac::Engine& e) { hpu_inputs.commit(e, plan); });
-      hpu_inputs.release(core.rt);
+      auto ids = core.update(edits, [&](sac::Engine& e) { hpu_state.commit(e, plan); });
+      hpu_state.release(core.rt);
       count(edits);
-      change = feed.take_change();
+      change = hpu_state.feed.take_change();
       return ids;
     }
     log.created.clear();
@@ -180,9 +166,7 @@ void check_trees_of(const DynamicMesh& mesh, const MeshState& s) {
 /// The hpu mesh's own structures: the feed's blocks, the input list and the cell store's
 /// base values. O(n lg n).
 void check_hpu_structures(const MeshState& s) {
-  s.feed.check_invariants();
-  s.hpu_inputs.check_invariants(s.present());
-  s.input_cells.check_invariants();
+  s.hpu_state.check_invariants(s.present());
 }
 
 /// Applies validated edits with one propagation. Built with the CMake option
@@ -215,10 +199,10 @@ DynamicMesh::DynamicMesh(const Box<2>& box, std::span<const Point<2>> points, Me
   const auto plan = s_->validate(edits, "point");
   validate_mesh_box(box);
   if (s_->is_hpu()) {
-    s_->hpu_inputs.commit(s_->core.rt, plan);
+    s_->hpu_state.commit(s_->core.rt, plan);
     auto* hpu = &s_->hpu;
     s_->core.build(points, [hpu](sac::Engine& rt) { detail::HpuCellsProgram::main(rt, hpu); });
-    s_->feed.clear_change();
+    s_->hpu_state.feed.clear_change();
   } else {
     auto* program = &s_->program;
     s_->core.build(points, [program](sac::Engine& rt) { detail::QuadtreeMeshProgram::main(rt, program); });
@@ -264,7 +248,7 @@ const Point<2>& DynamicMesh::point(PointId id) const { return s_->core.point(id)
 std::vector<std::pair<PointId, Point<2>>> DynamicMesh::points() const { return s_->core.points(); }
 
 std::vector<Triangle> DynamicMesh::triangles() const {
-  if (s_->is_hpu()) return s_->feed.triangles();
+  if (s_->is_hpu()) return s_->hpu_state.feed.triangles();
   std::vector<Triangle> out;
   out.reserve(s_->log.live_count * 2);
   for (const detail::LeafBlock* b = s_->log.live; b; b = b->next) detail::triangulate_leaf(s_->log.grid, b->shape, out);
@@ -273,7 +257,7 @@ std::vector<Triangle> DynamicMesh::triangles() const {
 }
 
 std::size_t DynamicMesh::num_triangles() const noexcept {
-  if (s_->is_hpu()) return s_->feed.live_count();
+  if (s_->is_hpu()) return s_->hpu_state.feed.live_count();
   std::size_t k = 0;
   std::vector<Triangle> scratch;
   for (const detail::LeafBlock* b = s_->log.live; b; b = b->next) {
@@ -307,7 +291,7 @@ const sac::Stats& DynamicMesh::engine_stats() const noexcept { return s_->core.r
 std::size_t DynamicMesh::trace_bytes() const {
   std::size_t hpu = 0;
   if (s_->is_hpu())
-    hpu = s_->hpu_inputs.bytes() + s_->feed.bytes() + s_->cells.bytes() + s_->input_cells.bytes();
+    hpu = s_->hpu_state.bytes();
   return s_->core.bytes() + hpu + s_->counts.size() * (sizeof(CellId<2>) + 2 * sizeof(void*) + sizeof(std::int64_t));
 }
 std::size_t DynamicMesh::record_bytes() const { return s_->core.rt.record_bytes(); }
