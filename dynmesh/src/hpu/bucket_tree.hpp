@@ -134,6 +134,12 @@ class BucketTree {
   void search(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f) const {
     search(focus, margin, keep, f);
   }
+  /// search() for a keep() bounded by the disc (focus, radius): the same on a static tree.
+  template <class Keep, class F>
+  void search_within(const Point<2>& focus, double /*radius*/, double /*scale*/, double margin, Keep&& keep,
+                     F&& f) const {
+    search(focus, margin, keep, f);
+  }
   /// A static tree holds every cell: a question on it never fails.
   static constexpr bool failed() noexcept { return false; }
 

@@ -20,10 +20,12 @@
 //     corner).
 // The store is anything with search(focus, scale, margin, keep, f) (nearest-first pruned
 // leaf visits: keep(x0, y0, x1, y1) asked of every cell, stop = f(v) for a leaf's vertices),
+// search_within(focus, radius, scale, margin, keep, f) (the same, keep() bounded by that disc),
 // margin_for(c, r), leaves_read() and failed(). A step's view fails when a question needs a
-// cell the step has not read yet: every later question then returns at once (its answer is
-// void) and the step reads the missing cells and asks again (cell_store.hpp). A static store
-// never fails.
+// cell the step has not read yet: the answers are then void, but the questions go on, on
+// the cells there are, so that the later ones ask for their cells too (a prefetch: the step
+// reads them all in its next round, cell_view.hpp); nothing throws on a failed view. A
+// static store never fails.
 // Invariants: a question reads nothing but the store; given a store that does not fail, the
 // answers are those of the twin's triangulation on the same vertices (tests/dynmesh/
 // hpu_cells_test.cpp compares meshes on every distribution and angle bound).
@@ -134,8 +136,8 @@ class CellQuestions {
   void visit_disc(const Point<2>& c, double r, F&& f, double scale = 0) const {
     const double margin = store_->margin_for(c, r);
     const double r2 = (r + margin) * (r + margin);
-    store_->search(
-        c, std::max(r, scale), margin,
+    store_->search_within(
+        c, r, scale, margin,
         [&](double x0, double y0, double x1, double y1) { return cellq::box_distance2(c, x0, y0, x1, y1) <= r2; },
         f);
   }
@@ -156,7 +158,6 @@ class CellQuestions {
   /// p→q is ccw-loose: the outside of the box is not on its left and no vertex lies strictly
   /// inside its ccw-leaf (the first vertex inside ends the search).
   bool loose(V p, V q) const {
-    if (failed()) return false;
     ++stats_.leaf_tests;
     if (outside_left(p, q)) return false;
     const Point<2>&a = P_(p), &b = P_(q);
@@ -171,7 +172,7 @@ class CellQuestions {
       return !empty;
     });
     stats_.leaves_read += store_->leaves_read() - before;
-    return empty && !failed();
+    return empty;
   }
 
   /// The distance from v to its nearest vertex, in doubles (nearest-first: only the cells
@@ -196,7 +197,7 @@ class CellQuestions {
   /// strictly nearer, so the search ends). none() when the store failed.
   V sure_neighbour(V v, double scale) const {
     const double d = nearest_distance(v, scale);
-    if (failed() || !std::isfinite(d)) return none_;
+    if (!std::isfinite(d)) return none_;
     V a = none_;
     const Point<2>& p = P_(v);
     visit_disc(p, d * (1 + cellq::kSlack) + cellq::ulp_room(p), [&](V w) {
@@ -205,7 +206,8 @@ class CellQuestions {
         a = w;
       return false;
     });
-    while (a != none_ && !failed()) {
+    // Each step moves strictly nearer to v, so the loop ends.
+    while (a != none_) {
       const V inside = diametral_intruder(v, a);
       if (inside == none_) return a;
       a = inside;
@@ -223,7 +225,7 @@ class CellQuestions {
       if (w != v && w != q && pencil(a, b, 0.0, P_(w)) <= 0) inside = w;
       return inside != none_;
     });
-    return failed() ? none_ : inside;
+    return inside;
   }
 
   /// The Delaunay neighbour of p→q on its left (the third corner of the triangle on its
@@ -233,7 +235,6 @@ class CellQuestions {
   /// midpoint, smallest first. none() when none lies that low (or the left is outside the
   /// box, or the store failed).
   V left_search(V p, V q, double h_max) const {
-    if (failed()) return none_;
     ++stats_.neighbour_asks;
     if (outside_left(p, q)) return none_;  // a box edge seen from outside: no triangle there
     const Point<2>&a = P_(p), &b = P_(q);
@@ -257,8 +258,8 @@ class CellQuestions {
       // Within the probe, a cell is read only while it can hold a vertex below the best
       // circle found so far (a vertex on that circle can still win a perturbed tie, hence
       // the widening).
-      store_->search(
-          pc, pr, store_->margin_for(pc, pr),
+      store_->search_within(
+          pc, pr, pr, store_->margin_for(pc, pr),
           [&](double x0, double y0, double x1, double y1) {
             return meets(x0, y0, x1, y1, pc, pr) && (best == none_ || meets(x0, y0, x1, y1, bc, br));
           },
@@ -282,8 +283,8 @@ class CellQuestions {
             }
             return false;
           });
-      if (failed()) return none_;
-      if (best != none_ || h >= h_max) break;
+      // A failed view does not widen: a larger probe would ask for cells on a void answer.
+      if (best != none_ || h >= h_max || failed()) break;
     }
     stats_.leaves_read += store_->leaves_read() - before;
     return best;
@@ -319,20 +320,22 @@ class CellQuestions {
         if (t == none_) return End::Gap;
         if (t == q0) return End::Closed;
         if (stop_at_star && std::find(star_.begin(), star_.end(), t) != star_.end()) return End::Met;
-        if (out.size() > 4096) throw InvariantError("dynmesh: a star walk that does not close");
+        if (out.size() > 4096) {
+          if (failed()) return End::Gap;
+          throw InvariantError("dynmesh: a star walk that does not close");
+        }
         out.push_back(t);
         q = t;
       }
     };
     star_.assign(1, q0);
     const End ccw = walk(true, false, star_);
-    if (failed()) return false;
     if (ccw == End::Closed) return true;
     back_.clear();
     const End cw = walk(false, ccw == End::Gap, back_);  // stops where it meets the other run
     gap_ends_ = (ccw == End::Gap) + (cw == End::Gap);
     star_.insert(star_.begin(), back_.rbegin(), back_.rend());
-    return gap_ends_ == 0 && !failed();
+    return gap_ends_ == 0;
   }
 
   const std::vector<V>& star() const noexcept { return star_; }
@@ -344,7 +347,7 @@ class CellQuestions {
   /// of a lower class has not, the star decides (exact ties at a power of two).
   int first_class(V v, double scale) {
     const double d = nearest_distance(v, scale);
-    if (failed()) return INT_MAX;
+    if (!std::isfinite(d)) return INT_MAX;  // a failed view that found nothing yet
     near_.clear();
     visit_disc(P_(v), d * (1 + 0x1p-39) + cellq::ulp_room(P_(v)), [&](V w) {
       if (w != v) near_.push_back(w);
@@ -358,7 +361,6 @@ class CellQuestions {
       if (diametral_intruder(v, q) == none_) best = c;
       else unsure = std::min(unsure, c);
     }
-    if (failed()) return INT_MAX;
     if (best != INT_MAX && unsure >= best) return best;
     star_of(v, d);
     best = INT_MAX;
@@ -376,7 +378,6 @@ class CellQuestions {
     // at the rule's edge on the walked side.
     const double reach = std::ldexp(1.0 + 0x1p-20, j + 1);
     const bool whole = star_of(v, std::ldexp(1.0, j), reach);
-    if (failed()) return false;
     const std::size_t d = star_.size();
     const bool cycle = !on_boundary(v) && whole;
     bool go_on = !whole;
@@ -394,7 +395,7 @@ class CellQuestions {
       if (edge_class(P_(v), P_(q)) > j) go_on = true;
       take(q);
     }
-    if (!whole) {
+    if (!whole && d > 0) {
       // Edges inside the gap have both triangles beyond 2^(j+1); those of class ≤ j end
       // within 2^(j+1) of v, and a loose one is an edge (its leaf is empty): ask each vertex
       // there that the walk did not reach. When both walks stopped at the gap, it is the
@@ -413,8 +414,8 @@ class CellQuestions {
         const double err = 0x1p-40 * (std::abs(ux * vy) + std::abs(uy * vx)) + 0x1p-1000;
         return cr > err ? 1 : cr < -err ? -1 : 0;
       };
-      store_->search(
-          c, r, store_->margin_for(c, r),
+      store_->search_within(
+          c, r, r, store_->margin_for(c, r),
           [&](double x0, double y0, double x1, double y1) {
             if (cellq::box_distance2(c, x0, y0, x1, y1) > r * r) return false;
             if (!angle) return true;
@@ -438,7 +439,6 @@ class CellQuestions {
           });
       for (const V q : near_) take(q);
     }
-    if (failed()) return false;
     std::sort(pairs.begin(), pairs.end(), [&](const auto& x, const auto& y) {
       if (P_(x[0]) != P_(y[0])) return xy_less(P_(x[0]), P_(y[0]));
       return xy_less(P_(x[1]), P_(y[1]));
@@ -456,25 +456,26 @@ class CellQuestions {
     const Point<2>&a = P_(p), &b = P_(q);
     // Beyond the apex's circle the neighbour does not matter: the off-center is the apex.
     const V t = left_search(p, q, apex_height_ * (1 + 4 * cellq::kSlack));
-    if (failed()) return out;
     // With no neighbour within the apex's reach the off-center is the apex; a far corner
     // stands in for t (the apex's bits do not depend on it: the frame's scaling is exact).
     const Point<2> tp = t != none_ ? P_(t) : far_corner(a, b);
     const auto [r, was_circumcentre] = off_center(a, b, tp, apex_height_);
-    if (t == none_ && was_circumcentre) throw InvariantError("dynmesh: cell refiner: a circumcentre from beyond the apex");
-    if (!std::isfinite(r[0]) || !std::isfinite(r[1])) throw InvariantError("dynmesh: a non-finite off-center");
+    if (!std::isfinite(r[0]) || !std::isfinite(r[1]) || (t == none_ && was_circumcentre)) {
+      if (failed()) return out;
+      throw InvariantError(t == none_ && was_circumcentre ? "dynmesh: cell refiner: a circumcentre from beyond the apex"
+                                                          : "dynmesh: a non-finite off-center");
+    }
     const double scale = std::ldexp(1.0, j);
     if (!(r[0] >= lo_[0] && r[0] <= hi_[0] && r[1] >= lo_[1] && r[1] <= hi_[1])) {
       const auto [s, x] = side_crossed(box_, a, b, r);
       const auto e = side_edge(s, x, scale, false);
-      if (failed()) return out;
+      if (failed() || !e) return out;
       out.kind = CellDecision<V>::Split;
       out.splits.push_back(*e);
       return out;
     }
     const bool taken = find(r, scale).has_value();
-    if (failed()) return out;
-    if (taken)
+    if (taken && !failed())
       throw InputError(InputError::Kind::Resolution, "an off-center falls on the vertex " + format_exact(r[0]) + " " +
                                                          format_exact(r[1]) +
                                                          ": the spread is beyond the mesh's resolution");
@@ -499,7 +500,6 @@ class CellQuestions {
   void triangles_of(V v, double scale, std::vector<std::array<V, 2>>& out) {
     out.clear();
     star_of(v, scale);
-    if (failed()) return;
     const std::size_t d = star_.size();
     const bool cycle = !on_boundary(v);
     for (std::size_t i = 0; i < d; ++i) {
@@ -575,7 +575,7 @@ class CellQuestions {
   std::optional<std::array<V, 2>> encroached_edge(int s, const Point<2>& r, double scale) {
     const unsigned along = s % 2 == 0 ? 0 : 1;
     const auto held = side_edge(s, r[along], scale, true);  // none: r projects onto a vertex
-    if (!held || failed()) return std::nullopt;
+    if (!held) return std::nullopt;
     const V lo_end = (*held)[0], hi_end = (*held)[1];
     if (!encroaches(P_(lo_end), P_(hi_end), r)) return std::nullopt;
     // The edge in counter-clockwise order along the boundary (the inside on its left).
@@ -586,7 +586,6 @@ class CellQuestions {
     // the diametral disc too; then the perturbed in-circle test decides, as for the twin's
     // cavity.
     const V x = left_search(ea, eb, 0.0);
-    if (failed()) return std::nullopt;
     if (x != none_ && encroaches(P_(ea), P_(eb), P_(x)) && !perturbed_incircle(P_(ea), P_(eb), P_(x), r))
       return std::nullopt;
     return std::array<V, 2>{ea, eb};

@@ -12,7 +12,9 @@
 // only when a cell it read changes (cut-off: a write of an equal vertex set is no change).
 // Which cells a search asks for: the view walks the tree from the root, like BucketTree's
 // search. An ancestor of a cell read as a leaf or split is split (the tree grows only), so
-// the step never reads the coarse cells above its region. An unread cell below the level
+// the step never reads the coarse cells above its region. A failed view keeps answering on
+// the cells it has (cell_questions.hpp), so one round asks for the cells of several questions
+// (at most 16, one read_many). An unread cell below the level
 // that suits the search's scale is read itself; above it, its descendants at that level
 // near the focus are read instead (at most 3 × 3), and a cell read as absent (an ancestor
 // is a leaf) makes its next ancestors be read.
@@ -27,6 +29,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -52,6 +55,7 @@ class CellView {
   CellView(sac::Engine& e, CellDirectory& dir) : e_(&e), dir_(&dir), box_(dir.box()) {
     table_.resize(1024);
     mask_ = table_.size() - 1;
+    for (int l = 0; l <= BucketTree::kMaxLevel; ++l) width_[l] = std::ldexp(box_.side, -l);
   }
   CellView(const CellView&) = delete;
   CellView& operator=(const CellView&) = delete;
@@ -115,6 +119,16 @@ class CellView {
   std::size_t leaves_read() const noexcept { return leaves_read_; }
   std::size_t cells_read() const noexcept { return read_.size(); }
 
+  /// What the steps' reads cost so far: rounds issued (read_many events) and cells in them.
+  struct Counts {
+    std::uint64_t rounds = 0, cells = 0;
+  };
+  const Counts& counts() const noexcept { return counts_; }
+  void count_round(std::size_t cells) noexcept {
+    ++counts_.rounds;
+    counts_.cells += cells;
+  }
+
   double margin_for(const Point<2>& c, double r) const noexcept {
     const double mag = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(box_.origin[0]), std::abs(box_.origin[1])});
     return r * 0x1p-30 + (mag + box_.side) * 0x1p-40;
@@ -124,10 +138,20 @@ class CellView {
   /// expects) chooses which cells to ask for when it needs unread ones.
   template <class Keep, class F>
   void search(const Point<2>& focus, double scale, double margin, Keep&& keep, F&& f) const {
-    if (failed_) return;
     bool stop = false;
     auto* self = const_cast<CellView*>(this);
     self->search_node(CellKey{}, focus, scale, margin, keep, f, stop);
+  }
+
+  /// search() for a keep() that accepts no cell farther than radius from focus: it starts at
+  /// the smallest cell read (or known split) that holds that disc's box, not at the root.
+  /// `scale` (at least the radius) chooses which cells to ask for.
+  template <class Keep, class F>
+  void search_within(const Point<2>& focus, double radius, double scale, double margin, Keep&& keep, F&& f) const {
+    bool stop = false;
+    auto* self = const_cast<CellView*>(this);
+    self->search_node(self->start_for(focus, radius + 3 * margin), focus, std::max(radius, scale), margin, keep, f,
+                      stop);
   }
 
   /// The leaf that holds grid position q, and its value; null when a cell is missing.
@@ -165,7 +189,7 @@ class CellView {
 
   /// A cell's box, widened by margin.
   void cell_box(const CellKey& k, double margin, double& x0, double& y0, double& x1, double& y1) const noexcept {
-    const double w = std::ldexp(box_.side, -k.level);
+    const double w = width_[k.level];
     x0 = box_.origin[0] + static_cast<double>(k.ix) * w - margin, x1 = x0 + w + 2 * margin;
     y0 = box_.origin[1] + static_cast<double>(k.iy) * w - margin, y1 = y0 + w + 2 * margin;
   }
@@ -198,6 +222,28 @@ class CellView {
     }
   }
 
+  /// The deepest cell holding the box [focus ± R] whose state the view knows (leaf or split),
+  /// else the root.
+  CellKey start_for(const Point<2>& focus, double R) {
+    const auto a = dir_->position(Point<2>{focus[0] - R, focus[1] - R});
+    const auto b = dir_->position(Point<2>{focus[0] + R, focus[1] + R});
+    const int diff = std::max(std::bit_width(a[0] ^ b[0]), std::bit_width(a[1] ^ b[1]));
+    CellKey k = CellDirectory::cell_at(a, BucketTree::kMaxLevel - diff);
+    for (; k.level > 0; k = k.parent()) {
+      const Slot* x = find_slot(k);
+      if (x && (x->tag == Tag::Split || x->tag == Tag::Leaf)) return k;
+    }
+    return CellKey{};
+  }
+
+  const Slot* find_slot(const CellKey& k) const {
+    for (std::size_t i = k.hash() & mask_;; i = (i + 1) & mask_) {
+      const Slot& s = table_[i];
+      if (s.gen != gen_) return nullptr;
+      if (s.key == k) return &s;
+    }
+  }
+
   void grow() {
     std::vector<Slot> old(table_.size() * 2);
     old.swap(table_);
@@ -212,6 +258,7 @@ class CellView {
 
   void ask(const CellKey& k) {
     failed_ = true;
+    if (misses_.size() >= kCellsPerRead) return;  // one round reads no more
     Slot& x = slot(k);
     if (x.tag == Tag::Asked) return;
     if (x.tag != Tag::Unknown && x.tag != Tag::AbsentBelow) return;  // read already
@@ -249,15 +296,16 @@ class CellView {
       }
       case Tag::Split: {
         // Children nearest to the focus first (by their centres' distance), as BucketTree.
-        std::array<std::pair<double, unsigned>, 4> order;
-        const double w = std::ldexp(box_.side, -k.level);
-        for (unsigned c = 0; c < 4; ++c) {
-          const double cx = box_.origin[0] + (static_cast<double>(2 * k.ix + (c & 1)) + 0.5) * 0.5 * w;
-          const double cy = box_.origin[1] + (static_cast<double>(2 * k.iy + (c >> 1)) + 0.5) * 0.5 * w;
-          order[c] = {(cx - focus[0]) * (cx - focus[0]) + (cy - focus[1]) * (cy - focus[1]), c};
-        }
-        std::sort(order.begin(), order.end());
-        for (const auto& [d2, c] : order) {
+        // The child holding the focus's side in x and y first, then its x neighbour, its y
+        // neighbour, and the opposite one: nearest first for the four equal squares.
+        const double w = width_[k.level];
+        const double mx = box_.origin[0] + (static_cast<double>(k.ix) + 0.5) * w;
+        const double my = box_.origin[1] + (static_cast<double>(k.iy) + 0.5) * w;
+        const unsigned hx = focus[0] >= mx ? 1 : 0, hy = focus[1] >= my ? 1 : 0;
+        const unsigned near = hx | (hy << 1);
+        const bool x_first = std::abs(focus[0] - mx) >= std::abs(focus[1] - my);
+        const unsigned order[4] = {near, near ^ (x_first ? 2u : 1u), near ^ (x_first ? 1u : 2u), near ^ 3u};
+        for (const unsigned c : order) {
           if (stop) return;
           search_node(k.child(c), focus, scale, margin, keep, f, stop);
         }
@@ -287,7 +335,7 @@ class CellView {
       const int g = level_for(s);
       if (g <= k.level) return ask(k);
       const int shift = g - k.level;
-      const double w = std::ldexp(box_.side, -g);
+      const double w = width_[g];
       const double R = 2 * s + margin;
       const auto index = [&](double x, unsigned a, std::uint64_t lo, std::uint64_t hi) -> std::uint64_t {
         const double u = std::floor((x - box_.origin[a]) / w);
@@ -327,6 +375,7 @@ class CellView {
   sac::Engine* e_;
   CellDirectory* dir_;
   Box<2> box_;
+  std::array<double, BucketTree::kMaxLevel + 1> width_{};
   std::vector<Slot> table_;
   std::size_t mask_ = 0, used_ = 0;
   std::uint32_t gen_ = 0;
@@ -334,6 +383,7 @@ class CellView {
   std::vector<CellNode*> misses_;
   bool failed_ = false;
   std::size_t leaves_read_ = 0;
+  Counts counts_;
 };
 
 // -------------------------------------------------------------------- rounds of reads
@@ -400,6 +450,7 @@ template <class Step>
 void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::span<CellNode* const> misses) {
   if (misses.empty()) throw InvariantError("dynmesh: a step failed without a missing cell");
   if (misses.size() > kCellsPerRead) misses = misses.first(kCellsPerRead);  // the rest next round
+  step.view(e)->count_round(misses.size());
   if (misses.size() <= 2) return issue_round_n<Step, 2>(e, step, parent, misses);
   if (misses.size() <= 4) return issue_round_n<Step, 4>(e, step, parent, misses);
   if (misses.size() <= 8) return issue_round_n<Step, 8>(e, step, parent, misses);

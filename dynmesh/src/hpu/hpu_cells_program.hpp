@@ -131,6 +131,17 @@ struct HcStart {
   sac::Mod<int> min_class;  // the smallest initial class
 };
 
+/// Steps completed (first run included, re-runs of change propagation too), by kind.
+struct HcStepCounts {
+  enum Kind : std::uint8_t { FirstClass, Collect, Try, Insert, Final, kKinds };
+  std::array<std::uint64_t, kKinds> done{};
+  std::uint64_t total() const noexcept {
+    std::uint64_t t = 0;
+    for (auto x : done) t += x;
+    return t;
+  }
+};
+
 /// The program. The mutator keeps `input` equal to the inputs and their side midpoints in
 /// insertion_less order, and the store's base values equal to the bucket tree of those and
 /// the four corners (HpuInputs with InputCells attached), and calls propagate().
@@ -156,6 +167,7 @@ struct HpuCellsProgram {
   HcStart* start = nullptr;
   CellView view;  // the running step's (steps run one at a time)
   CellQuestionStats stats;
+  HcStepCounts steps;
   Questions q;
   // Scratch of the running step.
   std::vector<std::array<HV, 2>> pairs, tris;
@@ -204,6 +216,7 @@ struct HpuCellsProgram {
       const double scale = hint == INT_MAX ? pg->box().side / 4 : scale_of(hint);
       const int c = pg->q.first_class(cell->v, scale);
       if (v.failed()) return false;
+      ++pg->steps.done[HcStepCounts::FirstClass];
       e.write(cell->cls, c);
       e.memo_read(cell->next, sac::fn<&class_step>(pg, std::min(mn, c), c));
       return true;
@@ -300,6 +313,7 @@ struct HpuCellsProgram {
       const int j = cs->j;
       const bool go_on = pg->q.collect(ent->v, j, ent->birth, pg->pairs);
       if (v.failed()) return false;
+      ++pg->steps.done[HcStepCounts::Collect];
       // The entry's own list: no tail threads through the round, so a change in one
       // entry's pairs does not change the keys of the (mostly pairless) entries after it.
       sac::Mod<HcPair*>* pd = &ent->pairs;
@@ -395,6 +409,7 @@ struct HpuCellsProgram {
       HpuCellsProgram* pg = c.pg;
       const CellDecision<HV> d = pg->q.decide(c.pc->p, c.pc->q, c.cs->j);
       if (v.failed()) return false;
+      ++pg->steps.done[HcStepCounts::Try];
       switch (d.kind) {
         case CellDecision<HV>::Done:
           done(e, c);
@@ -449,6 +464,7 @@ struct HpuCellsProgram {
       const auto q = pg->dir->position(x->p);
       const auto [node, s] = v.locate(q, scale_of(j));
       if (v.failed()) return false;
+      ++pg->steps.done[HcStepCounts::Insert];
       std::array<HV, CellState::kCapacity + 1> items;
       std::size_t n = 0;
       for (std::size_t i = 0; i < s->count; ++i) {
@@ -511,6 +527,7 @@ struct HpuCellsProgram {
         if (v.failed()) return false;
         for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
       }
+      ++pg->steps.done[HcStepCounts::Final];
       if (!pg->block.empty()) e.make<HpuTriBlock>(pg->feed, std::span<const Triangle>(pg->block));
       return true;
     }

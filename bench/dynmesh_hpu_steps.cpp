@@ -1,0 +1,155 @@
+// dynmesh_hpu_steps — where the self-adjusting hpu mesh's work goes, step by step
+// (src/hpu/hpu_cells_program.hpp on its own engine, without the quadtree).
+//
+// Method: for each (distribution, n), build the program on generate(dist, n, seed) in its
+// derived box; then U times delete a point drawn with the seed and insert it back, one
+// propagation each. Prints, from scratch: events, record bytes per input point, completed
+// steps per input point by kind (first class, collect, try, insert, final), rounds of reads
+// per step and cells per round; per update: the mean and median trace distance, the mean
+// update time, and the mean steps re-run by kind and rounds. With --verify the final mesh is
+// compared with HpuMesh's. Flat in n is the goal for every per-update column.
+//
+//   dynmesh_hpu_steps [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
+//                     [--seed 1] [--angle 20.7] [--verify]
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "bench_stats.hpp"
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/edit.hpp"
+#include "dynmesh/hpu_mesh.hpp"
+#include "hpu/hpu_cells_program.hpp"
+#include "hpu/hpu_cells_state.hpp"
+
+namespace {
+
+using namespace dynmesh;
+using detail::HcStepCounts;
+
+struct Run {
+  Run(const Box<2>& box, const std::vector<Point<2>>& pts, double angle)
+      : state(box), program(engine, state, angle) {
+    state.start(engine);
+    apply(pts, {});
+    engine.run([this](sac::Engine& e) { detail::HpuCellsProgram::main(e, &program); });
+    state.feed.clear_change();
+  }
+  ~Run() { state.feed.close(); }
+  void apply(const std::vector<Point<2>>& ins, const std::vector<Point<2>>& del) {
+    std::vector<Edit<2>> edits;
+    for (const auto& p : del) edits.push_back({EditOp::Delete, p});
+    for (const auto& p : ins) edits.push_back({EditOp::Insert, p});
+    state.commit(engine, state.plan(edits));
+  }
+  void update(const std::vector<Point<2>>& ins, const std::vector<Point<2>>& del) {
+    apply(ins, del);
+    engine.propagate();
+    state.release(engine);
+    (void)state.feed.take_change();
+  }
+
+  detail::HpuCellsState state;  // before the engine: outlives it
+  sac::Engine engine;
+  detail::HpuCellsProgram program;
+};
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::size_t a = 0;
+  for (;;) {
+    const std::size_t b = s.find(',', a);
+    out.push_back(s.substr(a, b - a));
+    if (b == std::string::npos) return out;
+    a = b + 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Where the self-adjusting hpu mesh's work goes, step by step"};
+  std::string dists = "spiral,curves,uniform", ns = "1000,4000,16000";
+  int updates = 20;
+  std::uint64_t seed = 1;
+  double angle = kHpuDefaultMinAngle;
+  bool verify = false;
+  app.add_option("--dist", dists, "distributions, comma-separated");
+  app.add_option("--n", ns, "sizes, comma-separated");
+  app.add_option("--updates", updates, "delete-insert pairs measured");
+  app.add_option("--seed", seed, "random seed");
+  app.add_option("--angle", angle, "angle bound");
+  app.add_flag("--verify", verify, "compare the final mesh with HpuMesh's");
+  CLI11_PARSE(app, argc, argv);
+
+  std::printf("%-8s %7s | %9s %8s %31s %6s %6s | %8s %8s %8s %31s %7s\n", "dist", "n", "events", "B/pt",
+              "steps/pt (fc co try ins fin)", "rnd/st", "cl/rnd", "dist", "median", "us", "re-run (fc co try ins fin)",
+              "rounds");
+  for (const std::string& dname : split(dists)) {
+    const auto parsed = parse_distribution(dname);
+    if (!parsed) {
+      std::fprintf(stderr, "dynmesh_hpu_steps: unknown distribution %s\n", dname.c_str());
+      return 2;
+    }
+    const Distribution dist = *parsed;
+    for (const std::string& nstr : split(ns)) {
+      const std::size_t n = std::stoul(nstr);
+      std::vector<Point<2>> pts = generate<2>(dist, n, seed);
+      const Box<2> box = derive_box<2>(pts);
+      Run run(box, pts, angle);
+      const sac::Stats& st = run.engine.stats();
+      const double scratch_events = static_cast<double>(st.events_created);
+      const double bytes = static_cast<double>(run.engine.record_bytes()) / static_cast<double>(n);
+      const HcStepCounts s0 = run.program.steps;
+      const auto c0 = run.program.view.counts();
+      const double steps0 = static_cast<double>(s0.total());
+      std::mt19937_64 rng(seed * 7919 + n);
+      std::vector<double> dist_v, us_v;
+      std::array<double, HcStepCounts::kKinds> rerun{};
+      double rounds = 0;
+      for (int u = 0; u < updates; ++u) {
+        const std::size_t i = rng() % pts.size();
+        const Point<2> x = pts[i];
+        for (int op = 0; op < 2; ++op) {
+          const HcStepCounts before = run.program.steps;
+          const auto rb = run.program.view.counts().rounds;
+          const double sec = bench::seconds([&] {
+            if (op == 0) run.update({}, {x});
+            else run.update({x}, {});
+          });
+          us_v.push_back(sec * 1e6);
+          dist_v.push_back(static_cast<double>(st.last_trace_distance));
+          for (int k = 0; k < HcStepCounts::kKinds; ++k)
+            rerun[k] += static_cast<double>(run.program.steps.done[k] - before.done[k]);
+          rounds += static_cast<double>(run.program.view.counts().rounds - rb);
+        }
+      }
+      const double m = std::max<double>(1, static_cast<double>(dist_v.size()));
+      char steps_pt[64], rr[64];
+      std::snprintf(steps_pt, sizeof steps_pt, "%.2f %.2f %.2f %.2f %.2f", s0.done[0] / double(n), s0.done[1] / double(n),
+                    s0.done[2] / double(n), s0.done[3] / double(n), s0.done[4] / double(n));
+      std::snprintf(rr, sizeof rr, "%.1f %.1f %.1f %.1f %.1f", rerun[0] / m, rerun[1] / m, rerun[2] / m, rerun[3] / m,
+                    rerun[4] / m);
+      std::printf("%-8s %7zu | %9.0f %8.0f %31s %6.2f %6.2f | %8.0f %8.0f %8.0f %31s %7.1f\n", dname.c_str(), n,
+                  scratch_events, bytes, steps_pt, static_cast<double>(c0.rounds) / steps0,
+                  static_cast<double>(c0.cells) / static_cast<double>(c0.rounds), bench::mean(dist_v),
+                  bench::median(dist_v), bench::mean(us_v), rr, rounds / m);
+      std::fflush(stdout);
+      if (verify) {
+        const bool same = run.state.feed.triangles() == HpuMesh(box, pts, angle).triangles();
+        std::printf("  verified against HpuMesh: %s\n", same ? "yes" : "NO");
+        if (!same) return 1;
+      }
+    }
+  }
+  return 0;
+}
