@@ -1,5 +1,5 @@
-// same_triangles.hpp — a gtest assertion shared by the tests of the self-adjusting
-// triangulations (sa_delaunay_test.cpp, hpu_program_test.cpp): two sorted triangle lists
+// same_triangles.hpp — a gtest assertion shared by the tests of the self-adjusting meshes
+// (hpu_cells_program_test.cpp): two sorted triangle lists
 // are equal, or the failure names the counts and the first few differences.
 #pragma once
 

@@ -6,7 +6,7 @@
 // the points by off-centers processed in size classes, smallest first (Har-Peled & Üngör's
 // order, the seed's Figure 5), and treats the box's sides as segments, as Triangle does with
 // a .poly file. It is the oracle and the baseline of the self-adjusting hpu mesh
-// (src/hpu/hpu_program.hpp).
+// (src/hpu/hpu_cells_program.hpp).
 //
 // The algorithm is the seed's Figure 5 on loose pairs, with the choices it leaves open made
 // as follows (ρ = 1/(2 sin θ), k = √(ρ² − 1/4) = 1/(2 tan θ); DESIGN.md, "DynHPU"):
@@ -56,10 +56,10 @@
 // spiral).
 //
 // The self-adjusting version: DynamicMesh with Postprocess::Hpu (dynamic_mesh.hpp) runs
-// this algorithm on the runtime (src/hpu/hpu_program.hpp, on the self-adjusting triangulation of
-// src/hpu/sa_delaunay.hpp, reading the inputs and side midpoints from a list the mutator keeps,
-// src/hpu/hpu_inputs.hpp), and is bit-identical to this twin after every update
-// (tests/dynmesh/dynamic_mesh_test.cpp, hpu_program_test.cpp).
+// this algorithm on the runtime (src/hpu/hpu_cells_program.hpp: every question answered from
+// the cells of a vertex store, the inputs and side midpoints read from a list the mutator
+// keeps, src/hpu/hpu_inputs.hpp), and is bit-identical to this twin after every update
+// (tests/dynmesh/dynamic_mesh_test.cpp, hpu_cells_program_test.cpp).
 //
 // Invariants: check_invariants(): the triangulation's own invariants (Delaunay, tiling) and
 // the mesh contract through check_mesh (every angle ≥ θ, every input a vertex).

@@ -1,5 +1,5 @@
 // hpu_geometry.hpp (private) — the pure geometry of the hpu mesh, shared by its static twin
-// (hpu_mesh.cpp, class Refiner) and its self-adjusting version (hpu_program.hpp).
+// (hpu_mesh.cpp, class Refiner) and its self-adjusting version (hpu_cells_program.hpp).
 //
 // Purpose: every mesher of the hpu rules (the twin, hpu_mesh.cpp; the cell refiner,
 // cell_refiner.cpp; the self-adjusting program) must take the same decisions on the same

@@ -2,8 +2,8 @@
 // mutator: the input points and the side midpoints they need, in insertion_less order
 // (hpu_geometry.hpp: BRIO rounds, then (Morton, xy)).
 //
-// Purpose: HpuProgram (hpu_program.hpp) reads one list, `head`, of the points it inserts
-// before refining: the inputs and side_midpoints(box, inputs) (hpu_geometry.hpp), less the
+// Purpose: HpuCellsProgram (hpu_cells_program.hpp) reads one list, `head`, of the first
+// vertices after the box's corners: the inputs and side_midpoints(box, inputs) (hpu_geometry.hpp), less the
 // box's corners (an input may lie on one, in the closed box: it is the box's own vertex;
 // fuzz_dynamic_mesh found the far corners inserted twice when only the near one was left
 // out). HpuInputs keeps that list equal to its
@@ -249,7 +249,7 @@ class HpuInputs {
     halving_path(a, b, p, f.u, out);
   }
 
-  /// A box corner (SaDelaunay::init_box's arithmetic): the box's own vertex already.
+  /// A box corner (HpuCellsState's arithmetic): the box's own vertex already.
   bool is_corner(const Point<2>& p) const noexcept {
     const double x1 = box_.origin[0] + box_.side, y1 = box_.origin[1] + box_.side;
     return (p[0] == box_.origin[0] || p[0] == x1) && (p[1] == box_.origin[1] || p[1] == y1);
