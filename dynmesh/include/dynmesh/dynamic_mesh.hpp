@@ -1,19 +1,20 @@
 // dynmesh/dynamic_mesh.hpp — a quality triangle mesh of a changing point set, kept up to date
 // by self-adjusting computation.
 //
-// Purpose: the public dynamic meshing API. QuadTreeRefine and the postprocess run as one
-// program on sac-runtime, in one trace; after each insert / erase / batch, one propagate()
-// carries the change through the tree into the mesh, and the triangles it removed and added
+// Purpose: the public dynamic meshing API. The mesh runs as a program on sac-runtime, in one
+// trace (quadtree: QuadTreeRefine and the postprocess; hpu: the refinement on its own cell
+// store, with no quadtree); after each insert / erase / batch, one propagate() carries the
+// change into the mesh, and the triangles it removed and added
 // are reported as the change feed (last_change()). The mesh is always exactly the static
 // twin's mesh of the current point set: HpuMesh for Postprocess::Hpu (the default; the
 // program is src/hpu/hpu_cells_program.hpp, which answers every question from the cells of a
 // vertex store, src/hpu/cell_store.hpp, and reads the inputs and their side midpoints from a
 // list the mutator keeps, src/hpu/hpu_inputs.hpp), QuadtreeMesh for Postprocess::Quadtree.
 //
-// Invariants (check_invariants()): the engine's invariants; the quadtree program's
-// invariants (DynamicQuadtree); quadtree: the refined tree T' satisfies its rules; hpu: the
-// change feed's blocks, the input list and the cell store's base values; the live triangles tile the box, every present
-// point is a vertex, and no angle is below the bound (hpu: Delaunay too, by exact
+// Invariants (check_invariants()): the engine's invariants; quadtree: the quadtree program's
+// invariants (DynamicQuadtree) and the refined tree T' satisfies its rules; hpu: the change
+// feed's blocks, the input list and the cell store's base values; the live triangles tile
+// the box, every present point is a vertex, and no angle is below the bound (hpu: Delaunay too, by exact
 // predicates). Built with the CMake option SAC_DEBUG_CHECKS, every insert, erase and apply
 // ends with the structures' checks (not the O(n lg n) mesh contract).
 // Failure atomicity: every mutator call validates its whole input first; a call that throws

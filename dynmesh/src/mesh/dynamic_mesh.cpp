@@ -146,8 +146,10 @@ struct MeshState {
   }
 };
 
-/// T* as the quadtree's contract states it, and T''s closure rule.
+/// T* as the quadtree's contract states it, and T''s closure rule (the quadtree mesh only:
+/// the hpu mesh runs no tree).
 void check_trees_of(const DynamicMesh& mesh, const MeshState& s) {
+  if (s.is_hpu()) return;
   std::vector<Position<2>> qs;
   for (const auto* n = s.core.first; n; n = n->succ) qs.push_back(n->q);
   std::vector<Leaf<2>> tree;
@@ -160,7 +162,7 @@ void check_trees_of(const DynamicMesh& mesh, const MeshState& s) {
   std::sort(tree.begin(), tree.end());
   require_valid_tree<2>(qs, tree);
   // T': every point leaf has its block of same-size leaves.
-  if (!s.is_hpu()) require_refined_tree(mesh.refined_leaves(), mesh.size());
+  require_refined_tree(mesh.refined_leaves(), mesh.size());
 }
 
 /// The hpu mesh's own structures: the feed's blocks, the input list and the cell store's
@@ -201,7 +203,8 @@ DynamicMesh::DynamicMesh(const Box<2>& box, std::span<const Point<2>> points, Me
   if (s_->is_hpu()) {
     s_->hpu_state.commit(s_->core.rt, plan);
     auto* hpu = &s_->hpu;
-    s_->core.build(points, [hpu](sac::Engine& rt) { detail::HpuCellsProgram::main(rt, hpu); });
+    // The hpu program reads its own input list and cell store, not the quadtree: no tree.
+    s_->core.build(points, [hpu](sac::Engine& rt) { detail::HpuCellsProgram::main(rt, hpu); }, false);
     s_->hpu_state.feed.clear_change();
   } else {
     auto* program = &s_->program;

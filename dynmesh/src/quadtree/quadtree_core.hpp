@@ -327,16 +327,17 @@ class QuadtreeCore {
   }
 
   // ------------------------------------------------------------------ building and updating
-  /// Links the (validated) points and runs QuadTreeRefine, then `post(engine)` in the same
+  /// Links the (validated) points and runs QuadTreeRefine (unless `with_tree` is false: a
+  /// postprocess that reads its own inputs, not the tree), then `post(engine)` in the same
   /// run. Ids are the input indices.
   template <class Post>
-  void build(std::span<const Point<d>> points, Post&& post) {
+  void build(std::span<const Point<d>> points, Post&& post, bool with_tree = true) {
     by_pos.reserve(points.size());
     by_id.reserve(points.size());
     for (const Point<d>& p : points) link_new(*try_locate(box, p), p);
     rt.set_context(&program);
-    rt.run([&post](sac::Engine& e) {
-      Program::main(e);
+    rt.run([&post, with_tree](sac::Engine& e) {
+      if (with_tree) Program::main(e);
       post(e);
     });
     compact_mark = dir.size();
