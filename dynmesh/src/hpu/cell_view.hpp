@@ -63,7 +63,24 @@ class CellView {
   // ---------------------------------------------------------------- filling
 
   /// Forgets every cell (a new round of some step).
-  void reset() {
+  /// Forgets every cell for a new round. `parent`: the round this one is nested in (null
+  /// for a step's first round or its run on an empty view). When the view's last run was that
+  /// round's, its complete searches are replayed (see search()).
+  void reset(const void* parent = nullptr) {
+    const bool replay = parent != nullptr && parent == owner_;
+    owner_ = nullptr;
+    if (replay) {
+      rep_v_.swap(rec_v_);
+      rep_n_.swap(rec_n_);
+      rep_searches_ = rec_complete_;
+    } else {
+      rep_searches_ = 0;
+    }
+    rec_v_.clear();
+    rec_n_.clear();
+    rec_complete_ = 0;
+    search_idx_ = 0;
+    rep_pos_ = 0;
     if (++gen_ == 0) {
       for (Slot& s : table_) s.gen = 0;
       gen_ = 1;
@@ -136,11 +153,14 @@ class CellView {
 
   /// BucketTree::search on the cells read; `scale` (the search's radius, or the distance it
   /// expects) chooses which cells to ask for when it needs unread ones.
+  /// A step's questions ask the same searches in the same order in every round until the
+  /// first one that failed (they are pure functions of the searches' answers), and a search
+  /// that did not fail saw every cell it needed; so in the next round such a search is
+  /// replayed from what it handed out, without walking the cells.
   template <class Keep, class F>
   void search(const Point<2>& focus, double scale, double margin, Keep&& keep, F&& f) const {
-    bool stop = false;
     auto* self = const_cast<CellView*>(this);
-    self->search_node(CellKey{}, focus, scale, margin, keep, f, stop);
+    self->run_search(CellKey{}, focus, scale, margin, keep, f, false, 0.0);
   }
 
   /// search() for a keep() that accepts no cell farther than radius from focus: it starts at
@@ -148,11 +168,12 @@ class CellView {
   /// `scale` (at least the radius) chooses which cells to ask for.
   template <class Keep, class F>
   void search_within(const Point<2>& focus, double radius, double scale, double margin, Keep&& keep, F&& f) const {
-    bool stop = false;
     auto* self = const_cast<CellView*>(this);
-    self->search_node(self->start_for(focus, radius + 3 * margin), focus, std::max(radius, scale), margin, keep, f,
-                      stop);
+    self->run_search(CellKey{}, focus, std::max(radius, scale), margin, keep, f, true, radius + 3 * margin);
   }
+
+  /// After a run that failed: the round `self` recorded its searches for the round it issues.
+  void hand_over(const void* self) noexcept { owner_ = self; }
 
   /// The leaf that holds grid position q, and its value; null when a cell is missing.
   std::pair<CellNode*, const CellState*> locate(const std::array<std::uint64_t, 2>& q, double scale) {
@@ -220,6 +241,36 @@ class CellView {
       }
       if (s.key == k) return s;
     }
+  }
+
+  template <class Keep, class F>
+  void run_search(CellKey start, const Point<2>& focus, double scale, double margin, Keep& keep, F& f, bool bounded,
+                  double R) {
+    const std::size_t idx = search_idx_++;
+    if (idx < rep_searches_) {
+      // Replay: hand out what this search handed out last round, in order.
+      const std::uint32_t k = rep_n_[idx];
+      const CellVertex* const* vs = rep_v_.data() + rep_pos_;
+      rep_pos_ += k;
+      std::uint32_t handed = 0;
+      while (handed < k) {
+        rec_v_.push_back(vs[handed]);
+        if (f(vs[handed++])) break;
+      }
+      rec_n_.push_back(handed);
+      if (!failed_) ++rec_complete_;
+      return;
+    }
+    const std::size_t first = rec_v_.size();
+    auto g = [&](const CellVertex* v) {
+      rec_v_.push_back(v);
+      return f(v);
+    };
+    bool stop = false;
+    if (bounded) start = start_for(focus, R);
+    search_node(start, focus, scale, margin, keep, g, stop);
+    rec_n_.push_back(static_cast<std::uint32_t>(rec_v_.size() - first));
+    if (!failed_) ++rec_complete_;
   }
 
   /// The deepest cell holding the box [focus ± R] whose state the view knows (leaf or split),
@@ -384,6 +435,11 @@ class CellView {
   bool failed_ = false;
   std::size_t leaves_read_ = 0;
   Counts counts_;
+  // Search replay (search()): this round's record, and the last round's to replay.
+  const void* owner_ = nullptr;  // the round whose record rec_ holds, after it failed
+  std::vector<const CellVertex*> rec_v_, rep_v_;
+  std::vector<std::uint32_t> rec_n_, rep_n_;
+  std::size_t rec_complete_ = 0, rep_searches_ = 0, search_idx_ = 0, rep_pos_ = 0;
 };
 
 // -------------------------------------------------------------------- rounds of reads
@@ -423,14 +479,17 @@ struct CellRound {
 
   void operator()(sac::Engine& e, std::span<const CellState* const> vals) const {
     CellView& v = *step.view(e);
-    v.reset();
+    v.reset(c.head.parent);
     for (std::uint32_t i = 0; i < c.head.n; ++i) v.add(c.cells[i], vals[i]);
     for (const CellRoundHead* r = c.head.parent; r; r = r->parent) {
       CellNode* const* cells = cells_of(r);
       for (std::uint32_t i = 0; i < r->n; ++i) v.add(cells[i], &e.current(cells[i]->state));
     }
     v.settle();
-    if (!step.run(e, v)) issue_round(e, step, &c.head, v.misses());
+    if (!step.run(e, v)) {
+      v.hand_over(&c.head);
+      issue_round(e, step, &c.head, v.misses());
+    }
   }
 };
 
