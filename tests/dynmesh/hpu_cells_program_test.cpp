@@ -264,7 +264,9 @@ TEST(HpuCellsProgram, EveryUpdateMatchesAFromScratchTwin) {
               static_cast<unsigned long long>(sorted[sorted.size() / 2]), pct(double(sorted[sorted.size() / 2])),
               static_cast<unsigned long long>(sorted.back()), pct(double(sorted.back())));
   // A figure, not a tight bound: a program that re-ran the refinement would be near 100%.
-  EXPECT_LT(mean, 0.25 * double(scratch));
+  // One update's reach is a fixed number of vertices, so its share falls with n: 6.5% at
+  // n = 200, 28% at the sanitizer build's 60.
+  EXPECT_LT(mean, (kSanitized ? 0.5 : 0.15) * double(scratch));
 }
 
 /// Updates next to and on the box's near sides at 30°: side midpoints come and go with
