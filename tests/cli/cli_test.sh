@@ -143,15 +143,15 @@ case $case_name in
     [[ $(wc -l <hpu.csv) -eq 41 ]] || fail "hpu CSV: expected header + 40 rows"
     paste -d, <(tail -n +2 tree.csv) <(tail -n +2 hpu.csv) | awk -F, '$4 != $11 || $5 != $12 || $13 <= $6 { bad = 1; print }
       END { exit bad }' || fail "hpu rows do not follow the tree rows (same ops and spreads, larger distances)"
-    expect_error 1 '--min-angle for hpu must be between 1 and 30 degrees, got 31' "$dynmesh" stability --dim 2 \
+    expect_error 2 '--min-angle for hpu must be between 1 and 30 degrees, got 31' "$dynmesh" stability --dim 2 \
       --dist uniform --n 50 --postprocess hpu --min-angle 31 --csv e.csv
     expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess hpu \
       --csv e.csv
     expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess quadtree \
       --csv e.csv
-    expect_error 1 '--min-angle needs a mesh' "$dynmesh" stability --dim 2 --dist uniform --n 50 --min-angle 10 \
+    expect_error 2 '--min-angle needs a mesh' "$dynmesh" stability --dim 2 --dist uniform --n 50 --min-angle 10 \
       --csv e.csv
-    expect_error 1 'above the quadtree' "$dynmesh" stability --dim 2 --dist uniform --n 50 --postprocess quadtree \
+    expect_error 2 'above the quadtree' "$dynmesh" stability --dim 2 --dist uniform --n 50 --postprocess quadtree \
       --min-angle 30 --csv e.csv
     [[ ! -e e.csv ]] || fail "a refused stability run wrote its CSV"
     if command -v gnuplot >/dev/null; then
@@ -404,14 +404,14 @@ case $case_name in
     done
     expect_error 1 'bad_number.txt:3: ' "$dynmesh" mesh "$data/bad_number.txt" "${qt[@]}" -o old
     expect_error 1 'duplicate.txt:5: ' "$dynmesh" mesh "$data/duplicate.txt" "${qt[@]}" -o old
-    expect_error 1 'above the quadtree' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --min-angle 25 -o old
+    expect_error 2 'above the quadtree' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --min-angle 25 -o old
     # The hpu mesh (the default) reports bad edits as the quadtree mesh does.
     expect_error 1 'edits_absent.txt:3: ' "$dynmesh" mesh "$data/points2d.node" --edits "$data/edits_absent.txt" \
       -o old --feed old.feed
     expect_error 1 'edits_outside.txt:3: ' "$dynmesh" mesh "$data/points2d.node" --edits "$data/edits_outside.txt" \
       --batch 2 -o old
     for angle in 0.5 30.5; do
-      expect_error 1 "--min-angle for hpu must be between 1 and 30 degrees, got $angle" "$dynmesh" mesh \
+      expect_error 2 "--min-angle for hpu must be between 1 and 30 degrees, got $angle" "$dynmesh" mesh \
         "$data/points2d.node" --min-angle "$angle" -o old
     done
     expect_error 1 'duplicate.txt:5: ' "$dynmesh" mesh "$data/duplicate.txt" -o old
@@ -698,10 +698,25 @@ GNUPLOT
     # (40000 points: 0.6-0.8 s in the test build, far more than 100 ms; 10000 points took about
     # 0.1 s once the quadtree got faster, and the line came or not by chance), then the final
     # line.
+    # stderr is a file here, not a terminal: each report is a line of its own, without '\r'.
     DYNMESH_PROGRESS_DELAY_MS=100 run "$dynmesh" stability --dim 2 --dist uniform --n 40000 --updates 2 --csv live.csv
-    grep -qF $'\r[dynmesh] building the quadtree of 40000 points: 0 s' err.txt ||
+    grep -qx '\[dynmesh\] building the quadtree of 40000 points: 0 s' err.txt ||
       fail "no live line during the build: $(tr '\r' '|' <err.txt)"
-    grep -qF $'\r[dynmesh] building the quadtree of 40000 points: done in ' err.txt || fail "no final line"
+    grep -q '^\[dynmesh\] building the quadtree of 40000 points: done in ' err.txt || fail "no final line"
+    ! grep -q $'\r' err.txt || fail "a carriage return in a log file: $(tr '\r' '|' <err.txt)"
+    # At most one report per 10 s: the edits of a short run give their first count, then the
+    # final one, and nothing between.
+    seq 1 300 | awk '{ printf "+ %.6f %.6f\n", 0.3 + $1 / 1000, 0.31 + ($1 % 7) / 1000 }' >many_edits.txt
+    DYNMESH_PROGRESS_DELAY_MS=0 run "$dynmesh" quadtree "$data/points2d.node" --edits many_edits.txt --cells m.cells
+    [[ $(grep -c '/300 edits$' err.txt) -eq 2 ]] || fail "not two edit reports in a log: $(tr '\r' '|' <err.txt)"
+    grep -qx '\[dynmesh\] 300/300 edits' err.txt || fail "no final edit count: $(cat err.txt)"
+    # On a terminal (script(1) gives the command one), the line is rewritten in place.
+    if command -v script >/dev/null; then
+      DYNMESH_PROGRESS_DELAY_MS=0 script -qec "'$dynmesh' quadtree '$data/points2d.node' --cells t.cells 2>&1" \
+        /dev/null >tty.txt </dev/null || fail "script: the run failed: $(cat tty.txt)"
+      grep -q $'\r\\[dynmesh\\] building the quadtree of 50 points: done in ' tty.txt ||
+        fail "no '\\r' on a terminal: $(tr '\r' '|' <tty.txt)"
+    fi
     ;;
 
   memory_guard) # a build that cannot fit in memory stops at once, before reading; --force goes on
