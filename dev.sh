@@ -6,9 +6,14 @@ cd "$ROOT"
 JOBS="${JOBS:-$(nproc 2>/dev/null || echo 2)}"
 
 # Debian packages the project needs. gnuplot-nox is listed so that apt satisfies gnuplot's
-# "gnuplot-qt | gnuplot-x11 | gnuplot-nox" without pulling in Qt.
+# "gnuplot-qt | gnuplot-x11 | gnuplot-nox" without pulling in Qt. The python3-* packages
+# build and test the Python module (pybind11, NumPy; pytest, meshio and matplotlib for its
+# tests and example; venv and pip for the README's install command); pkg-config tests the
+# installed dynmesh.pc.
 DEPS=(cmake g++ ninja-build libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev libgmp-dev
-      libmpfr-dev libcgal-dev gnuplot gnuplot-nox clang libclang-rt-14-dev)
+      libmpfr-dev libcgal-dev gnuplot gnuplot-nox clang libclang-rt-14-dev pkg-config
+      python3 python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest python3-meshio
+      python3-matplotlib python3-venv python3-pip)
 
 deps() {
   local missing=() p

@@ -719,6 +719,91 @@ GNUPLOT
     fi
     ;;
 
+  files) # files the project did not write: Triangle's .poly and .ele, numbered rows, headers, stdin
+    # A .poly file's vertices are meshed when it has no segments and no holes ...
+    run "$dynmesh" mesh "$data/vertices.poly" -o poly
+    run "$dynmesh" mesh "$data/vertices.node" -o node
+    cmp poly.node node.node && cmp poly.ele node.ele || fail ".poly vertices: not the mesh of the same .node"
+    run "$dynmesh" quadtree "$data/vertices.poly" --cells poly.cells
+    # ... and refused, in one line that says why, when it has either.
+    expect_error 1 'letter.poly:10: this .poly file has 6 segments: segments and holes are not supported yet' \
+      "$dynmesh" mesh "$data/letter.poly" -o e
+    expect_error 1 'holes are not supported yet' "$dynmesh" mesh "$data/holes_only.poly" -o e
+    expect_error 1 '1 holes' "$dynmesh" quadtree "$data/holes_only.poly" --cells e.cells
+    # Triangle's .ele (triangles, not points), by name and by shape; .node rows under another name.
+    expect_error 1 "triangles.ele: a Triangle .ele file holds triangles" "$dynmesh" mesh "$data/triangles.ele" -o e
+    expect_error 1 "triangles_ele.txt:1: this looks like Triangle's .ele format" \
+      "$dynmesh" mesh "$data/triangles_ele.txt" -o e
+    expect_error 1 "numbered.txt:1: this looks like Triangle's .node format" "$dynmesh" mesh "$data/numbered.txt" -o e
+    cp "$data/letter.poly" letter.txt
+    expect_error 1 "letter.txt:3: this looks like Triangle's .node format" "$dynmesh" quadtree letter.txt --cells e.cells
+    [[ ! -e e.node && ! -e e.cells ]] || fail "a refused file gave an output"
+    # A first line without a number is a header: skipped, with a note; the points are the same.
+    run "$dynmesh" mesh "$data/header.csv" -o header
+    grep -qx "dynmesh: note: $data/header.csv:1: skipped the header line 'easting,northing' (it holds no number)" \
+      err.txt || fail "no note about the header: $(cat err.txt)"
+    cmp header.node node.node || fail "a header line changed the mesh"
+    # '-' is standard input.
+    tail -n +2 "$data/header.csv" | run "$dynmesh" mesh - -o stdin
+    cmp stdin.node node.node && cmp stdin.ele node.ele || fail "'-': not the mesh of the same points"
+    printf '0 0\n1 x\n' | expect_error 1 "<stdin>:2: malformed number 'x'" "$dynmesh" quadtree - --cells e.cells
+    # Many copies of one point: the duplicate error comes at once (sorting, not pairs).
+    yes '0.5 0.5' | head -n 80000 >copies80k.txt
+    start=$(date +%s%N)
+    expect_error 1 'copies80k.txt:2: duplicate point' "$dynmesh" mesh copies80k.txt -o e
+    ms=$((($(date +%s%N) - start) / 1000000))
+    ((ms < 2000)) || fail "80,000 copies took $ms ms"
+    yes '0.5 0.5' | head -n 3000000 >copies3m.txt
+    start=$(date +%s%N)
+    expect_error 1 'copies3m.txt:2: duplicate point' "$dynmesh" quadtree copies3m.txt --cells e.cells --force
+    ms=$((($(date +%s%N) - start) / 1000000))
+    rm -f copies3m.txt
+    ((ms < 20000)) || fail "3,000,000 copies took $ms ms"
+    ;;
+
+  frictions) # the small things a first user trips over
+    # --version, and help that says what the command does now, pointing inside the project.
+    run "$dynmesh" --version
+    grep -qE '^dynmesh [0-9]+\.[0-9]+\.[0-9]+$' out.txt || fail "--version: $(cat out.txt)"
+    for cmd in "" quadtree mesh stability demo; do
+      # shellcheck disable=SC2086  # $cmd is zero or one word
+      "$dynmesh" $cmd --help >help.txt 2>&1 || fail "dynmesh $cmd --help failed"
+      ! grep -qE 'shared/|and, later' help.txt || fail "dynmesh $cmd --help: $(grep -E 'shared/|and, later' help.txt)"
+    done
+    "$dynmesh" mesh --help >help.txt 2>&1
+    grep -q 'hpu 1 to 30' help.txt || fail "mesh --help: the --min-angle range"
+    # A bad --min-angle is a malformed command line.
+    expect_error 2 '--min-angle for hpu must be between 1 and 30 degrees, got 45' \
+      "$dynmesh" mesh "$data/vertices.node" -o e --min-angle 45
+    expect_error 2 '--min-angle' "$dynmesh" stability --dim 2 --dist uniform --n 50 --postprocess hpu \
+      --min-angle 0 --csv e.csv
+    # An output may not overwrite an input.
+    cp "$data/final2d.txt" ok.txt
+    cp ok.txt ok.orig
+    expect_error 2 '--vtk ok.txt is the input file ok.txt (POINTS)' "$dynmesh" mesh ok.txt -o e --vtk ok.txt
+    expect_error 2 '--vtk ./ok.txt is the input file ok.txt' "$dynmesh" mesh ok.txt -o e --vtk ./ok.txt
+    cp "$data/vertices.node" v.node
+    expect_error 2 '-o v.node is the input file v.node' "$dynmesh" mesh v.node -o v
+    expect_error 2 '--cells ok.txt' "$dynmesh" quadtree "$data/points2d.node" --edits ok.txt --cells ok.txt
+    expect_error 2 '--csv ok.txt' "$dynmesh" stability --points ok.txt --edits "$data/edits2d.txt" --csv ok.txt
+    cmp ok.txt ok.orig && cmp v.node "$data/vertices.node" || fail "an input was overwritten"
+    [[ ! -e e.node ]] || fail "a refused run wrote its output"
+    # Binary junk: the control bytes of the message are escaped.
+    printf '0 0\n1 \001\033[31m\n' >junk.txt
+    expect_error 1 "junk.txt:2: malformed number '\\x01\\x1b[31m'" "$dynmesh" mesh junk.txt -o e
+    ! LC_ALL=C grep -q '[[:cntrl:]]' <(tr -d '\n' <err.txt) || fail "a control byte in: $(cat -v err.txt)"
+    # Two points too close for the resolution are named, not the box.
+    expect_error 1 'points (0.25, 0.5) and (0.25, 0.50000000000000011) (lines 1, 2) are too close together' \
+      "$dynmesh" mesh "$data/too_close.txt" -o e
+    expect_error 1 '(lines 1, 2) are too close together' "$dynmesh" mesh "$data/too_close.txt" --postprocess quadtree -o e
+    # An insertion outside the box suggests --box.
+    expect_error 1 'edits_outside.txt:3: insert' "$dynmesh" mesh "$data/points2d.node" --edits \
+      "$data/edits_outside.txt" -o e
+    grep -qF 'pass --box o1 o2 L' err.txt || fail "no --box hint: $(cat err.txt)"
+    expect_error 1 'pass --box o1 o2 L' "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits_outside.txt" \
+      --cells e.cells
+    ;;
+
   memory_guard) # a build that cannot fit in memory stops at once, before reading; --force goes on
     awk 'BEGIN { for (i = 1; i <= 1000; i++) printf "%d %d\n", i, (i * 7919) % 1009 }' >p.txt
     awk 'BEGIN { for (i = 1; i <= 10; i++) printf "+ %d.5 3.5\n", i }' >e.txt

@@ -69,7 +69,7 @@ struct PointFile {
   std::vector<Point<d>> points;    // in file order
   std::vector<std::size_t> lines;  // lines[i]: the 1-based line of points[i]
   std::size_t header_line = 0;     // plain text: the line of a skipped column header (0: none)
-  std::string header;              // that line, control bytes escaped
+  std::string header{};            // that line, control bytes escaped
 };
 
 enum class PointFormat { Auto, Node, Plain, Poly, Ele };
