@@ -93,14 +93,19 @@ py::array_t<double> corners_of(const std::vector<dynmesh::Triangle>& ts) {
   return out;
 }
 
-py::dict mesh_dict(const dynmesh::Mesh& mesh) {
+/// The triangles of a canonical mesh, (t, 3) int64 indices into its vertices.
+py::array_t<std::int64_t> triangle_array(const dynmesh::Mesh& mesh) {
   py::array_t<std::int64_t> tris({static_cast<py::ssize_t>(mesh.triangles.size()), py::ssize_t{3}});
   auto t = tris.mutable_unchecked<2>();
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
     for (py::ssize_t k = 0; k < 3; ++k) t(static_cast<py::ssize_t>(i), k) = mesh.triangles[i][static_cast<std::size_t>(k)];
+  return tris;
+}
+
+py::dict mesh_dict(const dynmesh::Mesh& mesh) {
   py::dict out;
   out["vertices"] = array_of<2>(mesh.vertices);
-  out["triangles"] = tris;
+  out["triangles"] = triangle_array(mesh);
   return out;
 }
 
@@ -403,7 +408,7 @@ PYBIND11_MODULE(_dynmesh, m) {
           "vertices", [](const PyMesh& s) { return array_of<2>(s.canonical().vertices); },
           "(V, 2) float64, sorted by (x, y)")
       .def_property_readonly(
-          "triangles", [](const PyMesh& s) { return mesh_dict(s.canonical())["triangles"]; },
+          "triangles", [](const PyMesh& s) { return triangle_array(s.canonical()); },
           "(T, 3) int64 indices into vertices, counter-clockwise from the smallest, sorted")
       .def("mesh", [](const PyMesh& s) { return mesh_dict(s.canonical()); },
            "{\"vertices\", \"triangles\"} of one canonical mesh (one computation for both)")
@@ -431,11 +436,11 @@ PYBIND11_MODULE(_dynmesh, m) {
       .def(
           "to_meshio",
           [](const PyMesh& s) {
-            const py::dict md = mesh_dict(s.canonical());
+            const dynmesh::Mesh mesh = s.canonical();
             const py::module_ meshio = py::module_::import("meshio");
             py::list cells;
-            cells.append(py::make_tuple("triangle", md["triangles"]));
-            return meshio.attr("Mesh")(md["vertices"], cells);
+            cells.append(py::make_tuple("triangle", triangle_array(mesh)));
+            return meshio.attr("Mesh")(array_of<2>(mesh.vertices), cells);
           },
           "the mesh as a meshio.Mesh (needs meshio)");
 

@@ -13,9 +13,11 @@
 //                     [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv [--plot OUT.svg]
 //                     [--force]
 //   dynmesh demo [--n N] [--updates U] [--seed X] [--svg OUT.svg]
+//   dynmesh --version
 // Exit status: 0 on success; 1 with exactly one line `dynmesh: <message>` on stderr on any
 // error (a build refused by the memory guard included); 2 for a command line CLI11 rejects
-// (also one line). Progress lines (progress.hpp) go to stderr too, only on runs longer than a
+// (also one line), a bad --postprocess or --min-angle, or an output path naming an input
+// file (distinct_paths.hpp). Messages have their control bytes escaped (one_line). Progress lines (progress.hpp) go to stderr too, only on runs longer than a
 // second (DYNMESH_PROGRESS_DELAY_MS overrides the second, for tests).
 #include <cstddef>
 #include <cstdint>
