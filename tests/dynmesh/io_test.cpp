@@ -223,7 +223,7 @@ TEST(ReadPlain, AFirstLineWithoutNumbersIsAHeader) {
   EXPECT_EQ(f.points, (std::vector<Point<2>>{{0.5, 0.25}, {1, 2}}));
   EXPECT_EQ(f.lines, (std::vector<std::size_t>{4, 5}));
   EXPECT_EQ(plain<2>("1 2\n").header_line, 0u);
-  EXPECT_EQ(plain<2>("easting\tnorthing\x01\n1 2\n").header, "easting\tnorthing\\x01");
+  EXPECT_EQ(plain<2>("easting\tnorthing\x01\n1 2\n").header, "easting\\x09northing\\x01");
 }
 
 TEST(ReadPlain, TriangleNumberedRowsAreRefusedByName) {
@@ -238,7 +238,9 @@ TEST(ReadPlain, TriangleNumberedRowsAreRefusedByName) {
   // A .poly: its segment list fails to read as points, and the file is named for what it is.
   expect_error([&] { plain<2>("3 2 0 0\n1 0 0\n2 1 0\n3 0.5 1\n3 0\n1 1 2\n", n); }, Kind::Unsupported, n, 1,
                ".node format");
-  // Plain points that merely start with whole numbers stay points.
+  // Plain points that merely start with whole numbers stay points; one numbered row is not
+  // enough to tell (here a decimal comma is the error).
+  expect_error([&] { plain<2>("1 2\n1,5 2\n", n); }, Kind::Malformed, n, 2, "'1,5'");
   EXPECT_EQ(plain<2>("3 2\n1 0\n2 0\n").points.size(), 3u);                // two fields per row
   EXPECT_EQ(plain<2>("3 2 0 0\n5 0 0\n6 1 0\n7 0.5 1\n").points.size(), 4u);  // not numbered from 0/1
   EXPECT_EQ(plain<2>("3 5 0 0\n1 0 0\n2 1 0\n3 0.5 1\n").points.size(), 4u);  // no dimension 5
@@ -313,7 +315,8 @@ TEST_F(TempDir, ReadPointsFileChoosesTheFormatByExtension) {
   EXPECT_EQ(format_for_path(b), PointFormat::Node);
   EXPECT_EQ(read_points_file<2>(c).points.size(), 1u);  // plain: "2 2 0 0" is the point (2, 2)
   EXPECT_EQ(read_points_file<2>(c).points[0], (Point<2>{2, 2}));
-  EXPECT_EQ(read_points_file<2>(a, PointFormat::Plain).points.size(), 3u);
+  // A .node file read as plain text is refused: its vertex numbers would become coordinates.
+  expect_error([&] { read_points_file<2>(a, PointFormat::Plain); }, Kind::Unsupported, a, 1, ".node format");
   EXPECT_EQ(node_file_dimension(a), 2);
   EXPECT_EQ(node_file_dimension(write("d.node", "5\n")), 0);
   expect_error([&] { read_points_file<2>(write("e.node", "1 2 0 0\n1 0 nan\n")); }, Kind::NotFinite,

@@ -4,7 +4,8 @@
 //
 // Input: the first byte picks the reader (bit 0: `.node` or plain text) and the dimension
 // (bit 1: 2 or 3); the rest is the file's text.
-// Properties: a read either succeeds or throws InputError (Malformed, NotFinite or Count)
+// Properties: a read either succeeds or throws InputError (Malformed, NotFinite, Count, or
+// Unsupported for plain text shaped like Triangle's numbered rows)
 // naming the file and an existing line in a one-line message; a successful read has one
 // strictly increasing line number per point and finite coordinates only, and the points
 // written back (%.17g) read back bit for bit, as plain text and as `.node`; dropping

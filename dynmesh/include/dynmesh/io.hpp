@@ -20,8 +20,9 @@
 //     comma ("1,5 2") is an error rather than the point (1, 5); an empty field (",,") is an
 //     error. `#` comments are allowed here too. A first line without a single number is a
 //     column header ("x,y"): it is skipped and reported in PointFile::header_line. A file
-//     shaped like Triangle's formats (a header of whole numbers, then rows numbered from 0
-//     or 1, as many as announced) is refused (Unsupported) naming the format it looks like.
+//     shaped like Triangle's formats (a first line starting with two whole numbers, then
+//     rows of three fields or more numbered from 0 or 1, as many as announced) is refused
+//     (Unsupported) naming the format it looks like.
 //   * the path "-" is standard input, read as plain text (named "<stdin>" in messages).
 //   * edit scripts: `+ x y [z]` / `- x y [z]`, exactly d coordinates separated as in plain
 //     text, blank lines and `#` comments ignored. The sign must be a token of its own.

@@ -455,17 +455,16 @@ bool is_number(std::string_view tok) {
 }
 
 /// Watches the lines of a plain-text file for the shape of Triangle's and TetGen's formats:
-/// a header line of 2 to 4 whole numbers (<#items> <2|3|4|6> ...), then rows numbered
-/// consecutively from 0 or 1, as many as the header announces (or to the end of the file),
-/// each with at least three fields. Such a file is a `.node`, `.ele` or `.poly` under
+/// a header line starting with two whole numbers (by value: <#items> <2|3|4|6> ...), then
+/// rows numbered consecutively from 0 or 1, as many as the header announces (or to the end
+/// of the file), each with at least three fields. Only the first fields decide, so that the
+/// verdict stays the same for the points written back with just their coordinates. Such a file is a `.node`, `.ele` or `.poly` under
 /// another name, and reading its numbers as coordinates would mesh nonsense.
 class NumberedRows {
  public:
   void header(const std::vector<std::string_view>& f) {
-    if (f.size() < 2 || f.size() > 4) return;
-    long long v[4] = {};
-    for (std::size_t k = 0; k < f.size(); ++k)
-      if (!whole(f[k], v[k])) return;
+    long long v[2] = {};
+    if (f.size() < 2 || !whole(f[0], v[0]) || !whole(f[1], v[1])) return;
     if (v[0] < 1 || (v[1] != 2 && v[1] != 3 && v[1] != 4 && v[1] != 6)) return;
     count_ = v[0];
     per_row_ = v[1];
@@ -488,10 +487,11 @@ class NumberedRows {
   }
 
   /// Throws InputError(Unsupported) naming the likely format when the file had the shape:
-  /// every row announced (a `.poly` goes on with other lists, which may fail to read as
-  /// points), or, at the end of the file, at least two numbered rows.
+  /// at least two numbered rows, and every row announced unless the file ended first (a
+  /// `.poly` goes on with other lists, which may fail to read as points). One row is too
+  /// little evidence: "1 2" then "1,5 2" is a decimal comma, not a one-vertex file.
   void check(const LineReader& r, std::size_t header_line, bool at_end) const {
-    if (!candidate_ || rows_ == 0 || (rows_ < count_ && (!at_end || rows_ < 2))) return;
+    if (!candidate_ || rows_ < 2 || (rows_ < count_ && !at_end)) return;
     const bool ele = all_integer_ && (per_row_ == 3 || per_row_ == 4 || per_row_ == 6);
     if (ele)
       r.fail_at(Kind::Unsupported,
@@ -505,9 +505,16 @@ class NumberedRows {
   }
 
  private:
+  /// A number whose value is a whole number ("3", "3.0", "3e0"): decided by value, not by
+  /// spelling, so that points written back with %.17g get the same verdict.
   static bool whole(std::string_view tok, long long& v) {
-    const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v);
-    return ec == std::errc{} && ptr == tok.data() + tok.size();
+    if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
+    double x = 0;
+    const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), x, std::chars_format::general);
+    if (ec != std::errc{} || ptr != tok.data() + tok.size() || !(std::fabs(x) < 0x1p53) || x != std::floor(x))
+      return false;
+    v = static_cast<long long>(x);
+    return true;
   }
   bool candidate_ = false, all_integer_ = true;
   long long count_ = 0, per_row_ = 0, rows_ = 0, base_ = 0;
