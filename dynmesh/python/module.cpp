@@ -438,11 +438,20 @@ PYBIND11_MODULE(_dynmesh, m) {
           [](const PyMesh& s) {
             const dynmesh::Mesh mesh = s.canonical();
             const py::module_ meshio = py::module_::import("meshio");
+            // Points with z = 0: VTK and Gmsh store 3D points (meshio warns on 2D ones).
+            py::array_t<double> xyz({static_cast<py::ssize_t>(mesh.vertices.size()), py::ssize_t{3}});
+            auto p = xyz.mutable_unchecked<2>();
+            for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+              const auto row = static_cast<py::ssize_t>(i);
+              p(row, 0) = mesh.vertices[i][0];
+              p(row, 1) = mesh.vertices[i][1];
+              p(row, 2) = 0.0;
+            }
             py::list cells;
             cells.append(py::make_tuple("triangle", triangle_array(mesh)));
-            return meshio.attr("Mesh")(array_of<2>(mesh.vertices), cells);
+            return meshio.attr("Mesh")(xyz, cells);
           },
-          "the mesh as a meshio.Mesh (needs meshio)");
+          "the mesh as a meshio.Mesh: points (V, 3) with z = 0, one \"triangle\" cell block (needs meshio)");
 
   m.def(
       "triangulate",

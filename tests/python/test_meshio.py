@@ -14,6 +14,7 @@ def test_to_meshio_round_trip(tmp_path, name, file_format):
     m.insert((0.5, 0.5))
     out = m.to_meshio()
     assert isinstance(out, meshio.Mesh)
+    assert out.points.shape == (len(m.vertices), 3) and np.all(out.points[:, 2] == 0)
     path = tmp_path / name
     if file_format == "gmsh22":
         meshio.write(path, out, file_format=file_format, binary=False)
