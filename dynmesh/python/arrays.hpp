@@ -148,4 +148,13 @@ inline py::dict update_dict(const UpdateStats& u) {
   return out;
 }
 
+/// A number argument (min_angle): InputError(Malformed) naming it when it is not one.
+inline double number_from(const py::handle& obj, const char* what) {
+  try {
+    return obj.cast<double>();
+  } catch (const py::cast_error&) {
+    throw InputError(Kind::Malformed, std::string(what) + " must be a number");
+  }
+}
+
 }  // namespace dynmesh::python

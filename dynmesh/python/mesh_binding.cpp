@@ -39,11 +39,11 @@ class PyMesh {
     MeshOptions options;
     if (postprocess == "hpu") {
       options.postprocess = Postprocess::Hpu;
-      if (!min_angle.is_none()) options.min_angle = min_angle.cast<double>();
+      if (!min_angle.is_none()) options.min_angle = number_from(min_angle, "min_angle");
     } else if (postprocess == "quadtree") {
       options.postprocess = Postprocess::Quadtree;
       // The quadtree mesh's bound is fixed: a larger request cannot be honoured.
-      if (!min_angle.is_none() && !(min_angle.cast<double>() <= kQuadtreeMinAngle))
+      if (!min_angle.is_none() && !(number_from(min_angle, "min_angle") <= kQuadtreeMinAngle))
         throw InputError(Kind::Malformed, "min_angle above the quadtree mesh's bound of 18.4 degrees");
     } else {
       throw InputError(Kind::Malformed, "postprocess must be \"hpu\" or \"quadtree\", got '" + postprocess + "'");
@@ -176,7 +176,7 @@ void bind_mesh(py::module_& m) {
       [](const py::object& points, const py::object& min_angle, const py::object& box) {
         const std::vector<Point<2>> pts = points_from<2>(points, "points");
         const Box<2> b = box_from<2>(box, pts);
-        const double bound = min_angle.is_none() ? kHpuDefaultMinAngle : min_angle.cast<double>();
+        const double bound = min_angle.is_none() ? kHpuDefaultMinAngle : number_from(min_angle, "min_angle");
         Mesh mesh;
         {
           py::gil_scoped_release release;

@@ -73,6 +73,8 @@ def test_bad_construction():
     expect("OutsideBox", lambda: dynmesh.Mesh(POINTS, box=(0, 0, -1)))
     expect("Malformed", lambda: dynmesh.Mesh(POINTS, box=(0, 0)))
     expect("Malformed", lambda: dynmesh.Mesh(POINTS, min_angle=45))
+    expect("Malformed", lambda: dynmesh.Mesh(POINTS, min_angle="steep"), text="min_angle must be a number")
+    expect("Malformed", lambda: dynmesh.triangulate(POINTS, min_angle=[1]))
     expect("Malformed", lambda: dynmesh.Mesh(POINTS, min_angle=25, postprocess="quadtree"))
     expect("Malformed", lambda: dynmesh.Mesh(POINTS, postprocess="delaunay"))
     expect("Malformed", lambda: dynmesh.Mesh(np.zeros((3, 3))))
