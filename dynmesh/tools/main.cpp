@@ -91,7 +91,8 @@ int main(int argc, char** argv) {
   QuadtreeOptions q;
   CLI::App* quadtree = app.add_subcommand(
       "quadtree", "Build the quadtree T* of a point file, apply an edit script dynamically, write the leaves");
-  quadtree->add_option("POINTS", q.points, "point file: .node (Triangle/TetGen) or plain text (x y [z] per line)")
+  quadtree->add_option("POINTS", q.points, "point file: .node (Triangle/TetGen), the vertices of a .poly, or plain text (x y [z] per "
+                        "line; a first line without numbers is a header); - reads standard input")
       ->required();
   CLI::Option* dim_opt =
       quadtree->add_option("--dim", q.dim, "dimension of plain-text points (a .node header decides when omitted)")
@@ -123,7 +124,8 @@ int main(int argc, char** argv) {
   MeshCommandOptions me;
   CLI::App* mesh = app.add_subcommand(
       "mesh", "Mesh the box of a 2D point file, apply an edit script dynamically, write the final mesh");
-  mesh->add_option("POINTS", me.points, "point file: .node (Triangle) or plain text (x y per line)")->required();
+  mesh->add_option("POINTS", me.points, "point file: .node (Triangle), the vertices of a .poly, or plain text (x y per line; a first "
+                    "line without numbers is a header); - reads standard input")->required();
   mesh->add_option("--box", me.box, "domain box: origin and side length (default: derived from the initial points)")
       ->expected(3)
       ->type_name("o1 o2 L");
