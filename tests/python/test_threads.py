@@ -54,4 +54,4 @@ def test_the_gil_is_released_during_a_build():
         ticks.append(1)
         done.wait(0.001)
     t.join()
-    assert len(ticks) > 1
+    assert len(ticks) > 10  # it ran on while the build held no GIL
