@@ -746,6 +746,9 @@ GNUPLOT
     grep -qx "dynmesh: note: $data/header.csv:1: skipped the header line 'easting,northing' (it holds no number)" \
       err.txt || fail "no note about the header: $(cat err.txt)"
     cmp header.node node.node || fail "a header line changed the mesh"
+    # A file that fails to read gets its error alone (lines counted with the header).
+    printf 'x,y\n0,0\n1,nan\n' >header_nan.csv
+    expect_error 1 "header_nan.csv:3: NaN or infinite coordinate 'nan'" "$dynmesh" mesh header_nan.csv -o e
     # '-' is standard input.
     tail -n +2 "$data/header.csv" | run "$dynmesh" mesh - -o stdin
     cmp stdin.node node.node && cmp stdin.ele node.ele || fail "'-': not the mesh of the same points"
