@@ -6,9 +6,14 @@ cd "$ROOT"
 JOBS="${JOBS:-$(nproc 2>/dev/null || echo 2)}"
 
 # Debian packages the project needs. gnuplot-nox is listed so that apt satisfies gnuplot's
-# "gnuplot-qt | gnuplot-x11 | gnuplot-nox" without pulling in Qt.
+# "gnuplot-qt | gnuplot-x11 | gnuplot-nox" without pulling in Qt. The python3-* packages
+# build and test the Python module (pybind11, NumPy; pytest, meshio and matplotlib for its
+# tests and example; venv and pip for the README's install command); pkg-config tests the
+# installed dynmesh.pc.
 DEPS=(cmake g++ ninja-build libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev libgmp-dev
-      libmpfr-dev libcgal-dev gnuplot gnuplot-nox clang libclang-rt-14-dev)
+      libmpfr-dev libcgal-dev gnuplot gnuplot-nox clang libclang-rt-14-dev pkg-config
+      python3 python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest python3-meshio
+      python3-matplotlib python3-venv python3-pip)
 
 deps() {
   local missing=() p
@@ -73,11 +78,17 @@ bench_job() {
 
 cmd_run() { deps; build_release dynmesh_cli; main_job "$@"; }  # dynmesh_cli: bin/dynmesh
 
+# The interpreter of the Python module and its tests: Debian's (whose pybind11, NumPy, pytest,
+# meshio and matplotlib DEPS installs), not whichever python3 comes first on PATH. PYTHON
+# overrides it.
+PYTHON="${PYTHON:-/usr/bin/python3}"
+
 cmd_test() {
   deps
-  # RelWithDebInfo without -DNDEBUG: optimised, with debug info and assertions on.
+  # RelWithDebInfo without -DNDEBUG: optimised, with debug info and assertions on. With the
+  # Python module, whose pytest suite (tests/python/) runs with the rest.
   build build/debug -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g" \
-    -DSAC_WARNINGS_AS_ERRORS=ON
+    -DSAC_WARNINGS_AS_ERRORS=ON -DDYNMESH_PYTHON=ON -DPython3_EXECUTABLE="$PYTHON"
   ctest --test-dir build/debug --output-on-failure --no-tests=error -j "$JOBS"
 }
 
@@ -116,7 +127,7 @@ usage() {
 usage: bash dev.sh COMMAND [args]
   deps         install missing Debian packages (apt-get; sudo when not root)
   run [args]   Release build of bin/dynmesh into build/release, then the main job (dynmesh demo [args])
-  test         RelWithDebInfo build (asserts on, -Werror) into build/debug, then every ctest test
+  test         RelWithDebInfo build (asserts on, -Werror, the Python module) into build/debug, then every ctest test
   asan         Debug build with ASan+UBSan (clang++ if present) into build/asan, then ctest
   bench        Release build of the benchmarks, then sac_suite and dynmesh_bench at the README sizes
   fuzz [secs]  clang libFuzzer build into build/fuzz, then each fuzz target for secs (default 60)

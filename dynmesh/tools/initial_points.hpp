@@ -9,6 +9,9 @@
 // from all others when it alone stretches a derived box (a stray 1e17 among terrain
 // coordinates makes L so large that near terrain points collide), else the later point of
 // the pair.
+// Points so close together that a box derived from them cannot be divided (the library's
+// "too small for its offset") are named as that pair. A skipped column header is noted on
+// stderr ("dynmesh: note: ...") and the run goes on.
 // Invariants: every error thrown names the POINTS file, and a line when one is known.
 // Complexity: O(n log n) (locating, duplicates); a resolution error costs O(n) more.
 #pragma once
@@ -16,9 +19,11 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "dynmesh/box.hpp"
@@ -66,7 +71,45 @@ std::optional<std::size_t> resolution_partner(const InitialPoints<d>& in, std::s
   return std::nullopt;
 }
 
+/// The two points at the ends of the widest axis of the points' extent: the pair that spans
+/// a derived box (first in file order first).
+template <std::size_t d>
+std::pair<std::size_t, std::size_t> extent_pair(std::span<const Point<d>> pts) {
+  std::size_t best_axis = 0;
+  double best = -1;
+  std::size_t lo[d] = {}, hi[d] = {};
+  for (std::size_t a = 0; a < d; ++a) {
+    for (std::size_t i = 1; i < pts.size(); ++i) {
+      if (pts[i][a] < pts[lo[a]][a]) lo[a] = i;
+      if (pts[i][a] > pts[hi[a]][a]) hi[a] = i;
+    }
+    if (pts.size() > 0 && pts[hi[a]][a] - pts[lo[a]][a] > best) {
+      best = pts[hi[a]][a] - pts[lo[a]][a];
+      best_axis = a;
+    }
+  }
+  return {std::min(lo[best_axis], hi[best_axis]), std::max(lo[best_axis], hi[best_axis])};
+}
+
 }  // namespace detail
+
+/// The error for a box derived from points so close together, for their distance from the
+/// origin, that double coordinates cannot resolve it (the library says "the domain box is
+/// too small for its offset", or a point falls outside the rounded box): it names the two
+/// points that span the box.
+template <std::size_t d>
+[[noreturn]] void throw_too_close_error(const InitialPoints<d>& in) {
+  const auto [a, b] = detail::extent_pair<d>(in.file.points);
+  const auto& pts = in.file.points;
+  throw InputError(InputError::Kind::Resolution,
+                   "points " + to_string<d>(pts[a]) + " and " + to_string<d>(pts[b]) + " (lines " +
+                       std::to_string(detail::line_of(in, a)) + ", " + std::to_string(detail::line_of(in, b)) +
+                       ") are too close together for the resolution of double coordinates at their distance from "
+                       "the origin: the box derived from them cannot be divided into cells; spread the points "
+                       "further apart, or give a larger box with --box",
+                   in.file.name, detail::line_of(in, b))
+      .with_points({a, b});
+}
 
 /// The error for points i and j that the grid cannot tell apart at `level` (52 for the
 /// quadtree, the mesh's resolution level for the mesh): the spread L/s of the pair exceeds
@@ -109,6 +152,12 @@ InitialPoints<d> read_initial_points(const std::string& path, const std::vector<
                                      bool skip_duplicates) {
   InitialPoints<d> in;
   in.file = read_points_file<d>(path);
+  if (in.file.header_line != 0) {
+    // A note, not an error: the run goes on. On stderr, so that stdout stays the outputs'.
+    std::fflush(stdout);
+    std::fprintf(stderr, "dynmesh: note: %s:%zu: skipped the header line '%s' (it holds no number)\n",
+                 escape_control_bytes(in.file.name).c_str(), in.file.header_line, in.file.header.c_str());
+  }
   if (skip_duplicates) in.duplicates_skipped = drop_duplicate_points<d>(in.file);
   in.box_derived = box_option.empty();
   if (in.box_derived) {
@@ -124,6 +173,9 @@ InitialPoints<d> read_initial_points(const std::string& path, const std::vector<
   try {
     in.located = locate_points<d>(in.file, in.box);
   } catch (const InputError& e) {
+    // A derived box holds every point unless rounding shrank it: the points are too close.
+    if (e.kind() == InputError::Kind::OutsideBox && in.box_derived && in.file.points.size() >= 2)
+      throw_too_close_error(in);
     if (e.kind() != InputError::Kind::Resolution || e.point_indices().size() != 2) throw;
     throw_resolution_error(in, e.point_indices()[0], e.point_indices()[1]);
   }
@@ -137,6 +189,12 @@ template <std::size_t d>
 [[noreturn]] void rethrow_construction_error(const InputError& e, const InitialPoints<d>& in,
                                              int resolution_level = kMaxLevel) {
   std::vector<std::size_t> idx = e.point_indices();
+  // A Resolution error naming no point is about the box (too small for its offset): with a
+  // derived box, the points that span it are too close together.
+  // A negative resolution level says the same of the mesh's box.
+  if ((idx.empty() || resolution_level < 0) && e.kind() == InputError::Kind::Resolution && in.box_derived &&
+      in.file.points.size() >= 2)
+    throw_too_close_error(in);
   if (idx.empty()) rethrow_in(e, in.file.name);
   if (e.kind() == InputError::Kind::Resolution && idx.size() <= 2 && idx.back() < in.file.points.size()) {
     if (idx.size() == 2) throw_resolution_error(in, idx[0], idx[1]);

@@ -47,6 +47,10 @@ InputError edit_error(const EditScript<d>& script, std::size_t i, const InputErr
   const std::string point = to_string<d>(e.point);
   std::string text = e.op == EditOp::Insert ? "insert" : "delete";
   if (why.find(point) == std::string::npos) text += " " + point;
+  // The box is fixed when the tree is built: a point outside it needs a larger --box.
+  if (err.kind() == InputError::Kind::OutsideBox && e.op == EditOp::Insert)
+    why += std::string("; the box is derived from the initial points unless --box gives it: pass --box ") +
+           (d == 2 ? "o1 o2 L" : "o1 o2 o3 L") + " with a box that holds every point the edits insert";
   return InputError(err.kind(), text + ": " + why, script.name, script.lines[i]);
 }
 

@@ -13,9 +13,11 @@
 //                     [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv [--plot OUT.svg]
 //                     [--force]
 //   dynmesh demo [--n N] [--updates U] [--seed X] [--svg OUT.svg]
+//   dynmesh --version
 // Exit status: 0 on success; 1 with exactly one line `dynmesh: <message>` on stderr on any
 // error (a build refused by the memory guard included); 2 for a command line CLI11 rejects
-// (also one line). Progress lines (progress.hpp) go to stderr too, only on runs longer than a
+// (also one line), a bad --postprocess or --min-angle, or an output path naming an input
+// file (distinct_paths.hpp). Messages have their control bytes escaped (one_line). Progress lines (progress.hpp) go to stderr too, only on runs longer than a
 // second (DYNMESH_PROGRESS_DELAY_MS overrides the second, for tests).
 #include <cstddef>
 #include <cstdint>
@@ -23,19 +25,36 @@
 #include <exception>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "distinct_paths.hpp"
 #include "dynmesh/distributions.hpp"
 #include "memory_guard.hpp"
 #include "number_options.hpp"
+#include "postprocess_option.hpp"
 #include "verify.hpp"
+
+namespace {
+
+/// An output that names an input file (distinct_paths.hpp) is a malformed command line.
+void require_distinct(const std::string& points, const std::string& edits,
+                      const std::vector<dynmesh::tool::NamedPath>& outputs) {
+  const std::string clash =
+      dynmesh::tool::output_overwrites_input({{"POINTS", points}, {"--edits", edits}}, outputs);
+  if (!clash.empty()) throw CLI::ValidationError(clash);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace dynmesh::tool;
-  CLI::App app{"dynmesh: dynamic well-graded quadtrees (and, later, meshes) of changing point sets"};
+  CLI::App app{"dynmesh: dynamic well-graded quadtrees and quality meshes of changing point sets "
+               "(file formats and contracts: docs/FORMATS.md)"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("dynmesh ") + DYNMESH_VERSION, "print the version and exit");
 
   // Whole-number options: digits only, within range (number_options.hpp).
   const CLI::Validator at_least_one = whole_number(1, std::numeric_limits<std::size_t>::max());
@@ -72,7 +91,8 @@ int main(int argc, char** argv) {
   QuadtreeOptions q;
   CLI::App* quadtree = app.add_subcommand(
       "quadtree", "Build the quadtree T* of a point file, apply an edit script dynamically, write the leaves");
-  quadtree->add_option("POINTS", q.points, "point file: .node (Triangle/TetGen) or plain text (x y [z] per line)")
+  quadtree->add_option("POINTS", q.points, "point file: .node (Triangle/TetGen), the vertices of a .poly, or plain text (x y [z] per "
+                        "line; a first line without numbers is a header); - reads standard input")
       ->required();
   CLI::Option* dim_opt =
       quadtree->add_option("--dim", q.dim, "dimension of plain-text points (a .node header decides when omitted)")
@@ -92,6 +112,7 @@ int main(int argc, char** argv) {
   CLI::Option* quadtree_svg = quadtree->add_option("--svg", q.svg, "also draw the final tree and points (2D only)");
   add_svg_density(quadtree, quadtree_svg, q.svg_point_radius, q.svg_max_points);
   quadtree->add_flag("--force", q.force, force_help);
+  quadtree->parse_complete_callback([&q] { require_distinct(q.points, q.edits, {{"--cells", q.cells}, {"--svg", q.svg}}); });
   quadtree->footer(
       "\nSynopsis (docs/FORMATS.md):\n"
       "  dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--duplicates error|skip]\n"
@@ -103,7 +124,8 @@ int main(int argc, char** argv) {
   MeshCommandOptions me;
   CLI::App* mesh = app.add_subcommand(
       "mesh", "Mesh the box of a 2D point file, apply an edit script dynamically, write the final mesh");
-  mesh->add_option("POINTS", me.points, "point file: .node (Triangle) or plain text (x y per line)")->required();
+  mesh->add_option("POINTS", me.points, "point file: .node (Triangle), the vertices of a .poly, or plain text (x y per line; a first "
+                    "line without numbers is a header); - reads standard input")->required();
   mesh->add_option("--box", me.box, "domain box: origin and side length (default: derived from the initial points)")
       ->expected(3)
       ->type_name("o1 o2 L");
@@ -113,9 +135,17 @@ int main(int argc, char** argv) {
   mesh->add_option("--postprocess", me.postprocess,
                    "hpu (the default: the off-center Delaunay mesh; self-adjusting under --edits) or quadtree (the "
                    "self-adjusting quadtree mesh, angles >= 18.4)");
-  CLI::Option* min_angle_opt =
-      mesh->add_option("--min-angle", me.min_angle, "smallest angle in degrees (hpu: 1 to 30, default 20.7; quadtree: at most 18.4)")
-          ->check(CLI::Range(0.0, 60.0));  // no triangle has a smallest angle above 60
+  CLI::Option* min_angle_opt = mesh->add_option(
+      "--min-angle", me.min_angle,
+      "smallest angle in degrees: hpu 1 to 30 (default 20.7); quadtree 0 to 18.4 (its bound, always kept)");
+  // A bad --postprocess or --min-angle is a malformed command line (exit 2), found before
+  // anything is read.
+  mesh->parse_complete_callback([&me, min_angle_opt] {
+    check_postprocess_option(me.postprocess, /*allow_none=*/false, min_angle_opt, me.min_angle);
+    require_distinct(me.points, me.edits,
+                     {{"-o", me.outbase + ".node"}, {"-o", me.outbase + ".ele"}, {"--feed", me.feed},
+                      {"--vtk", me.vtk}, {"--msh", me.msh}, {"--svg", me.svg}});
+  });
   mesh->add_option("--edits", me.edits, "edit script: '+ x y' inserts, '- x y' deletes, one per line");
   mesh->add_option("--batch", me.batch, "propagate K consecutive edits together (default: each edit alone)")
       ->check(at_least_one);
@@ -180,15 +210,18 @@ int main(int argc, char** argv) {
   stability_edits_opt->needs(points_opt);
   stability_box_opt->needs(points_opt);
   for (CLI::Option* opt : {n_opt, spread_opt, updates_opt, seed_opt}) opt->excludes(points_opt);
-  stability->parse_complete_callback([dist_opt, points_opt] {
+  CLI::Option* stability_angle_opt = nullptr;  // set below; read when parsing completes
+  stability->parse_complete_callback([dist_opt, points_opt, &s, &stability_angle_opt] {
     if (dist_opt->count() == 0 && points_opt->count() == 0) throw CLI::RequiredError("--dist or --points");
+    check_postprocess_option(s.postprocess, /*allow_none=*/true, stability_angle_opt, s.min_angle);
+    require_distinct(s.points, s.edits, {{"--csv", s.csv}, {"--plot", s.plot}});
   });
   stability->add_option("--postprocess", s.postprocess,
                         "none (the default: the quadtree alone), quadtree (2D: the quadtree mesh too) or hpu (2D: "
                         "the off-center Delaunay mesh too); "
                         "with a mesh, trace_distance and seconds count the whole update, tree and mesh");
-  CLI::Option* stability_angle_opt = stability->add_option(
-      "--min-angle", s.min_angle, "with a mesh: hpu's angle bound (1 to 30, default 20.7); quadtree: the smallest angle checked on the final mesh (<= 18.4)");
+  stability_angle_opt = stability->add_option(
+      "--min-angle", s.min_angle, "with a mesh: hpu's angle bound, 1 to 30 (default 20.7); quadtree: the smallest angle checked on the final mesh, 0 to 18.4");
   stability->add_option("--csv", s.csv, "output CSV (appended to; header written when new or empty)")->required();
   stability->add_option("--plot", s.plot, "also plot every row of the CSV with gnuplot (SVG)");
   stability->add_flag("--force", s.force, force_help);

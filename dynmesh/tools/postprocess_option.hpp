@@ -16,6 +16,8 @@
 #include <optional>
 #include <string>
 
+#include <CLI/CLI.hpp>
+
 #include "dynmesh/errors.hpp"
 #include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
@@ -65,6 +67,19 @@ inline PostprocessChoice check_postprocess(const std::string& name, bool allow_n
                                             angle_text(kQuadtreeMinAngle) + " degrees");
   }
   return choice;
+}
+
+/// check_postprocess at parse time: a bad value is CLI11's ValidationError, so that the
+/// command exits with status 2 (a malformed command line) before reading anything.
+inline void check_postprocess_option(const std::string& name, bool allow_none, const CLI::Option* min_angle_opt,
+                                     double min_angle) {
+  try {
+    (void)check_postprocess(name, allow_none,
+                            min_angle_opt && min_angle_opt->count() > 0 ? std::optional<double>(min_angle)
+                                                                         : std::nullopt);
+  } catch (const InputError& e) {
+    throw CLI::ValidationError(e.text());
+  }
 }
 
 }  // namespace dynmesh::tool

@@ -1,17 +1,19 @@
 // dynmesh/tools/progress.hpp — progress lines on stderr for long runs.
 //
-// Purpose: two kinds of line, both rewritten in place with '\r' and both silent for the first
-// second (progress_delay()), so that short runs print nothing:
+// Purpose: two kinds of line, both silent for the first second (progress_delay()), so that
+// short runs print nothing:
 //   * Progress: `[dynmesh] 1234/10000 updates`, for loops that can count their steps (edits,
 //     updates). tick() refreshes it at most five times a second; finish() (or the destructor)
 //     ends the line with a newline if anything was printed.
 //   * Phase: `[dynmesh] building the quadtree of 2000000 points: 12 s`, for one long library
 //     call that cannot report its own progress (a from-scratch build, the --check rebuild).
-//     A background thread refreshes the elapsed time once a second; the destructor stops and
+//     A background thread refreshes the elapsed time once a second (on a terminal); the destructor stops and
 //     joins it, then ends the line: `...: done in 12.4 s` (or `...: stopped after 12.4 s` when
 //     unwinding from an error).
-// Both go to stderr whether or not it is a terminal (a log file gets the '\r'-separated
-// updates); stdout is never touched.
+// Both go to stderr; stdout is never touched. On a terminal each report rewrites the line in
+// place with '\r'. Anywhere else (a log file, a pipe) each report is a line of its own, at
+// most one every kLogInterval (10 s) per line, and no '\r' is written, so a log stays
+// readable line by line.
 // DYNMESH_PROGRESS_DELAY_MS (milliseconds, default 1000) overrides the one-second delay; the
 // command-line tests set it to 0 to see the lines on small inputs.
 // Invariants: nothing is printed before the delay has elapsed since construction. A Phase
@@ -34,6 +36,8 @@
 #include <thread>
 #include <utility>
 
+#include <unistd.h>
+
 namespace dynmesh::tool {
 
 /// How long a run stays silent before its progress line appears: one second, or
@@ -50,6 +54,16 @@ inline std::chrono::milliseconds progress_delay() {
   return delay;
 }
 
+/// Is stderr a terminal (reports rewrite one line) rather than a file or a pipe (reports are
+/// lines of their own, at most one per kLogInterval)? Asked once.
+inline bool progress_on_terminal() {
+  static const bool terminal = ::isatty(STDERR_FILENO) == 1;
+  return terminal;
+}
+
+/// The least time between two reports of one progress line when stderr is not a terminal.
+inline constexpr std::chrono::seconds kLogInterval{10};
+
 class Progress {
  public:
   Progress(std::string what, std::size_t total)
@@ -65,17 +79,19 @@ class Progress {
   void tick(std::size_t done) {
     const auto now = Clock::now();
     if (now - start_ < delay_) return;
-    if (printed_ && now - last_ < std::chrono::milliseconds(200)) return;
+    if (printed_ && now - last_ < (terminal_ ? Clock::duration(std::chrono::milliseconds(200)) : kLogInterval))
+      return;
     last_ = now;
     printed_ = true;
-    std::fprintf(stderr, "\r[dynmesh] %zu/%zu %s", done, total_, what_.c_str());
+    std::fprintf(stderr, terminal_ ? "\r[dynmesh] %zu/%zu %s" : "[dynmesh] %zu/%zu %s\n", done, total_, what_.c_str());
     std::fflush(stderr);
   }
 
   /// Prints the final count and a newline, once, if the line was shown at all.
   void finish() {
     if (!printed_) return;
-    std::fprintf(stderr, "\r[dynmesh] %zu/%zu %s\n", total_, total_, what_.c_str());
+    std::fprintf(stderr, terminal_ ? "\r[dynmesh] %zu/%zu %s\n" : "[dynmesh] %zu/%zu %s\n", total_, total_,
+                 what_.c_str());
     std::fflush(stderr);
     printed_ = false;
   }
@@ -83,7 +99,7 @@ class Progress {
   /// Ends the line without claiming completion (an error is about to be reported).
   void abandon() {
     if (!printed_) return;
-    std::fputc('\n', stderr);
+    if (terminal_) std::fputc('\n', stderr);  // elsewhere every report ended its line
     printed_ = false;
   }
 
@@ -93,6 +109,7 @@ class Progress {
   std::size_t total_;
   Clock::time_point start_, last_;
   std::chrono::milliseconds delay_ = progress_delay();
+  bool terminal_ = progress_on_terminal();
   bool printed_ = false;
   int exceptions_ = std::uncaught_exceptions();
 };
@@ -123,8 +140,8 @@ class Phase {
     const Clock::duration elapsed = Clock::now() - start_;
     if (elapsed < delay_) return;
     const bool failed = std::uncaught_exceptions() > exceptions_;
-    std::fprintf(stderr, "\r[dynmesh] %s: %s %.1f s\n", what_.c_str(), failed ? "stopped after" : "done in",
-                 std::chrono::duration<double>(elapsed).count());
+    std::fprintf(stderr, "%s[dynmesh] %s: %s %.1f s\n", terminal_ ? "\r" : "", what_.c_str(),
+                 failed ? "stopped after" : "done in", std::chrono::duration<double>(elapsed).count());
     std::fflush(stderr);
   }
 
@@ -138,15 +155,17 @@ class Phase {
     Clock::time_point next = start_ + delay_;
     while (!wake_.wait_until(lock, next, [this] { return stopping_; })) {
       const auto seconds = std::chrono::duration_cast<std::chrono::seconds>(Clock::now() - start_).count();
-      std::fprintf(stderr, "\r[dynmesh] %s: %lld s", what_.c_str(), static_cast<long long>(seconds));
+      std::fprintf(stderr, terminal_ ? "\r[dynmesh] %s: %lld s" : "[dynmesh] %s: %lld s\n", what_.c_str(),
+                   static_cast<long long>(seconds));
       std::fflush(stderr);
-      next += std::chrono::seconds(1);
+      next += terminal_ ? Clock::duration(std::chrono::seconds(1)) : kLogInterval;
     }
   }
 
   std::string what_;
   Clock::time_point start_;
   std::chrono::milliseconds delay_ = progress_delay();
+  bool terminal_ = progress_on_terminal();
   int exceptions_ = std::uncaught_exceptions();
   std::mutex mutex_;
   std::condition_variable wake_;

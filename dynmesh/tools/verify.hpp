@@ -33,7 +33,9 @@
 
 namespace dynmesh::tool {
 
-/// The message folded onto one line ("a\nb" -> "a; b"), trailing newlines dropped.
+/// The message folded onto one line ("a\nb" -> "a; b"), trailing newlines dropped, and every
+/// other control byte escaped as \xNN (escape_control_bytes): a message that quotes binary
+/// junk or a strange file name cannot drive the terminal.
 inline std::string one_line(std::string s) {
   while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
   std::string out;
@@ -44,7 +46,7 @@ inline std::string one_line(std::string s) {
     else if (c != '\r')
       out += c;
   }
-  return out;
+  return escape_control_bytes(out);
 }
 
 struct Verification {

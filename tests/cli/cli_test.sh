@@ -143,15 +143,15 @@ case $case_name in
     [[ $(wc -l <hpu.csv) -eq 41 ]] || fail "hpu CSV: expected header + 40 rows"
     paste -d, <(tail -n +2 tree.csv) <(tail -n +2 hpu.csv) | awk -F, '$4 != $11 || $5 != $12 || $13 <= $6 { bad = 1; print }
       END { exit bad }' || fail "hpu rows do not follow the tree rows (same ops and spreads, larger distances)"
-    expect_error 1 '--min-angle for hpu must be between 1 and 30 degrees, got 31' "$dynmesh" stability --dim 2 \
+    expect_error 2 '--min-angle for hpu must be between 1 and 30 degrees, got 31' "$dynmesh" stability --dim 2 \
       --dist uniform --n 50 --postprocess hpu --min-angle 31 --csv e.csv
     expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess hpu \
       --csv e.csv
     expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess quadtree \
       --csv e.csv
-    expect_error 1 '--min-angle needs a mesh' "$dynmesh" stability --dim 2 --dist uniform --n 50 --min-angle 10 \
+    expect_error 2 '--min-angle needs a mesh' "$dynmesh" stability --dim 2 --dist uniform --n 50 --min-angle 10 \
       --csv e.csv
-    expect_error 1 'above the quadtree' "$dynmesh" stability --dim 2 --dist uniform --n 50 --postprocess quadtree \
+    expect_error 2 'above the quadtree' "$dynmesh" stability --dim 2 --dist uniform --n 50 --postprocess quadtree \
       --min-angle 30 --csv e.csv
     [[ ! -e e.csv ]] || fail "a refused stability run wrote its CSV"
     if command -v gnuplot >/dev/null; then
@@ -404,14 +404,14 @@ case $case_name in
     done
     expect_error 1 'bad_number.txt:3: ' "$dynmesh" mesh "$data/bad_number.txt" "${qt[@]}" -o old
     expect_error 1 'duplicate.txt:5: ' "$dynmesh" mesh "$data/duplicate.txt" "${qt[@]}" -o old
-    expect_error 1 'above the quadtree' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --min-angle 25 -o old
+    expect_error 2 'above the quadtree' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" --min-angle 25 -o old
     # The hpu mesh (the default) reports bad edits as the quadtree mesh does.
     expect_error 1 'edits_absent.txt:3: ' "$dynmesh" mesh "$data/points2d.node" --edits "$data/edits_absent.txt" \
       -o old --feed old.feed
     expect_error 1 'edits_outside.txt:3: ' "$dynmesh" mesh "$data/points2d.node" --edits "$data/edits_outside.txt" \
       --batch 2 -o old
     for angle in 0.5 30.5; do
-      expect_error 1 "--min-angle for hpu must be between 1 and 30 degrees, got $angle" "$dynmesh" mesh \
+      expect_error 2 "--min-angle for hpu must be between 1 and 30 degrees, got $angle" "$dynmesh" mesh \
         "$data/points2d.node" --min-angle "$angle" -o old
     done
     expect_error 1 'duplicate.txt:5: ' "$dynmesh" mesh "$data/duplicate.txt" -o old
@@ -698,10 +698,116 @@ GNUPLOT
     # (40000 points: 0.6-0.8 s in the test build, far more than 100 ms; 10000 points took about
     # 0.1 s once the quadtree got faster, and the line came or not by chance), then the final
     # line.
+    # stderr is a file here, not a terminal: each report is a line of its own, without '\r'.
     DYNMESH_PROGRESS_DELAY_MS=100 run "$dynmesh" stability --dim 2 --dist uniform --n 40000 --updates 2 --csv live.csv
-    grep -qF $'\r[dynmesh] building the quadtree of 40000 points: 0 s' err.txt ||
+    grep -qx '\[dynmesh\] building the quadtree of 40000 points: 0 s' err.txt ||
       fail "no live line during the build: $(tr '\r' '|' <err.txt)"
-    grep -qF $'\r[dynmesh] building the quadtree of 40000 points: done in ' err.txt || fail "no final line"
+    grep -q '^\[dynmesh\] building the quadtree of 40000 points: done in ' err.txt || fail "no final line"
+    ! grep -q $'\r' err.txt || fail "a carriage return in a log file: $(tr '\r' '|' <err.txt)"
+    # At most one report per 10 s: a run of S seconds gives its first count, at most S/10
+    # more, and the final one (two in the test build; a sanitizer build is slower).
+    seq 1 300 | awk '{ printf "+ %.6f %.6f\n", 0.3 + $1 / 1000, 0.31 + ($1 % 7) / 1000 }' >many_edits.txt
+    start=$(date +%s)
+    DYNMESH_PROGRESS_DELAY_MS=0 run "$dynmesh" quadtree "$data/points2d.node" --edits many_edits.txt --cells m.cells
+    reports=$(grep -c '/300 edits$' err.txt)
+    ((reports >= 2 && reports <= 2 + ($(date +%s) - start) / 10)) ||
+      fail "$reports edit reports in a log: $(tr '\r' '|' <err.txt)"
+    grep -qx '\[dynmesh\] 300/300 edits' err.txt || fail "no final edit count: $(cat err.txt)"
+    # On a terminal (script(1) gives the command one), the line is rewritten in place.
+    if command -v script >/dev/null; then
+      DYNMESH_PROGRESS_DELAY_MS=0 script -qec "'$dynmesh' quadtree '$data/points2d.node' --cells t.cells 2>&1" \
+        /dev/null >tty.txt </dev/null || fail "script: the run failed: $(cat tty.txt)"
+      grep -q $'\r\\[dynmesh\\] building the quadtree of 50 points: done in ' tty.txt ||
+        fail "no '\\r' on a terminal: $(tr '\r' '|' <tty.txt)"
+    fi
+    ;;
+
+  files) # files the project did not write: Triangle's .poly and .ele, numbered rows, headers, stdin
+    # A .poly file's vertices are meshed when it has no segments and no holes ...
+    run "$dynmesh" mesh "$data/vertices.poly" -o poly
+    run "$dynmesh" mesh "$data/vertices.node" -o node
+    cmp poly.node node.node && cmp poly.ele node.ele || fail ".poly vertices: not the mesh of the same .node"
+    run "$dynmesh" quadtree "$data/vertices.poly" --cells poly.cells
+    # ... and refused, in one line that says why, when it has either.
+    expect_error 1 'letter.poly:10: this .poly file has 6 segments: segments and holes are not supported yet' \
+      "$dynmesh" mesh "$data/letter.poly" -o e
+    expect_error 1 'holes are not supported yet' "$dynmesh" mesh "$data/holes_only.poly" -o e
+    expect_error 1 '1 holes' "$dynmesh" quadtree "$data/holes_only.poly" --cells e.cells
+    # Triangle's .ele (triangles, not points), by name and by shape; .node rows under another name.
+    expect_error 1 "triangles.ele: a Triangle .ele file holds triangles" "$dynmesh" mesh "$data/triangles.ele" -o e
+    expect_error 1 "triangles_ele.txt:1: this looks like Triangle's .ele format" \
+      "$dynmesh" mesh "$data/triangles_ele.txt" -o e
+    expect_error 1 "numbered.txt:1: this looks like Triangle's .node format" "$dynmesh" mesh "$data/numbered.txt" -o e
+    cp "$data/letter.poly" letter.txt
+    expect_error 1 "letter.txt:3: this looks like Triangle's .node format" "$dynmesh" quadtree letter.txt --cells e.cells
+    [[ ! -e e.node && ! -e e.cells ]] || fail "a refused file gave an output"
+    # A first line without a number is a header: skipped, with a note; the points are the same.
+    run "$dynmesh" mesh "$data/header.csv" -o header
+    grep -qx "dynmesh: note: $data/header.csv:1: skipped the header line 'easting,northing' (it holds no number)" \
+      err.txt || fail "no note about the header: $(cat err.txt)"
+    cmp header.node node.node || fail "a header line changed the mesh"
+    # A file that fails to read gets its error alone (lines counted with the header).
+    printf 'x,y\n0,0\n1,nan\n' >header_nan.csv
+    expect_error 1 "header_nan.csv:3: NaN or infinite coordinate 'nan'" "$dynmesh" mesh header_nan.csv -o e
+    # '-' is standard input.
+    tail -n +2 "$data/header.csv" | run "$dynmesh" mesh - -o stdin
+    cmp stdin.node node.node && cmp stdin.ele node.ele || fail "'-': not the mesh of the same points"
+    printf '0 0\n1 x\n' | expect_error 1 "<stdin>:2: malformed number 'x'" "$dynmesh" quadtree - --cells e.cells
+    # Many copies of one point: the duplicate error comes at once (sorting, not pairs).
+    yes '0.5 0.5' | head -n 80000 >copies80k.txt
+    start=$(date +%s%N)
+    expect_error 1 'copies80k.txt:2: duplicate point' "$dynmesh" mesh copies80k.txt -o e
+    ms=$((($(date +%s%N) - start) / 1000000))
+    ((ms < 2000)) || fail "80,000 copies took $ms ms"
+    yes '0.5 0.5' | head -n 3000000 >copies3m.txt
+    start=$(date +%s%N)
+    expect_error 1 'copies3m.txt:2: duplicate point' "$dynmesh" quadtree copies3m.txt --cells e.cells --force
+    ms=$((($(date +%s%N) - start) / 1000000))
+    rm -f copies3m.txt
+    ((ms < 20000)) || fail "3,000,000 copies took $ms ms"
+    ;;
+
+  frictions) # the small things a first user trips over
+    # --version, and help that says what the command does now, pointing inside the project.
+    run "$dynmesh" --version
+    grep -qE '^dynmesh [0-9]+\.[0-9]+\.[0-9]+$' out.txt || fail "--version: $(cat out.txt)"
+    for cmd in "" quadtree mesh stability demo; do
+      # shellcheck disable=SC2086  # $cmd is zero or one word
+      "$dynmesh" $cmd --help >help.txt 2>&1 || fail "dynmesh $cmd --help failed"
+      ! grep -qE 'shared/|and, later' help.txt || fail "dynmesh $cmd --help: $(grep -E 'shared/|and, later' help.txt)"
+    done
+    "$dynmesh" mesh --help >help.txt 2>&1
+    grep -q 'hpu 1 to 30' help.txt || fail "mesh --help: the --min-angle range"
+    # A bad --min-angle is a malformed command line.
+    expect_error 2 '--min-angle for hpu must be between 1 and 30 degrees, got 45' \
+      "$dynmesh" mesh "$data/vertices.node" -o e --min-angle 45
+    expect_error 2 '--min-angle' "$dynmesh" stability --dim 2 --dist uniform --n 50 --postprocess hpu \
+      --min-angle 0 --csv e.csv
+    # An output may not overwrite an input.
+    cp "$data/final2d.txt" ok.txt
+    cp ok.txt ok.orig
+    expect_error 2 '--vtk ok.txt is the input file ok.txt (POINTS)' "$dynmesh" mesh ok.txt -o e --vtk ok.txt
+    expect_error 2 '--vtk ./ok.txt is the input file ok.txt' "$dynmesh" mesh ok.txt -o e --vtk ./ok.txt
+    cp "$data/vertices.node" v.node
+    expect_error 2 '-o v.node is the input file v.node' "$dynmesh" mesh v.node -o v
+    expect_error 2 '--cells ok.txt' "$dynmesh" quadtree "$data/points2d.node" --edits ok.txt --cells ok.txt
+    expect_error 2 '--csv ok.txt' "$dynmesh" stability --points ok.txt --edits "$data/edits2d.txt" --csv ok.txt
+    cmp ok.txt ok.orig && cmp v.node "$data/vertices.node" || fail "an input was overwritten"
+    [[ ! -e e.node ]] || fail "a refused run wrote its output"
+    # Binary junk: the control bytes of the message are escaped.
+    printf '0 0\n1 \001\033[31m\n' >junk.txt
+    expect_error 1 "junk.txt:2: malformed number '\\x01\\x1b[31m'" "$dynmesh" mesh junk.txt -o e
+    ! LC_ALL=C grep -q '[[:cntrl:]]' <(tr -d '\n' <err.txt) || fail "a control byte in: $(cat -v err.txt)"
+    # Two points too close for the resolution are named, not the box.
+    expect_error 1 'points (0.25, 0.5) and (0.25, 0.50000000000000011) (lines 1, 2) are too close together' \
+      "$dynmesh" mesh "$data/too_close.txt" -o e
+    expect_error 1 '(lines 1, 2) are too close together' "$dynmesh" mesh "$data/too_close.txt" --postprocess quadtree -o e
+    # An insertion outside the box suggests --box.
+    expect_error 1 'edits_outside.txt:3: insert' "$dynmesh" mesh "$data/points2d.node" --edits \
+      "$data/edits_outside.txt" -o e
+    grep -qF 'pass --box o1 o2 L' err.txt || fail "no --box hint: $(cat err.txt)"
+    expect_error 1 'pass --box o1 o2 L' "$dynmesh" quadtree "$data/points2d.node" --edits "$data/edits_outside.txt" \
+      --cells e.cells
     ;;
 
   memory_guard) # a build that cannot fit in memory stops at once, before reading; --force goes on

@@ -1,7 +1,9 @@
 # cmake -DBUILD_DIR= -DCONFIG= -DSOURCE_DIR= -DWORK_DIR= -DGENERATOR= -DMAKE_PROGRAM=
 #       -DCXX_COMPILER= [-DCXX_FLAGS=] -P run_consumer.cmake
 # Installs the sac package from BUILD_DIR into WORK_DIR/prefix, then configures, builds and
-# runs the consumer project in SOURCE_DIR against it with the same compiler and flags.
+# runs the consumer project in SOURCE_DIR against it with the same compiler and flags; then
+# builds and runs the same main.cpp with the flags `pkg-config --cflags --libs dynmesh` gives
+# from the installed dynmesh.pc (when pkg-config is installed).
 function(step)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0)
@@ -32,3 +34,26 @@ endif()
 list(GET exe 0 exe)
 step(${exe})
 message(STATUS "consumer test: find_package(sac) + sac::runtime OK (${exe})")
+
+# pkg-config: the same program, compiled by hand with the installed dynmesh.pc's flags.
+find_program(PKG_CONFIG_EXECUTABLE NAMES pkg-config pkgconf)
+if(NOT PKG_CONFIG_EXECUTABLE)
+  message(STATUS "consumer test: pkg-config not found, dynmesh.pc not tested")
+  return()
+endif()
+file(GLOB_RECURSE pc LIST_DIRECTORIES false ${prefix}/dynmesh.pc)
+if(NOT pc)
+  message(FATAL_ERROR "consumer test: dynmesh.pc was not installed")
+endif()
+get_filename_component(pc_dir ${pc} DIRECTORY)
+execute_process(COMMAND ${CMAKE_COMMAND} -E env PKG_CONFIG_PATH=${pc_dir}
+                        ${PKG_CONFIG_EXECUTABLE} --cflags --libs dynmesh
+                OUTPUT_VARIABLE pc_flags OUTPUT_STRIP_TRAILING_WHITESPACE RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "consumer test: pkg-config --cflags --libs dynmesh failed (${rc})")
+endif()
+separate_arguments(pc_flags UNIX_COMMAND "${pc_flags}")
+separate_arguments(extra_flags UNIX_COMMAND "${CXX_FLAGS}")
+step(${CXX_COMPILER} ${extra_flags} ${SOURCE_DIR}/main.cpp -o ${WORK_DIR}/pc_consumer ${pc_flags})
+step(${WORK_DIR}/pc_consumer)
+message(STATUS "consumer test: pkg-config dynmesh OK (${pc_flags})")

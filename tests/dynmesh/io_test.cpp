@@ -210,9 +210,82 @@ TEST(ReadPlain, Errors) {
   expect_error([&] { plain<2>("1 2\n3\n", n); }, Kind::Count, n, 2, "expected 2 coordinates, found 1");
   expect_error([&] { plain<3>("1 2 3\n\n1 2\n", n); }, Kind::Count, n, 3);
   expect_error([&] { plain<2>("1 2\n1,5 2\n", n); }, Kind::Malformed, n, 2, "'1,5'");
-  expect_error([&] { plain<2>("x y\n", n); }, Kind::Malformed, n, 1);
+  expect_error([&] { plain<2>("1 2\nx y\n", n); }, Kind::Malformed, n, 2);  // a header only comes first
+  expect_error([&] { plain<2>("x 1\n", n); }, Kind::Malformed, n, 1);      // a number: not a header
   expect_error([&] { plain<2>("1 2\n3 4\nNaN 1\n", n); }, Kind::NotFinite, n, 3);
   expect_error([&] { plain<2>("1 inf\n", n); }, Kind::NotFinite, n, 1);
+}
+
+TEST(ReadPlain, AFirstLineWithoutNumbersIsAHeader) {
+  const auto f = plain<2>("# exported\n\nx, y\n0.5, 0.25\n1, 2\n", "h.csv");
+  EXPECT_EQ(f.header_line, 3u);
+  EXPECT_EQ(f.header, "x, y");
+  EXPECT_EQ(f.points, (std::vector<Point<2>>{{0.5, 0.25}, {1, 2}}));
+  EXPECT_EQ(f.lines, (std::vector<std::size_t>{4, 5}));
+  EXPECT_EQ(plain<2>("1 2\n").header_line, 0u);
+  EXPECT_EQ(plain<2>("easting\tnorthing\x01\n1 2\n").header, "easting\\x09northing\\x01");
+}
+
+TEST(ReadPlain, TriangleNumberedRowsAreRefusedByName) {
+  const std::string n = "rows.txt";
+  // A .node under another name: a header of whole numbers, then numbered vertices.
+  expect_error([&] { plain<2>("3 2 0 0\n1 0 0\n2 1 0\n3 0.5 1\n", n); }, Kind::Unsupported, n, 1,
+               "Triangle's .node format");
+  expect_error([&] { plain<2>("# c\n3 2\n0 0 0\n1 1 0\n2 0.5 1\n", n); }, Kind::Unsupported, n, 2, ".node");
+  // Triangles: every field a vertex number.
+  expect_error([&] { plain<2>("2 3 0\n1 1 2 3\n2 2 3 4\n", n); }, Kind::Unsupported, n, 1,
+               "Triangle's .ele format");
+  // A .poly: its segment list fails to read as points, and the file is named for what it is.
+  expect_error([&] { plain<2>("3 2 0 0\n1 0 0\n2 1 0\n3 0.5 1\n3 0\n1 1 2\n", n); }, Kind::Unsupported, n, 1,
+               ".node format");
+  // Plain points that merely start with whole numbers stay points; one numbered row is not
+  // enough to tell (here a decimal comma is the error).
+  expect_error([&] { plain<2>("1 2\n1,5 2\n", n); }, Kind::Malformed, n, 2, "'1,5'");
+  EXPECT_EQ(plain<2>("3 2\n1 0\n2 0\n").points.size(), 3u);                // two fields per row
+  EXPECT_EQ(plain<2>("3 2 0 0\n5 0 0\n6 1 0\n7 0.5 1\n").points.size(), 4u);  // not numbered from 0/1
+  EXPECT_EQ(plain<2>("3 5 0 0\n1 0 0\n2 1 0\n3 0.5 1\n").points.size(), 4u);  // no dimension 5
+}
+
+TEST(ReadPoly, VerticesWithoutSegmentsOrHoles) {
+  std::istringstream in("# p\n3 2 1 1\n1 0 0 7 1\n2 1 0 7 1\n3 0.5 1 7 0\n0 0\n0\n");
+  const auto f = read_poly<2>(in, "p.poly");
+  EXPECT_EQ(f.points, (std::vector<Point<2>>{{0, 0}, {1, 0}, {0.5, 1}}));
+  EXPECT_EQ(f.lines, (std::vector<std::size_t>{3, 4, 5}));
+  std::istringstream regions("3 2\n0 0 0\n1 1 0\n2 0.5 1\n0\n0\n0\n");
+  EXPECT_EQ(read_poly<2>(regions, "r.poly").points.size(), 3u);
+}
+
+TEST(ReadPoly, SegmentsHolesAndMissingListsAreRefused) {
+  const std::string n = "a.poly";
+  auto poly = [&](const std::string& text) {
+    std::istringstream in(text);
+    return read_poly<2>(in, n);
+  };
+  const std::string vertices = "3 2 0 0\n1 0 0\n2 1 0\n3 0.5 1\n";
+  expect_error([&] { poly(vertices + "3 0\n1 1 2\n2 2 3\n3 3 1\n0\n"); }, Kind::Unsupported, n, 5,
+               "3 segments: segments and holes are not supported yet");
+  expect_error([&] { poly(vertices + "0 0\n1\n1 0.5 0.5\n"); }, Kind::Unsupported, n, 6, "1 holes");
+  expect_error([&] { poly(vertices + "0 0\n0\n1\n1 0.5 0.5 1 0\n"); }, Kind::Unsupported, n, 7, "regional");
+  expect_error([&] { poly(vertices); }, Kind::Malformed, n, 4, "ends before its number of segments");
+  expect_error([&] { poly(vertices + "0\n"); }, Kind::Malformed, n, 5, "holes");
+  expect_error([&] { poly("0 2 0 1\n0 0\n0\n"); }, Kind::Unsupported, n, 1, "lists no vertices");
+  expect_error([&] { poly("3 3 0 0\n"); }, Kind::Malformed, n, 1, "dimension 3");
+}
+
+TEST(ReadPoints, EleIsRefusedAndFormatsGoByName) {
+  EXPECT_EQ(format_for_path("x.POLY"), PointFormat::Poly);
+  EXPECT_EQ(format_for_path("x.ele"), PointFormat::Ele);
+  EXPECT_EQ(format_for_path("x.elements"), PointFormat::Plain);
+  std::istringstream ele("1 3 0\n1 1 2 3\n");
+  expect_error([&] { (void)read_points<2>(ele, "m.ele"); }, Kind::Unsupported, "m.ele", 0, "holds triangles");
+  std::istringstream poly("1 2\n1 0.5 0.5\n0 0\n0\n");
+  EXPECT_EQ(read_points<2>(poly, "m.poly").points.size(), 1u);
+}
+
+TEST(EscapeControlBytes, EveryControlByteAndOnlyThose) {
+  EXPECT_EQ(escape_control_bytes("a\tb\r\x1b[31m\x7f\xc3\xa9"), "a\\x09b\\x0d\\x1b[31m\\x7f\xc3\xa9");
+  std::istringstream junk("1 2\n\x01\x02 3\n");
+  expect_error([&] { (void)read_plain<2>(junk, "j.txt"); }, Kind::Malformed, "j.txt", 2, "'\\x01\\x02'");
 }
 
 // --- files, boxes and duplicates -------------------------------------------------------------
@@ -242,7 +315,8 @@ TEST_F(TempDir, ReadPointsFileChoosesTheFormatByExtension) {
   EXPECT_EQ(format_for_path(b), PointFormat::Node);
   EXPECT_EQ(read_points_file<2>(c).points.size(), 1u);  // plain: "2 2 0 0" is the point (2, 2)
   EXPECT_EQ(read_points_file<2>(c).points[0], (Point<2>{2, 2}));
-  EXPECT_EQ(read_points_file<2>(a, PointFormat::Plain).points.size(), 3u);
+  // A .node file read as plain text is refused: its vertex numbers would become coordinates.
+  expect_error([&] { read_points_file<2>(a, PointFormat::Plain); }, Kind::Unsupported, a, 1, ".node format");
   EXPECT_EQ(node_file_dimension(a), 2);
   EXPECT_EQ(node_file_dimension(write("d.node", "5\n")), 0);
   expect_error([&] { read_points_file<2>(write("e.node", "1 2 0 0\n1 0 nan\n")); }, Kind::NotFinite,
@@ -283,6 +357,22 @@ TEST(LocatePoints, EqualPositionsAreDuplicatesOrASpreadBeyondTheResolution) {
   expect_error([&] { (void)locate_points(g, derive_box<2>(g.points)); }, Kind::Duplicate, "dup2.txt", 4);
   const auto ok = plain<2>("0 0\n1 1\n");
   EXPECT_EQ(locate_points(ok, derive_box<2>(ok.points)).size(), 2u);
+}
+
+TEST(LocatePoints, ManyCopiesOfOnePointAreFoundInOneSortedPass) {
+  // 200,000 copies: the first repeat is reported, in O(n log n) (a walk back over the equal
+  // positions for each copy took minutes at 3 million).
+  PointFile<2> f;
+  f.name = "copies.txt";
+  f.points.assign(200000, Point<2>{0.5, 0.5});
+  f.points.push_back({0.25, 0.75});
+  for (std::size_t i = 0; i < f.points.size(); ++i) f.lines.push_back(i + 1);
+  expect_error([&] { (void)locate_points(f, derive_box<2>(f.points)); }, Kind::Duplicate, "copies.txt", 2,
+               "the point on line 1");
+  // The earliest repeat in file order wins, whichever group it is in.
+  const auto g = plain<2>("1 1\n2 2\n3 3\n2 2\n1 1\n2 2\n", "g.txt");
+  expect_error([&] { (void)locate_points(g, derive_box<2>(g.points)); }, Kind::Duplicate, "g.txt", 4,
+               "the point on line 2");
 }
 
 TEST(LocatePoints, DropDuplicatePointsKeepsTheFirstCopy) {

@@ -1,10 +1,11 @@
 // fuzz_point_readers — libFuzzer target of the point-file readers (dynmesh/io.hpp):
-// read_node and read_plain in 2D and 3D, and what the commands do next with a file they read
+// read_node, read_poly and read_plain in 2D and 3D, and what the commands do next with a file they read
 // (drop_duplicate_points, derive_box, locate_points, the static tree on small files).
 //
-// Input: the first byte picks the reader (bit 0: `.node` or plain text) and the dimension
-// (bit 1: 2 or 3); the rest is the file's text.
-// Properties: a read either succeeds or throws InputError (Malformed, NotFinite or Count)
+// Input: the first byte picks the reader (bit 0: `.node` or plain text; bit 2 set: `.poly`)
+// and the dimension (bit 1: 2 or 3); the rest is the file's text.
+// Properties: a read either succeeds or throws InputError (Malformed, NotFinite, Count, or
+// Unsupported for plain text shaped like Triangle's numbered rows or a .poly with segments)
 // naming the file and an existing line in a one-line message; a successful read has one
 // strictly increasing line number per point and finite coordinates only, and the points
 // written back (%.17g) read back bit for bit, as plain text and as `.node`; dropping
@@ -99,13 +100,17 @@ void check_located(const PointFile<d>& file) {
   }
 }
 
+enum class Reader { Plain, Node, Poly };
+
 template <std::size_t d>
-void fuzz(bool node, std::string_view text) {
-  const std::string name = node ? "fuzz.node" : "fuzz.txt";
+void fuzz(Reader reader, std::string_view text) {
+  const std::string name = reader == Reader::Poly ? "fuzz.poly" : reader == Reader::Node ? "fuzz.node" : "fuzz.txt";
   std::istringstream in{std::string(text)};
   PointFile<d> file;
   try {
-    file = node ? read_node<d>(in, name) : read_plain<d>(in, name);
+    file = reader == Reader::Poly   ? read_poly<d>(in, name)
+           : reader == Reader::Node ? read_node<d>(in, name)
+                                    : read_plain<d>(in, name);
   } catch (const InputError& e) {
     check_reader_error(e, name, text);
     return;
@@ -124,9 +129,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size == 0) return 0;
   const std::uint8_t selector = data[0];
   const std::string_view text(reinterpret_cast<const char*>(data + 1), size - 1);
+  const Reader reader = (selector & 4) ? Reader::Poly : (selector & 1) ? Reader::Node : Reader::Plain;
   if (selector & 2)
-    fuzz<3>(selector & 1, text);
+    fuzz<3>(reader, text);
   else
-    fuzz<2>(selector & 1, text);
+    fuzz<2>(reader, text);
   return 0;
 }

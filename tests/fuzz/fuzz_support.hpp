@@ -73,8 +73,10 @@ inline void check_reader_error(const InputError& e, const std::string& name, std
   check(std::string_view(e.what()).find_first_of("\n\r") == std::string_view::npos,
         "a reader error's message is not one line");
   using Kind = InputError::Kind;
-  check(e.kind() == Kind::Malformed || e.kind() == Kind::NotFinite || e.kind() == Kind::Count,
-        "a reader error of a kind other than Malformed, NotFinite or Count");
+  // Unsupported: plain text shaped like Triangle's numbered rows (a .node or .ele file).
+  check(e.kind() == Kind::Malformed || e.kind() == Kind::NotFinite || e.kind() == Kind::Count ||
+            e.kind() == Kind::Unsupported,
+        "a reader error of a kind other than Malformed, NotFinite, Count or Unsupported");
 }
 
 /// Line numbers of a successful read: one per item, strictly increasing, within the input.

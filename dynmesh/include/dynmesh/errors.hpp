@@ -47,6 +47,8 @@ class InputError : public Error {
     Absent,       // deleting a point that is not in the set
     Present,      // inserting a point that is already in the set
     Empty,        // no points where some are needed (deriving a box from nothing)
+    Unsupported,  // a well-formed file of a kind not read (yet): Triangle's .ele, a .poly
+                  // with segments or holes, rows numbered as in Triangle's formats
   };
 
   InputError(Kind kind, std::string text, std::string file = {}, std::size_t line = 0)
@@ -105,6 +107,7 @@ constexpr const char* kind_name(InputError::Kind kind) noexcept {
     case Kind::Absent: return "Absent";
     case Kind::Present: return "Present";
     case Kind::Empty: return "Empty";
+    case Kind::Unsupported: return "Unsupported";
   }
   return "?";
 }

@@ -8,12 +8,22 @@
 //     `#` starts a comment anywhere on a line; blank lines are skipped. Attributes and the
 //     marker, when present, must be numbers and are otherwise ignored; further fields are
 //     ignored.
+//   * `.poly` (Triangle; TetGen's in 3D): a `.node` header and vertex list, then the number
+//     of segments (facets) and of holes, and optionally of regional attributes. Only the
+//     vertices are read: a file whose lists are not all empty is refused (Unsupported), as
+//     is one with no vertices of its own (they would be in a separate `.node`).
+//   * `.ele` (Triangle's triangles): refused (Unsupported) with a message naming the format.
 //   * plain text (any other name): one point per non-blank line, fields separated by
 //     whitespace or by ',' / ';' (whitespace around them allowed: "0.5,0.25", "0.5; 0.25");
 //     the first d fields are the coordinates and further columns are ignored (not parsed).
 //     The separators up to the last coordinate's must be of one kind, so that a decimal
 //     comma ("1,5 2") is an error rather than the point (1, 5); an empty field (",,") is an
-//     error. `#` comments are allowed here too.
+//     error. `#` comments are allowed here too. A first line without a single number is a
+//     column header ("x,y"): it is skipped and reported in PointFile::header_line. A file
+//     shaped like Triangle's formats (a first line starting with two whole numbers, then
+//     rows of three fields or more numbered from 0 or 1, as many as announced) is refused
+//     (Unsupported) naming the format it looks like.
+//   * the path "-" is standard input, read as plain text (named "<stdin>" in messages).
 //   * edit scripts: `+ x y [z]` / `- x y [z]`, exactly d coordinates separated as in plain
 //     text, blank lines and `#` comments ignored. The sign must be a token of its own.
 //   * `.cells`: "# dynmesh cells v1", "# dim D", "# box o1 o2 [o3] L" (numbers printed as
@@ -24,15 +34,18 @@
 // scientific notation with an optional leading '+' or '-'; hexadecimal floats are not
 // accepted. A decimal overflow (1e999) is an infinity and an error; a decimal underflow
 // (1e-999) is the correctly rounded signed zero.
-// Every error is an InputError whose message names the file and the 1-based line:
+// Every error is an InputError whose message names the file and the 1-based line, with the
+// control bytes of quoted file text escaped as \xNN:
 // Malformed (bad number or line shape), NotFinite (NaN, infinity), Count (too few or too many
 // fields or vertices), Duplicate (two equal points), Resolution (two different points with
 // equal located q, see locate_points), OutsideBox, Io (cannot open or read: a directory, or
-// the OS reason such as "Permission denied").
+// the OS reason such as "Permission denied"), Unsupported (a well-formed file of a kind not
+// read: see above).
 //
 // Invariants: PointFile::lines[i] is the line of points[i]; points keep file order. A
 // successful read never returns a NaN or infinite coordinate.
-// Complexity: linear in the file size; locate_points O(n log n).
+// Complexity: linear in the file size; locate_points O(n log n), however many copies of one
+// point there are.
 // Paper: none (formats of this project; Triangle and TetGen for `.node`).
 #pragma once
 
@@ -56,18 +69,35 @@ struct PointFile {
   std::string name;                // as used in error messages
   std::vector<Point<d>> points;    // in file order
   std::vector<std::size_t> lines;  // lines[i]: the 1-based line of points[i]
+  std::size_t header_line = 0;     // plain text: the line of a skipped column header (0: none)
+  std::string header{};            // that line, control bytes escaped
 };
 
-enum class PointFormat { Auto, Node, Plain };
+enum class PointFormat { Auto, Node, Plain, Poly, Ele };
 
-/// Node for names ending in ".node" (any letter case), Plain otherwise.
+/// By the name's ending, in any letter case: Node for ".node", Poly for ".poly", Ele for
+/// ".ele" (refused by the readers), Plain otherwise.
 PointFormat format_for_path(std::string_view path) noexcept;
+
+/// The path that names standard input, and the name its messages use.
+inline constexpr std::string_view kStandardInput = "-";
+inline const std::string kStandardInputName = "<stdin>";
+
+/// `text` with every control byte (below 0x20, and 0x7f) written as \xNN: file text quoted
+/// in a message can then neither break the line nor drive the terminal.
+std::string escape_control_bytes(std::string_view text);
 
 template <std::size_t d>
 PointFile<d> read_node(std::istream& in, const std::string& name);
 template <std::size_t d>
+PointFile<d> read_poly(std::istream& in, const std::string& name);
+template <std::size_t d>
 PointFile<d> read_plain(std::istream& in, const std::string& name);
-/// Opens `path` and reads it as `format` (Auto: by extension).
+/// Reads `in` as `format` (Auto: by the extension of `name`); Ele is refused.
+template <std::size_t d>
+PointFile<d> read_points(std::istream& in, const std::string& name, PointFormat format = PointFormat::Auto);
+/// Opens `path` (standard input for "-", as plain text unless `format` says otherwise) and
+/// reads it as `format` (Auto: by extension).
 template <std::size_t d>
 PointFile<d> read_points_file(const std::string& path, PointFormat format = PointFormat::Auto);
 

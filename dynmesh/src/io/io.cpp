@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <istream>
 #include <limits>
 #include <numeric>
@@ -22,11 +23,10 @@ namespace {
 
 using Kind = InputError::Kind;
 
+/// `tok` in single quotes, its control bytes escaped (escape_control_bytes), so that binary
+/// junk in a file cannot put a carriage return or a terminal escape into an error message.
 std::string quoted(std::string_view tok) {
-  std::string s = "'";
-  s += tok;
-  s += '\'';
-  return s;
+  return "'" + escape_control_bytes(tok) + "'";
 }
 
 /// How fields are separated: whitespace only (`.node`, `.cells`), or also a ',' or ';' with
@@ -252,16 +252,44 @@ std::string box_string(const Box<d>& box) {
 
 }  // namespace
 
-PointFormat format_for_path(std::string_view path) noexcept {
-  constexpr std::string_view ext = ".node";
-  if (path.size() < ext.size()) return PointFormat::Plain;
+std::string escape_control_bytes(std::string_view text) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto b = static_cast<unsigned char>(c);
+    if (b < 0x20 || b == 0x7f) {
+      out += "\\x";
+      out += kHex[b >> 4];
+      out += kHex[b & 15];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+namespace {
+
+/// Does `path` end in `ext` (lower case), in any letter case?
+bool has_extension(std::string_view path, std::string_view ext) noexcept {
+  if (path.size() < ext.size()) return false;
   const std::string_view tail = path.substr(path.size() - ext.size());
   for (std::size_t i = 0; i < ext.size(); ++i) {
     char c = tail[i];
     if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
-    if (c != ext[i]) return PointFormat::Plain;
+    if (c != ext[i]) return false;
   }
-  return PointFormat::Node;
+  return true;
+}
+
+}  // namespace
+
+PointFormat format_for_path(std::string_view path) noexcept {
+  if (has_extension(path, ".node")) return PointFormat::Node;
+  if (has_extension(path, ".poly")) return PointFormat::Poly;
+  if (has_extension(path, ".ele")) return PointFormat::Ele;
+  return PointFormat::Plain;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -311,22 +339,21 @@ int node_file_dimension(const std::string& path) {
   return static_cast<int>(read_node_header(r).dim);
 }
 
+namespace {
+
+/// The vertex lines after a `.node` or `.poly` header: exactly h.count of them when
+/// `rest_of_file` is false (a .poly file goes on with its segments), else every remaining
+/// line, which must number h.count.
 template <std::size_t d>
-PointFile<d> read_node(std::istream& in, const std::string& name) {
-  LineReader r(in, name);
-  const NodeHeader h = read_node_header(r);
-  if (h.dim != 0 && static_cast<std::size_t>(h.dim) != d)
-    r.fail(Kind::Malformed, ".node header announces dimension " + std::to_string(h.dim) + " but " +
-                                std::to_string(d) + "-dimensional points were requested");
-  PointFile<d> out;
-  out.name = name;
+void read_vertex_lines(LineReader& r, const NodeHeader& h, PointFile<d>& out, bool rest_of_file) {
   const auto reserve = static_cast<std::size_t>(std::min<long long>(h.count, 1 << 20));
   out.points.reserve(reserve);
   out.lines.reserve(reserve);
   const auto count = static_cast<std::size_t>(h.count);
   long long base = 0;
   std::vector<std::string_view> f;
-  while (r.next(f)) {
+  while (out.points.size() < count || rest_of_file) {
+    if (!r.next(f)) break;
     const std::size_t k = out.points.size();
     if (k == count)
       r.fail(Kind::Count, "more vertices than the " + std::to_string(count) + " announced in the header (line " +
@@ -355,19 +382,169 @@ PointFile<d> read_node(std::istream& in, const std::string& name) {
     r.fail_at(Kind::Count, "the header announces " + std::to_string(count) + " vertices but the file has " +
                                std::to_string(out.points.size()),
               h.line);
+}
+
+template <std::size_t d>
+void require_header_dimension(const LineReader& r, const NodeHeader& h, const char* what) {
+  if (h.dim != 0 && static_cast<std::size_t>(h.dim) != d)
+    r.fail_at(Kind::Malformed, std::string(what) + " header announces dimension " + std::to_string(h.dim) + " but " +
+                                   std::to_string(d) + "-dimensional points were requested",
+              h.line);
+}
+
+}  // namespace
+
+template <std::size_t d>
+PointFile<d> read_node(std::istream& in, const std::string& name) {
+  LineReader r(in, name);
+  const NodeHeader h = read_node_header(r);
+  require_header_dimension<d>(r, h, ".node");
+  PointFile<d> out;
+  out.name = name;
+  read_vertex_lines<d>(r, h, out, /*rest_of_file=*/true);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// .poly
+
+template <std::size_t d>
+PointFile<d> read_poly(std::istream& in, const std::string& name) {
+  LineReader r(in, name);
+  const NodeHeader h = read_node_header(r);
+  require_header_dimension<d>(r, h, ".poly");
+  if (h.count == 0)
+    r.fail_at(Kind::Unsupported,
+              "this .poly file lists no vertices (Triangle then takes them from the .node file of the same name): "
+              "give that .node file instead",
+              h.line);
+  PointFile<d> out;
+  out.name = name;
+  read_vertex_lines<d>(r, h, out, /*rest_of_file=*/false);
+  // Then `<#segments> [<#markers>]` (TetGen: facets), `<#holes>` and, optionally,
+  // `<#regions>`, each followed by its lines. Only empty lists can be honoured.
+  const char* const lists[] = {d == 2 ? "segments" : "facets", "holes", "regional attributes"};
+  std::vector<std::string_view> f;
+  for (const char* what : lists) {
+    if (!r.next(f)) {
+      if (what == lists[2]) break;  // the region list is optional
+      r.fail(Kind::Malformed, std::string("the .poly file ends before its number of ") + what);
+    }
+    const long long n = r.integer(f[0]);
+    if (n < 0) r.fail(Kind::Malformed, std::string("negative number of ") + what + " " + quoted(f[0]));
+    if (n > 0)
+      r.fail(Kind::Unsupported, std::string("this .poly file has ") + std::to_string(n) + " " + what +
+                                    ": segments and holes are not supported yet (dynmesh meshes the vertices "
+                                    "in their box)");
+  }
+  if (r.next(f)) r.fail(Kind::Malformed, "unexpected line after the .poly file's lists");
   return out;
 }
 
 // ---------------------------------------------------------------------------------------
 // plain text
 
+namespace {
+
+/// Does `tok` parse as a number (what from_chars accepts, with an optional leading '+')?
+bool is_number(std::string_view tok) {
+  if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
+  double v = 0;
+  const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), v, std::chars_format::general);
+  return ec != std::errc::invalid_argument && ptr == tok.data() + tok.size() && !tok.empty();
+}
+
+/// Watches the lines of a plain-text file for the shape of Triangle's and TetGen's formats:
+/// a header line starting with two whole numbers (by value: <#items> <2|3|4|6> ...), then
+/// rows numbered consecutively from 0 or 1, as many as the header announces (or to the end
+/// of the file), each with at least three fields. Only the first fields decide, so that the
+/// verdict stays the same for the points written back with just their coordinates. Such a file is a `.node`, `.ele` or `.poly` under
+/// another name, and reading its numbers as coordinates would mesh nonsense.
+class NumberedRows {
+ public:
+  void header(const std::vector<std::string_view>& f) {
+    long long v[2] = {};
+    if (f.size() < 2 || !whole(f[0], v[0]) || !whole(f[1], v[1])) return;
+    if (v[0] < 1 || (v[1] != 2 && v[1] != 3 && v[1] != 4 && v[1] != 6)) return;
+    count_ = v[0];
+    per_row_ = v[1];
+    candidate_ = true;
+  }
+
+  void row(const std::vector<std::string_view>& f) {
+    if (!candidate_ || rows_ == count_) return;
+    long long id = 0;
+    if (f.size() < 3 || !whole(f[0], id) || (rows_ == 0 ? id != 0 && id != 1 : id != base_ + rows_)) {
+      candidate_ = false;
+      return;
+    }
+    if (rows_ == 0) base_ = id;
+    // Triangles: every field a whole number, 1 + <nodes per triangle> of them at least.
+    bool ints = f.size() >= static_cast<std::size_t>(1 + per_row_);
+    for (std::size_t k = 1; k < f.size() && ints; ++k) ints = whole(f[k], id);
+    all_integer_ = all_integer_ && ints;
+    ++rows_;
+  }
+
+  /// Throws InputError(Unsupported) naming the likely format when the file had the shape:
+  /// at least two numbered rows, and every row announced unless the file ended first (a
+  /// `.poly` goes on with other lists, which may fail to read as points). One row is too
+  /// little evidence: "1 2" then "1,5 2" is a decimal comma, not a one-vertex file.
+  void check(const LineReader& r, std::size_t header_line, bool at_end) const {
+    if (!candidate_ || rows_ < 2 || (rows_ < count_ && !at_end)) return;
+    const bool ele = all_integer_ && (per_row_ == 3 || per_row_ == 4 || per_row_ == 6);
+    if (ele)
+      r.fail_at(Kind::Unsupported,
+                "this looks like Triangle's .ele format (a header line, then numbered triangles of vertex numbers), "
+                "not points: give the .node file of its vertices",
+                header_line);
+    r.fail_at(Kind::Unsupported,
+              "this looks like Triangle's .node format (a header line, then numbered vertices), not plain-text "
+              "points: name the file '.node' (or '.poly') to read its vertices",
+              header_line);
+  }
+
+ private:
+  /// A number whose value is a whole number ("3", "3.0", "3e0"): decided by value, not by
+  /// spelling, so that points written back with %.17g get the same verdict.
+  static bool whole(std::string_view tok, long long& v) {
+    if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
+    double x = 0;
+    const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), x, std::chars_format::general);
+    if (ec != std::errc{} || ptr != tok.data() + tok.size() || !(std::fabs(x) < 0x1p53) || x != std::floor(x))
+      return false;
+    v = static_cast<long long>(x);
+    return true;
+  }
+  bool candidate_ = false, all_integer_ = true;
+  long long count_ = 0, per_row_ = 0, rows_ = 0, base_ = 0;
+};
+
+}  // namespace
+
 template <std::size_t d>
 PointFile<d> read_plain(std::istream& in, const std::string& name) {
   LineReader r(in, name, Separators::Lists);
   PointFile<d> out;
   out.name = name;
+  NumberedRows numbered;
+  std::size_t first_line = 0;
   std::vector<std::string_view> f;
+  try {
   while (r.next(f)) {
+    if (first_line == 0) {
+      first_line = r.line();
+      // A first line without a single number is a column header ("x,y", "easting northing").
+      if (std::none_of(f.begin(), f.end(), is_number)) {
+        out.header_line = r.line();
+        out.header = escape_control_bytes(r.raw_line());
+        continue;
+      }
+    }
+    if (out.points.empty())
+      numbered.header(f);
+    else
+      numbered.row(f);
     r.require_one_separator_kind(f, 0, d);  // up to the separator after the last coordinate
     if (f.size() < d)
       r.fail(Kind::Count, "expected " + std::to_string(d) + " coordinates, found " + std::to_string(f.size()));
@@ -376,14 +553,37 @@ PointFile<d> read_plain(std::istream& in, const std::string& name) {
     out.points.push_back(p);
     out.lines.push_back(r.line());
   }
+  } catch (const InputError&) {
+    // A line after a numbered list (a .poly's segment count, say) is no point: say what the
+    // file looks like rather than what its later line lacks.
+    if (!out.lines.empty()) numbered.check(r, out.lines.front(), /*at_end=*/false);
+    throw;
+  }
+  if (!out.lines.empty()) numbered.check(r, out.lines.front(), /*at_end=*/true);
   return out;
 }
 
 template <std::size_t d>
+PointFile<d> read_points(std::istream& in, const std::string& name, PointFormat format) {
+  if (format == PointFormat::Auto) format = format_for_path(name);
+  switch (format) {
+    case PointFormat::Node: return read_node<d>(in, name);
+    case PointFormat::Poly: return read_poly<d>(in, name);
+    case PointFormat::Ele:
+      throw InputError(Kind::Unsupported,
+                       "a Triangle .ele file holds triangles (vertex numbers), not points: give the .node file of "
+                       "its vertices",
+                       name);
+    default: return read_plain<d>(in, name);
+  }
+}
+
+template <std::size_t d>
 PointFile<d> read_points_file(const std::string& path, PointFormat format) {
+  if (path == kStandardInput)
+    return read_points<d>(std::cin, kStandardInputName, format == PointFormat::Auto ? PointFormat::Plain : format);
   std::ifstream in = open_input(path);
-  if (format == PointFormat::Auto) format = format_for_path(path);
-  return format == PointFormat::Node ? read_node<d>(in, path) : read_plain<d>(in, path);
+  return read_points<d>(in, path, format);
 }
 
 template <std::size_t d>
@@ -408,22 +608,23 @@ std::vector<Position<d>> locate_points(const PointFile<d>& file, const Box<d>& b
     q[i] = *located;
   }
   // Duplicates: equal located positions. Report the first point, in file order, that repeats
-  // an earlier one.
+  // an earlier one. Sorted by (q, index), each group of equal positions starts with its
+  // smallest index, and its second member is the group's first repeat: one pass, remembering
+  // where the current group starts, finds them all (O(n log n) with any number of copies).
   std::vector<std::size_t> order(n);
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return q[a] != q[b] ? q[a] < q[b] : a < b;
   });
   std::size_t dup = n, orig = n;
-  for (std::size_t k = 1; k < n; ++k) {
-    const std::size_t cur = order[k], prev = order[k - 1];
-    if (q[cur] != q[prev]) continue;
-    // cur repeats the first member of its group (the group's smallest index).
-    std::size_t first = k - 1;
-    while (first > 0 && q[order[first - 1]] == q[cur]) --first;
-    if (cur < dup) {
-      dup = cur;
-      orig = order[first];
+  for (std::size_t k = 1, group = 0; k < n; ++k) {
+    if (q[order[k]] != q[order[k - 1]]) {
+      group = k;
+      continue;
+    }
+    if (k == group + 1 && order[k] < dup) {
+      dup = order[k];
+      orig = order[group];
     }
   }
   if (dup == n) return q;
@@ -605,6 +806,8 @@ CellsFile<d> read_cells_file(const std::string& path) {
 #define DYNMESH_INSTANTIATE_IO(D)                                                                    \
   template PointFile<D> read_node<D>(std::istream&, const std::string&);                             \
   template PointFile<D> read_plain<D>(std::istream&, const std::string&);                            \
+  template PointFile<D> read_poly<D>(std::istream&, const std::string&);                             \
+  template PointFile<D> read_points<D>(std::istream&, const std::string&, PointFormat);              \
   template PointFile<D> read_points_file<D>(const std::string&, PointFormat);                        \
   template std::vector<Position<D>> locate_points<D>(const PointFile<D>&, const Box<D>&);            \
   template std::size_t drop_duplicate_points<D>(PointFile<D>&);                                      \
