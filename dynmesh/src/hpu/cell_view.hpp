@@ -62,11 +62,12 @@ class CellView {
 
   // ---------------------------------------------------------------- filling
 
-  /// Forgets every cell (a new round of some step).
-  /// Forgets every cell for a new round. `parent`: the round this one is nested in (null
-  /// for a step's first round or its run on an empty view). When the view's last run was that
-  /// round's, its complete searches are replayed (see search()).
-  void reset(const void* parent = nullptr) {
+  /// A new round. `parent`: the round this one is nested in (null for a step's first round
+  /// or its run on an empty view). When the view's last run was that round's (it failed and
+  /// issued this one), the view keeps its cells and returns true: the caller adds only this
+  /// round's, and the searches the parent completed are replayed (see search()). Otherwise
+  /// it forgets every cell and returns false.
+  bool reset(const void* parent = nullptr) {
     const bool replay = parent != nullptr && parent == owner_;
     owner_ = nullptr;
     if (replay) {
@@ -81,29 +82,35 @@ class CellView {
     rec_complete_ = 0;
     search_idx_ = 0;
     rep_pos_ = 0;
+    misses_.clear();
+    failed_ = false;
+    if (replay) return true;
     if (++gen_ == 0) {
       for (Slot& s : table_) s.gen = 0;
       gen_ = 1;
     }
     used_ = 0;
     read_.clear();
-    misses_.clear();
-    failed_ = false;
+    settled_ = 0;
+    return false;
   }
 
   /// A cell the step has read, with its value now.
   void add(CellNode* n, const CellState* s) { read_.push_back({n, s}); }
 
   /// After the adds: marks the ancestors of the cells read as leaves or splits as split, and
-  /// those of cells read as absent as "absent below".
+  /// those of cells read as absent as "absent below" (the cells added since the last call).
   void settle() {
-    for (const auto& [n, s] : read_) {
+    const std::span<const std::pair<CellNode*, const CellState*>> fresh(read_.data() + settled_,
+                                                                        read_.size() - settled_);
+    settled_ = read_.size();
+    for (const auto& [n, s] : fresh) {
       Slot& x = slot(n->key);
       x.tag = s->kind == CellState::Leaf ? Tag::Leaf : s->kind == CellState::Split ? Tag::Split : Tag::Absent;
       x.state = s;
       x.node = n;
     }
-    for (const auto& [n, s] : read_) {
+    for (const auto& [n, s] : fresh) {
       if (s->kind == CellState::Absent || n->key.level == 0) continue;
       for (CellKey k = n->key.parent();; k = k.parent()) {
         Slot& x = slot(k);
@@ -114,7 +121,7 @@ class CellView {
         if (k.level == 0) break;
       }
     }
-    for (const auto& [n, s] : read_) {
+    for (const auto& [n, s] : fresh) {
       if (s->kind != CellState::Absent) continue;
       if (n->key.level == 0) throw InvariantError("dynmesh: CellView: the root cell is absent");
       for (CellKey k = n->key.parent();; k = k.parent()) {
@@ -317,14 +324,18 @@ class CellView {
     misses_.push_back(dir_->node(*e_, k));
   }
 
-  /// Cells read as absent below k: ask for the next ancestors of one of them (up to three,
-  /// and not above k), where the leaf that holds it must be.
+  /// Cells read as absent below k: ask for the next unread ancestors of one of them (up to
+  /// three, and not above k), where the leaf that holds it must be.
   void ask_above(const CellKey& k, const CellKey& below) {
-    CellKey a = below.parent();
-    for (int i = 0; i < 3 && a.level >= k.level; ++i) {
-      ask(a);
+    failed_ = true;
+    int asked = 0;
+    for (CellKey a = below.parent(); a.level >= k.level && asked < 3; a = a.parent()) {
+      const Slot* x = find_slot(a);
+      if (!x || x->tag == Tag::Unknown || x->tag == Tag::AbsentBelow || x->tag == Tag::Asked) {
+        ask(a);
+        ++asked;
+      }
       if (a.level == 0) break;
-      a = a.parent();
     }
   }
 
@@ -431,6 +442,7 @@ class CellView {
   std::size_t mask_ = 0, used_ = 0;
   std::uint32_t gen_ = 0;
   std::vector<std::pair<CellNode*, const CellState*>> read_;
+  std::size_t settled_ = 0;  // read_'s prefix settle() has seen
   std::vector<CellNode*> misses_;
   bool failed_ = false;
   std::size_t leaves_read_ = 0;
@@ -479,12 +491,13 @@ struct CellRound {
 
   void operator()(sac::Engine& e, std::span<const CellState* const> vals) const {
     CellView& v = *step.view(e);
-    v.reset(c.head.parent);
+    const bool kept = v.reset(c.head.parent);  // the parent's cells are still in the view
     for (std::uint32_t i = 0; i < c.head.n; ++i) v.add(c.cells[i], vals[i]);
-    for (const CellRoundHead* r = c.head.parent; r; r = r->parent) {
-      CellNode* const* cells = cells_of(r);
-      for (std::uint32_t i = 0; i < r->n; ++i) v.add(cells[i], &e.current(cells[i]->state));
-    }
+    if (!kept)
+      for (const CellRoundHead* r = c.head.parent; r; r = r->parent) {
+        CellNode* const* cells = cells_of(r);
+        for (std::uint32_t i = 0; i < r->n; ++i) v.add(cells[i], &e.current(cells[i]->state));
+      }
     v.settle();
     if (!step.run(e, v)) {
       v.hand_over(&c.head);
