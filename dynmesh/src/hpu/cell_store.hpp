@@ -153,8 +153,9 @@ class CellDirectory {
     return nodes_.size() * (sizeof(CellNode) + sizeof(void*) * 3 + sizeof(CellKey));
   }
 
-  /// The newest values' leaves (the bucket tree after the last run or propagation), in
-  /// (level, x, y) order, each with its vertices' indices in `order` sorted (for tests).
+  /// The newest values' non-empty leaves (the bucket tree after the last run or
+  /// propagation), in (level, x, y) order, each vertex given as index_of(v), sorted: the
+  /// form of BucketTree::leaves(), for tests to compare.
   template <class IndexOf>
   std::vector<BucketLeaf> leaves(IndexOf index_of) const {
     std::vector<BucketLeaf> out;

@@ -18,11 +18,14 @@
 // that suits the search's scale is read itself; above it, its descendants at that level
 // near the focus are read instead (at most 3 × 3), and a cell read as absent (an ancestor
 // is a leaf) makes its next ancestors be read.
-// Invariants: a view's cells are read by the step's enclosing reads, and their values are
-// looked up with Engine::current (no write between: a step writes only in its last round);
-// a failed run writes, allocates and issues nothing but the next round; the answers of a
-// run that did not fail are those of the static tree on the same vertices.
-// Complexity: a round O(cells read × depth) to build the view, plus the step's questions.
+// Invariants: a view's cells are read by the step's enclosing reads. A round that runs right
+// after the one it is nested in keeps that round's view and adds its own cells; any other
+// (a round re-run by change propagation) rebuilds the view, looking the outer rounds' values
+// up with Engine::current (no write between: a step writes only in its last round). A
+// failed run writes, allocates and issues nothing but the next round; the answers of a run
+// that did not fail are those of the static tree on the same vertices. A round replays the
+// searches its parent round completed (same order, same answers) instead of walking cells.
+// Complexity: a round O(new cells × depth) to extend the view, plus the step's questions.
 // Paper: Acar & Hudson, Section 4; Hammer, Acar & Chen (CEAL, 2009) for reads as the unit of
 // re-execution.
 #pragma once

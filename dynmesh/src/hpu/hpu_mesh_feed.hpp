@@ -118,8 +118,8 @@ class HpuMeshFeed {
     try {
       for (const Triangle& t : b->tris_) events_.emplace_back(t, -1);
     } catch (...) {
-      // Out of memory while logging: the feed is lost, the mesh is not. Leave it to the
-      // next take_change's check to notice nothing (the live list stays right).
+      // Out of memory while logging (a destructor must not throw): this update's feed
+      // loses these removals; the live list, and so triangles(), stays right.
     }
   }
 
