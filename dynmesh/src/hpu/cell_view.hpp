@@ -37,6 +37,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include <sac/engine.hpp>
@@ -512,6 +513,7 @@ struct CellRound {
 template <class Step, std::size_t N>
 void issue_round_n(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::span<CellNode* const> misses) {
   static_assert(std::is_standard_layout_v<CellRoundCells<N>>);
+  static_assert(offsetof(CellRoundCells<N>, cells) == offsetof(CellRoundCells<1>, cells));
   CellRound<Step, N> r{{{parent, static_cast<std::uint32_t>(misses.size())}, {}}, step};
   std::array<const sac::Mod<CellState>*, N> mods;
   for (std::size_t i = 0; i < misses.size(); ++i) {
