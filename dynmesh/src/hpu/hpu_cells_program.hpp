@@ -317,8 +317,8 @@ struct HpuCellsProgram {
       // The entry's own list: no tail threads through the round, so a change in one
       // entry's pairs does not change the keys of the (mostly pairless) entries after it.
       sac::Mod<HcPair*>* pd = &ent->pairs;
-      for (const auto& [p, q] : pg->pairs) {
-        HcPair* pc = e.alloc<HcPair>(std::tuple{ent, p, q}, p, q);
+      for (const auto& [a, b] : pg->pairs) {
+        HcPair* pc = e.alloc<HcPair>(std::tuple{ent, a, b}, a, b);
         e.write(*pd, pc);
         pd = &pc->next;
       }
@@ -461,8 +461,8 @@ struct HpuCellsProgram {
     K k;
     CellView* view(sac::Engine&) const { return &pg->view; }
     bool run(sac::Engine& e, CellView& v) const {
-      const auto q = pg->dir->position(x->p);
-      const auto [node, s] = v.locate(q, scale_of(j));
+      const auto at = pg->dir->position(x->p);
+      const auto [node, s] = v.locate(at, scale_of(j));
       if (v.failed()) return false;
       ++pg->steps.done[HcStepCounts::Insert];
       std::array<HV, CellState::kCapacity + 1> items;
