@@ -63,28 +63,18 @@ struct Run {
   detail::HpuCellsProgram program;
 };
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::size_t a = 0;
-  for (;;) {
-    const std::size_t b = s.find(',', a);
-    out.push_back(s.substr(a, b - a));
-    if (b == std::string::npos) return out;
-    a = b + 1;
-  }
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Where the self-adjusting hpu mesh's work goes, step by step"};
-  std::string dists = "spiral,curves,uniform", ns = "1000,4000,16000";
+  std::vector<std::string> dists{"spiral", "curves", "uniform"};
+  std::vector<std::size_t> sizes{1000, 4000, 16000};
   int updates = 20;
   std::uint64_t seed = 1;
   double angle = kHpuDefaultMinAngle;
   bool verify = false;
-  app.add_option("--dist", dists, "distributions, comma-separated");
-  app.add_option("--n", ns, "sizes, comma-separated");
+  app.add_option("--dist", dists, "distributions, comma-separated")->delimiter(',');
+  app.add_option("--n", sizes, "sizes, comma-separated")->delimiter(',');
   app.add_option("--updates", updates, "delete-insert pairs measured");
   app.add_option("--seed", seed, "random seed");
   app.add_option("--angle", angle, "angle bound");
@@ -94,15 +84,14 @@ int main(int argc, char** argv) {
   std::printf("%-8s %7s | %9s %8s %31s %6s %6s | %8s %8s %8s %31s %7s\n", "dist", "n", "events", "B/pt",
               "steps/pt (fc co try ins fin)", "rnd/st", "cl/rnd", "dist", "median", "us", "re-run (fc co try ins fin)",
               "rounds");
-  for (const std::string& dname : split(dists)) {
+  for (const std::string& dname : dists) {
     const auto parsed = parse_distribution(dname);
     if (!parsed) {
       std::fprintf(stderr, "dynmesh_hpu_steps: unknown distribution %s\n", dname.c_str());
       return 2;
     }
     const Distribution dist = *parsed;
-    for (const std::string& nstr : split(ns)) {
-      const std::size_t n = std::stoul(nstr);
+    for (const std::size_t n : sizes) {
       std::vector<Point<2>> pts = generate<2>(dist, n, seed);
       const Box<2> box = derive_box<2>(pts);
       Run run(box, pts, angle);

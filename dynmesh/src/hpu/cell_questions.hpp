@@ -50,6 +50,7 @@
 #include "dynmesh/point.hpp"
 #include "dynmesh/predicates.hpp"
 #include "geometry/delaunay.hpp"  // perturbed_incircle: the twin's tie rule
+#include "hpu/bucket_tree.hpp"     // box_distance2
 #include "hpu/hpu_geometry.hpp"
 
 namespace dynmesh::detail {
@@ -76,12 +77,6 @@ inline constexpr double kSlack = 0x1p-20;
 /// question's radius.
 inline double ulp_room(const Point<2>& p) noexcept { return std::max(std::abs(p[0]), std::abs(p[1])) * 0x1p-40; }
 
-/// The squared distance from c to the box [x0, x1] × [y0, y1] (0 inside).
-inline double box_distance2(const Point<2>& c, double x0, double y0, double x1, double y1) noexcept {
-  const double dx = c[0] < x0 ? x0 - c[0] : c[0] > x1 ? c[0] - x1 : 0.0;
-  const double dy = c[1] < y0 ? y0 - c[1] : c[1] > y1 ? c[1] - y1 : 0.0;
-  return dx * dx + dy * dy;
-}
 }  // namespace cellq
 
 /// One try of a loose pair (the twin's process loop body): what to do next.
@@ -138,7 +133,7 @@ class CellQuestions {
     const double r2 = (r + margin) * (r + margin);
     store_->search_within(
         c, r, scale, margin,
-        [&](double x0, double y0, double x1, double y1) { return cellq::box_distance2(c, x0, y0, x1, y1) <= r2; },
+        [&](double x0, double y0, double x1, double y1) { return BucketTree::box_distance2(c, x0, y0, x1, y1) <= r2; },
         f);
   }
 
@@ -183,7 +178,7 @@ class CellQuestions {
     store_->search(
         p, scale, store_->margin_for(p, 0.0),
         [&](double x0, double y0, double x1, double y1) {
-          return std::sqrt(cellq::box_distance2(p, x0, y0, x1, y1)) <= best;
+          return std::sqrt(BucketTree::box_distance2(p, x0, y0, x1, y1)) <= best;
         },
         [&](V w) {
           if (w != v) best = std::min(best, std::hypot(P_(w)[0] - p[0], P_(w)[1] - p[1]));
@@ -243,7 +238,7 @@ class CellQuestions {
     const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
     const std::size_t before = store_->leaves_read();
     const auto meets = [](double x0, double y0, double x1, double y1, const Point<2>& c, double r) {
-      return cellq::box_distance2(c, x0, y0, x1, y1) <= r * r;
+      return BucketTree::box_distance2(c, x0, y0, x1, y1) <= r * r;
     };
     // The disc of the circle through p and q at height h, widened for rounding.
     const auto disc = [&](double h, Point<2>& c, double& r) {
@@ -417,7 +412,7 @@ class CellQuestions {
       store_->search_within(
           c, r, r, store_->margin_for(c, r),
           [&](double x0, double y0, double x1, double y1) {
-            if (cellq::box_distance2(c, x0, y0, x1, y1) > r * r) return false;
+            if (BucketTree::box_distance2(c, x0, y0, x1, y1) > r * r) return false;
             if (!angle) return true;
             // Outside the angle for certain: every corner right of ca, or every corner left
             // of cb (a reflex angle: both at once).

@@ -146,8 +146,9 @@ class CellDirectory {
     const int s = BucketTree::kMaxLevel - level;
     return CellKey{level, q[0] >> s, q[1] >> s};
   }
+  /// The widening of cells against the rounding of point location (BucketTree's).
+  double margin_for(const Point<2>& c, double r) const noexcept { return grid_.margin_for(c, r); }
   const Box<2>& box() const noexcept { return box_; }
-  std::size_t size() const noexcept { return nodes_.size(); }
   /// Bytes held outside the trace (nodes and the map).
   std::size_t bytes() const noexcept {
     return nodes_.size() * (sizeof(CellNode) + sizeof(void*) * 3 + sizeof(CellKey));
@@ -184,7 +185,7 @@ class CellDirectory {
     out.push_back(std::move(leaf));
   }
 
-  BucketTree grid_;  // only its position() is used
+  BucketTree grid_;  // only its position() and margin_for() are used
   Box<2> box_;
   std::unordered_map<CellKey, CellNode*, CellKeyHash> map_;
   std::deque<CellNode> nodes_;
@@ -256,22 +257,6 @@ class InputCells {
       touched_.push_back(merge_at);
     }
     flush(e);
-  }
-
-  /// The vertex at p's position if present.
-  const CellVertex* at(const Point<2>& p) const {
-    const auto q = dir_->position(p);
-    CellKey k{};
-    for (;;) {
-      const auto it = cells_.find(k);
-      if (it == cells_.end()) return nullptr;
-      if (!it->second.split) {
-        for (const CellVertex* w : it->second.items)
-          if (w->p == p) return w;
-        return nullptr;
-      }
-      k = CellDirectory::cell_at(q, k.level + 1);
-    }
   }
 
   std::size_t size() const noexcept {

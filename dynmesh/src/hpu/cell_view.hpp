@@ -145,7 +145,6 @@ class CellView {
   bool failed() const noexcept { return failed_; }
   std::span<CellNode* const> misses() const noexcept { return misses_; }
   std::size_t leaves_read() const noexcept { return leaves_read_; }
-  std::size_t cells_read() const noexcept { return read_.size(); }
 
   /// What the steps' reads cost so far: rounds issued (read_many events) and cells in them.
   struct Counts {
@@ -157,10 +156,7 @@ class CellView {
     counts_.cells += cells;
   }
 
-  double margin_for(const Point<2>& c, double r) const noexcept {
-    const double mag = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(box_.origin[0]), std::abs(box_.origin[1])});
-    return r * 0x1p-30 + (mag + box_.side) * 0x1p-40;
-  }
+  double margin_for(const Point<2>& c, double r) const noexcept { return dir_->margin_for(c, r); }
 
   /// BucketTree::search on the cells read; `scale` (the search's radius, or the distance it
   /// expects) chooses which cells to ask for when it needs unread ones.
@@ -171,7 +167,7 @@ class CellView {
   template <class Keep, class F>
   void search(const Point<2>& focus, double scale, double margin, Keep&& keep, F&& f) const {
     auto* self = const_cast<CellView*>(this);
-    self->run_search(CellKey{}, focus, scale, margin, keep, f, false, 0.0);
+    self->run_search(focus, scale, margin, keep, f, false, 0.0);
   }
 
   /// search() for a keep() that accepts no cell farther than radius from focus: it starts at
@@ -180,7 +176,7 @@ class CellView {
   template <class Keep, class F>
   void search_within(const Point<2>& focus, double radius, double scale, double margin, Keep&& keep, F&& f) const {
     auto* self = const_cast<CellView*>(this);
-    self->run_search(CellKey{}, focus, std::max(radius, scale), margin, keep, f, true, radius + 3 * margin);
+    self->run_search(focus, std::max(radius, scale), margin, keep, f, true, radius + 3 * margin);
   }
 
   /// After a run that failed: the round `self` recorded its searches for the round it issues.
@@ -255,8 +251,7 @@ class CellView {
   }
 
   template <class Keep, class F>
-  void run_search(CellKey start, const Point<2>& focus, double scale, double margin, Keep& keep, F& f, bool bounded,
-                  double R) {
+  void run_search(const Point<2>& focus, double scale, double margin, Keep& keep, F& f, bool bounded, double R) {
     const std::size_t idx = search_idx_++;
     if (idx < rep_searches_) {
       // Replay: hand out what this search handed out last round, in order.
@@ -278,8 +273,7 @@ class CellView {
       return f(v);
     };
     bool stop = false;
-    if (bounded) start = start_for(focus, R);
-    search_node(start, focus, scale, margin, keep, g, stop);
+    search_node(bounded ? start_for(focus, R) : CellKey{}, focus, scale, margin, keep, g, stop);
     rec_n_.push_back(static_cast<std::uint32_t>(rec_v_.size() - first));
     if (!failed_) ++rec_complete_;
   }
@@ -417,7 +411,7 @@ class CellView {
       cell_box(k, 0.0, kx0, ky0, kx1, ky1);
       if (fx1 < kx0 || fx0 > kx1 || fy1 < ky0 || fy0 > ky1) {
         // Beyond the focus box: scale up to k's distance and try again.
-        s = std::max(s, std::sqrt(cellq::box_distance2(focus, kx0, ky0, kx1, ky1)));
+        s = std::max(s, std::sqrt(BucketTree::box_distance2(focus, kx0, ky0, kx1, ky1)));
         continue;
       }
       const std::uint64_t ax = index(fx0, 0, lo_x, hi_x), bx = index(fx1, 0, lo_x, hi_x);
@@ -478,11 +472,6 @@ inline CellNode* const* cells_of(const CellRoundHead* h) {
   // follow the head at the same offset for every N.
   return reinterpret_cast<const CellRoundCells<1>*>(h)->cells.data();
 }
-
-/// Where the running program keeps its view (one per engine: rounds run one at a time).
-struct CellViewOwner {
-  CellView* view;
-};
 
 template <class Step>
 void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::span<CellNode* const> misses);
@@ -546,7 +535,6 @@ template <class Step>
 void run_step(sac::Engine& e, const Step& step) {
   CellView& v = *step.view(e);
   v.reset();
-  v.settle();
   if (!step.run(e, v)) issue_round(e, step, nullptr, v.misses());
 }
 

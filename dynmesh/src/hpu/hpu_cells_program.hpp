@@ -51,7 +51,6 @@
 
 #include <sac/engine.hpp>
 #include <sac/fn.hpp>
-#include <sac/hash.hpp>
 #include <sac/mod.hpp>
 
 #include "dynmesh/errors.hpp"
@@ -357,13 +356,6 @@ struct HpuCellsProgram {
     HcPair* prev;       // the pair before pc in its entry's list (null: pc is first)
     HcEntry* ent;       // pc's entry
     HcEntry* ent_prev;  // the entry before it (null: ent is first)
-    friend bool operator==(const Ctx&, const Ctx&) = default;
-    std::size_t hash() const noexcept {
-      std::uint64_t h = sac::Hash<HcPair*>{}(pc);
-      h = sac::hash_combine(h, sac::Hash<sac::Mod<HcEntry*>*>{}(bdest));
-      h = sac::hash_combine(h, sac::Hash<HcRound*>{}(rs));
-      return static_cast<std::size_t>(h);
-    }
   };
 
   static void process_entry(sac::Engine& e, HcEntry* nent, HpuCellsProgram* pg, HcClass* cs, HcRound* rs,
@@ -398,7 +390,6 @@ struct HpuCellsProgram {
   struct Splits {
     std::array<std::array<HV, 2>, 4> s{};
     std::uint32_t n = 0;
-    friend bool operator==(const Splits&, const Splits&) = default;
   };
 
   /// One try of the twin's process(p, q, j) loop.

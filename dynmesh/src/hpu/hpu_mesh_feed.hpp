@@ -59,7 +59,6 @@ class HpuMeshFeed {
     return out;
   }
   std::size_t live_count() const noexcept { return live_; }
-  std::size_t blocks() const noexcept { return blocks_; }
   /// Bytes held by the live blocks outside the trace records (their triangle arrays).
   std::size_t bytes() const noexcept { return live_ * sizeof(Triangle); }
 
