@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstdint>
+#include <cstdio>
 #include <memory>
 #include <random>
 #include <span>
@@ -444,4 +445,116 @@ TEST(ReadMany, CurrentOutsideTheComputationIsAUsageError) {
   Engine e;
   e.set(a, 1);
   EXPECT_THROW((void)e.current(a), sac::UsageError);
+}
+
+TEST(ReadMany, PeekSeesTheValueVisibleNowAndRecordsNothing) {
+  Mod<int> a, b, guess, later, out;
+  Engine e;
+  e.set(a, 1);
+  e.set(b, 0);
+  e.set(guess, 5);
+  int runs = 0, before = 0, after = 0;
+  e.run([&](Engine& en) {
+    en.read(a, [&](Engine& x, int v) {
+      ++runs;
+      const int* p = x.peek(later);  // written later in this body: no version visible yet
+      before = p ? *p : -1;
+      x.write(later, v * 10);
+      x.write(out, v + *x.peek(guess));
+      x.read(b, [&](Engine& y, int) { after = *y.peek(later); });  // later in time: seen
+    });
+  });
+  EXPECT_EQ(before, -1);
+  EXPECT_EQ(after, 10);
+  EXPECT_EQ(out.get(), 6);
+
+  e.set(guess, 7);  // peeked, not read: nothing re-runs, so out keeps the old guess
+  e.propagate();
+  EXPECT_EQ(runs, 1);
+  EXPECT_EQ(out.get(), 6);
+
+  e.set(a, 2);  // the re-run undoes its old write first: the peek sees none again
+  e.propagate();
+  EXPECT_EQ(runs, 2);
+  EXPECT_EQ(before, -1);
+  EXPECT_EQ(after, 20);
+  EXPECT_EQ(out.get(), 9);
+  e.check_invariants();
+}
+
+namespace {
+
+// The prefetch pattern: a chain walk through cells[] (each value the next index, -1 ends)
+// learns its cells by peeking, reads them as one read_many, and walks again on the values
+// read; a cell the walk needs that the rounds have not read makes one more nested round.
+constexpr int kChainCells = 12;
+struct ChainWalk {
+  std::array<Mod<int>, kChainCells>* cells;
+  Mod<int>* out;
+  int* rounds;
+  std::uint32_t read_mask = 0;  // the cells this round and the rounds around it read
+  template <class Value>
+  std::pair<int, std::uint32_t> walk(Value value) const {
+    int sum = 0;
+    std::uint32_t need = 0;
+    for (int i = 0, steps = 0; i >= 0 && steps < kChainCells; ++steps) {
+      need |= 1u << i;
+      const int next = value(i);
+      sum += i;
+      i = next;
+    }
+    return {sum, need};
+  }
+  void round(Engine& e) const {
+    ++*rounds;
+    // Values: read ones through current (the enclosing reads depend on them), others peeked.
+    const auto [sum, need] = walk([&](int i) {
+      if (read_mask >> i & 1) return e.current((*cells)[i]);
+      const int* p = e.peek((*cells)[i]);
+      return p ? *p : -1;
+    });
+    const std::uint32_t missing = need & ~read_mask;
+    if (missing == 0) return e.write(*out, sum);
+    std::vector<const Mod<int>*> mods;
+    for (int i = 0; i < kChainCells; ++i)
+      if (missing >> i & 1) mods.push_back(&(*cells)[i]);
+    ChainWalk next = *this;
+    next.read_mask |= missing;
+    e.read_many(std::span<const Mod<int>* const>(mods), [next](Engine& x, Vals) { next.round(x); });
+  }
+};
+
+}  // namespace
+
+TEST(ReadMany, APeekedPrefetchMatchesFromScratchAfterEveryChange) {
+  std::array<Mod<int>, kChainCells> cells;
+  Mod<int> out;
+  Engine e;
+  std::mt19937 rng(20261125);
+  std::printf("seed 20261125\n");
+  std::array<int, kChainCells> v{};
+  for (int i = 0; i < kChainCells; ++i) {
+    v[i] = i + 1 < kChainCells ? i + 1 : -1;
+    e.set(cells[i], v[i]);
+  }
+  int rounds = 0;
+  e.run([&](Engine& en) { ChainWalk{&cells, &out, &rounds}.round(en); });
+  const auto expected = [&] {
+    int sum = 0;
+    for (int i = 0, steps = 0; i >= 0 && steps < kChainCells; ++steps) {
+      sum += i;
+      i = v[i];
+    }
+    return sum;
+  };
+  EXPECT_EQ(out.get(), expected());
+  EXPECT_EQ(rounds, 2);  // one peeking walk, then one round that reads every cell it needs
+  for (int t = 0; t < 200; ++t) {
+    const int i = static_cast<int>(rng() % kChainCells);
+    v[i] = static_cast<int>(rng() % (kChainCells + 1)) - 1;
+    e.set(cells[i], v[i]);
+    e.propagate();
+    ASSERT_EQ(out.get(), expected()) << "change " << t;
+    e.check_invariants();
+  }
 }

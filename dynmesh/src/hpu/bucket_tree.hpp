@@ -140,8 +140,6 @@ class BucketTree {
                      F&& f) const {
     search(focus, margin, keep, f);
   }
-  /// A static tree holds every cell: a question on it never fails.
-  static constexpr bool failed() noexcept { return false; }
 
   /// The widening of cells that keeps every vertex of a cell inside it despite the rounding
   /// of point location, for a query of radius r around c.

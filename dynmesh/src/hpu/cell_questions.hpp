@@ -21,11 +21,9 @@
 // The store is anything with search(focus, scale, margin, keep, f) (nearest-first pruned
 // leaf visits: keep(x0, y0, x1, y1) asked of every cell, stop = f(v) for a leaf's vertices),
 // search_within(focus, radius, scale, margin, keep, f) (the same, keep() bounded by that disc),
-// margin_for(c, r), leaves_read() and failed(). A step's view fails when a question needs a
-// cell the step has not read yet: the answers are then void, but the questions go on, on
-// the cells there are, so that the later ones ask for their cells too (a prefetch: the step
-// reads them all in its next round, cell_view.hpp); nothing throws on a failed view. A
-// static store never fails.
+// margin_for(c, r) and leaves_read(). Every store answers exactly: a step's view
+// (cell_view.hpp) looks a cell the step has not read up as it is now and notes it for the
+// step's next round of reads.
 // Invariants: a question reads nothing but the store; given a store that does not fail, the
 // answers are those of the twin's triangulation on the same vertices (tests/dynmesh/
 // hpu_cells_test.cpp compares meshes on every distribution and angle bound).
@@ -104,7 +102,6 @@ class CellQuestions {
 
   void set_store(const Store& s) noexcept { store_ = &s; }
   const Store& store() const noexcept { return *store_; }
-  bool failed() const noexcept { return store_->failed(); }
   V none() const noexcept { return none_; }
   const Point<2>& pt(V v) const { return P_(v); }
   double apex() const noexcept { return apex_height_; }
@@ -189,7 +186,7 @@ class CellQuestions {
 
   /// Some vertex that v has an edge to in every Delaunay triangulation: the nearest one whose
   /// closed diametral disc with v holds no other vertex (a vertex inside or on that disc is
-  /// strictly nearer, so the search ends). none() when the store failed.
+  /// strictly nearer, so the search ends). none() when v is alone.
   V sure_neighbour(V v, double scale) const {
     const double d = nearest_distance(v, scale);
     if (!std::isfinite(d)) return none_;
@@ -228,7 +225,7 @@ class CellQuestions {
   /// whose circle through p and q lies lowest in the pencil of circles through p and q,
   /// searched among the circles centred at most h_max·|pq| along J(q − p) from pq's
   /// midpoint, smallest first. none() when none lies that low (or the left is outside the
-  /// box, or the store failed).
+  /// box).
   V left_search(V p, V q, double h_max) const {
     ++stats_.neighbour_asks;
     if (outside_left(p, q)) return none_;  // a box edge seen from outside: no triangle there
@@ -278,8 +275,7 @@ class CellQuestions {
             }
             return false;
           });
-      // A failed view does not widen: a larger probe would ask for cells on a void answer.
-      if (best != none_ || h >= h_max || failed()) break;
+      if (best != none_ || h >= h_max) break;
     }
     stats_.leaves_read += store_->leaves_read() - before;
     return best;
@@ -297,7 +293,7 @@ class CellQuestions {
     star_.clear();
     gap_ends_ = 0;
     const V q0 = sure_neighbour(v, scale);
-    if (q0 == none_) return false;  // the store failed
+    if (q0 == none_) return false;  // no other vertex
     const auto h_cap = [&](V a, V b) {
       if (R == std::numeric_limits<double>::infinity()) return R;
       const double half = 0.5 * std::hypot(P_(b)[0] - P_(a)[0], P_(b)[1] - P_(a)[1]);
@@ -315,10 +311,7 @@ class CellQuestions {
         if (t == none_) return End::Gap;
         if (t == q0) return End::Closed;
         if (stop_at_star && std::find(star_.begin(), star_.end(), t) != star_.end()) return End::Met;
-        if (out.size() > 4096) {
-          if (failed()) return End::Gap;
-          throw InvariantError("dynmesh: a star walk that does not close");
-        }
+        if (out.size() > 4096) throw InvariantError("dynmesh: a star walk that does not close");
         out.push_back(t);
         q = t;
       }
@@ -342,7 +335,7 @@ class CellQuestions {
   /// of a lower class has not, the star decides (exact ties at a power of two).
   int first_class(V v, double scale) {
     const double d = nearest_distance(v, scale);
-    if (!std::isfinite(d)) return INT_MAX;  // a failed view that found nothing yet
+    if (!std::isfinite(d)) return INT_MAX;  // no other vertex
     near_.clear();
     visit_disc(P_(v), d * (1 + 0x1p-39) + cellq::ulp_room(P_(v)), [&](V w) {
       if (w != v) near_.push_back(w);
@@ -455,28 +448,25 @@ class CellQuestions {
     // stands in for t (the apex's bits do not depend on it: the frame's scaling is exact).
     const Point<2> tp = t != none_ ? P_(t) : far_corner(a, b);
     const auto [r, was_circumcentre] = off_center(a, b, tp, apex_height_);
-    if (!std::isfinite(r[0]) || !std::isfinite(r[1]) || (t == none_ && was_circumcentre)) {
-      if (failed()) return out;
+    if (!std::isfinite(r[0]) || !std::isfinite(r[1]) || (t == none_ && was_circumcentre))
       throw InvariantError(t == none_ && was_circumcentre ? "dynmesh: cell refiner: a circumcentre from beyond the apex"
                                                           : "dynmesh: a non-finite off-center");
-    }
     const double scale = std::ldexp(1.0, j);
     if (!(r[0] >= lo_[0] && r[0] <= hi_[0] && r[1] >= lo_[1] && r[1] <= hi_[1])) {
       const auto [s, x] = side_crossed(box_, a, b, r);
       const auto e = side_edge(s, x, scale, false);
-      if (failed() || !e) return out;
+      if (!e) return out;
       out.kind = CellDecision<V>::Split;
       out.splits.push_back(*e);
       return out;
     }
     const bool taken = find(r, scale).has_value();
-    if (taken && !failed())
+    if (taken)
       throw InputError(InputError::Kind::Resolution, "an off-center falls on the vertex " + format_exact(r[0]) + " " +
                                                          format_exact(r[1]) +
                                                          ": the spread is beyond the mesh's resolution");
     for (int s = 0; s < 4; ++s)
       if (const auto e = encroached_edge(s, r, scale)) out.splits.push_back(*e);
-    if (failed()) return out;
     if (!out.splits.empty()) {
       std::sort(out.splits.begin(), out.splits.end(), [&](const auto& x, const auto& y) {
         return pair_less(P_(x[0]), P_(x[1]), P_(y[0]), P_(y[1]));
@@ -547,7 +537,6 @@ class CellQuestions {
           });
     };
     scan(-std::numeric_limits<double>::infinity(), false);
-    if (failed()) return std::nullopt;
     if (holding) {
       if (below == none_ || above == none_ || !(P_(below)[along] < x)) return std::nullopt;
       return std::array<V, 2>{below, above};
@@ -557,7 +546,7 @@ class CellQuestions {
       above = below;
       below = none_;
       scan(-std::numeric_limits<double>::infinity(), true);
-      if (failed() || below == none_) return std::nullopt;
+      if (below == none_) return std::nullopt;
       return std::array<V, 2>{below, above};
     }
     if (below == none_) throw InvariantError("dynmesh: a side crossing before the side's first corner");

@@ -3,29 +3,28 @@
 //
 // Purpose: a step (a vertex's first class, an entry's collect, one try of a pair, a leaf's
 // final triangles) runs the static questions of cell_questions.hpp on a CellView. The view
-// holds the cells the step has read and answers searches from them; a search that needs a
-// cell the step has not read records it as missing and fails, and every later question of
-// the step then returns at once. run_step() then reads the missing cells, as one
-// Engine::read_many (one trace event, up to 16 cells), nested in the reads before, and runs
-// the step again on the larger view; the round that fails nothing does the step's writes.
-// So a step costs a few events, whatever the number of vertices it looks at, and it re-runs
-// only when a cell it read changes (cut-off: a write of an equal vertex set is no change).
-// Which cells a search asks for: the view walks the tree from the root, like BucketTree's
-// search. An ancestor of a cell read as a leaf or split is split (the tree grows only), so
-// the step never reads the coarse cells above its region. A failed view keeps answering on
-// the cells it has (cell_questions.hpp), so one round asks for the cells of several questions
-// (at most 16, one read_many). An unread cell below the level
-// that suits the search's scale is read itself; above it, its descendants at that level
-// near the focus are read instead (at most 3 × 3), and a cell read as absent (an ancestor
-// is a leaf) makes its next ancestors be read.
-// Invariants: a view's cells are read by the step's enclosing reads. A round that runs right
-// after the one it is nested in keeps that round's view and adds its own cells; any other
-// (a round re-run by change propagation) rebuilds the view, looking the outer rounds' values
-// up with Engine::current (no write between: a step writes only in its last round). A
-// failed run writes, allocates and issues nothing but the next round; the answers of a run
-// that did not fail are those of the static tree on the same vertices. A round replays the
-// searches its parent round completed (same order, same answers) instead of walking cells.
-// Complexity: a round O(new cells × depth) to extend the view, plus the step's questions.
+// holds the cells the step has read and answers searches from them. A cell it has not read
+// is looked up with Engine::peek (its value now, recorded nothing), so every answer is
+// exact, and the cell becomes pending: the run "fails" and must not act. run_step() then
+// reads the pending cells as one Engine::read_many (one trace event, up to 16 cells), nested
+// in the reads before, and runs the step again; that run replays the searches from what they
+// handed out and does the step's writes. So a step is one read of exactly the cells its
+// answers depend on (1.01 rounds per step measured: bench/RESULTS.md), and it re-runs only
+// when one of them changes (cut-off: a write of an equal vertex set is no change).
+// Which cells a step depends on: the leaves a search hands vertices from, a split cell whose
+// children it all prunes, and the leaf an insertion locates. The leaves tile the region the
+// search covers, so any change there (a vertex, a split, a merge) changes one of them; the
+// cells above them are split, implied by the leaves. A bounded search starts at the deepest
+// cell holding its disc that is present now (a binary search over the levels).
+// Invariants: a view's read cells are read by the step's enclosing reads; a run that did
+// not fail used no cell beyond them. A round that runs right after the run it was issued by
+// keeps that run's view, peeked cells included (no write between: a step writes only in its
+// last run); any other (a round re-run by change propagation) rebuilds the view, looking the
+// outer rounds' values up with Engine::current. A failed run writes, allocates and issues
+// nothing but the next round; a run that did not fail answers as the static tree on the same
+// vertices.
+// Complexity: a step's questions once on peeked cells (each peek a directory lookup and a
+// version walk), then once more replayed; O(1) cells per question in a graded mesh.
 // Paper: Acar & Hudson, Section 4; Hammer, Acar & Chen (CEAL, 2009) for reads as the unit of
 // re-execution.
 #pragma once
@@ -66,29 +65,28 @@ class CellView {
 
   // ---------------------------------------------------------------- filling
 
-  /// A new round. `parent`: the round this one is nested in (null for a step's first round
-  /// or its run on an empty view). When the view's last run was that round's (it failed and
-  /// issued this one), the view keeps its cells and returns true: the caller adds only this
-  /// round's, and the searches the parent completed are replayed (see search()). Otherwise
-  /// it forgets every cell and returns false.
-  bool reset(const void* parent = nullptr) {
-    const bool replay = parent != nullptr && parent == owner_;
+  /// A new round. `parent`: the round this one is nested in (null for a step's first run).
+  /// When the view's last run was that round's (it needed cells and issued this one), the
+  /// view keeps its cells, peeked ones included (no write between), and returns true: the
+  /// caller adds only this round's, and the parent's searches are replayed (see search()).
+  /// Otherwise it forgets every cell and returns false.
+  bool reset(const void* parent = nullptr, std::uint32_t serial = 0) {
+    const bool replay = parent != nullptr ? parent == owner_ : serial != 0 && serial == owner_serial_;
     owner_ = nullptr;
+    owner_serial_ = 0;
     if (replay) {
       rep_v_.swap(rec_v_);
       rep_n_.swap(rec_n_);
-      rep_searches_ = rec_complete_;
+      rep_searches_ = rec_n_.size();
     } else {
       rep_searches_ = 0;
     }
     rec_v_.clear();
     rec_n_.clear();
-    rec_complete_ = 0;
     search_idx_ = 0;
     rep_pos_ = 0;
-    misses_.clear();
-    failed_ = false;
     if (replay) return true;
+    pending_.clear();
     if (++gen_ == 0) {
       for (Slot& s : table_) s.gen = 0;
       gen_ = 1;
@@ -102,48 +100,42 @@ class CellView {
   /// A cell the step has read, with its value now.
   void add(CellNode* n, const CellState* s) { read_.push_back({n, s}); }
 
-  /// After the adds: marks the ancestors of the cells read as leaves or splits as split, and
-  /// those of cells read as absent as "absent below" (the cells added since the last call).
+  /// After the adds: the cells added since the last call become read, and so do their
+  /// ancestors, as splits (a read leaf or split has a split parent); the cells still
+  /// pending are those no round has read yet.
   void settle() {
     const std::span<const std::pair<CellNode*, const CellState*>> fresh(read_.data() + settled_,
                                                                         read_.size() - settled_);
     settled_ = read_.size();
     for (const auto& [n, s] : fresh) {
       Slot& x = slot(n->key);
-      x.tag = s->kind == CellState::Leaf ? Tag::Leaf : s->kind == CellState::Split ? Tag::Split : Tag::Absent;
+      x.tag = tag_of(s);
       x.state = s;
       x.node = n;
+      x.read = true;
     }
     for (const auto& [n, s] : fresh) {
       if (s->kind == CellState::Absent || n->key.level == 0) continue;
       for (CellKey k = n->key.parent();; k = k.parent()) {
         Slot& x = slot(k);
-        if (x.tag == Tag::Split) break;
-        if (x.tag == Tag::Leaf || x.tag == Tag::Absent)
+        if (x.read && x.tag == Tag::Split) break;
+        if (x.read && x.tag != Tag::Unknown)
           throw InvariantError("dynmesh: CellView: a cell read below a leaf or an absent cell");
         x.tag = Tag::Split;
+        x.read = true;
         if (k.level == 0) break;
       }
     }
-    for (const auto& [n, s] : fresh) {
-      if (s->kind != CellState::Absent) continue;
-      if (n->key.level == 0) throw InvariantError("dynmesh: CellView: the root cell is absent");
-      for (CellKey k = n->key.parent();; k = k.parent()) {
-        Slot& x = slot(k);
-        if (x.tag != Tag::Unknown && x.tag != Tag::AbsentBelow) break;
-        if (x.tag == Tag::Unknown) {
-          x.tag = Tag::AbsentBelow;
-          x.below = n->key;
-        }
-        if (k.level == 0) break;
-      }
-    }
+    std::erase_if(pending_, [&](CellNode* n) { return find_slot(n->key)->read; });
   }
 
   // ---------------------------------------------------------------- the store interface
 
-  bool failed() const noexcept { return failed_; }
-  std::span<CellNode* const> misses() const noexcept { return misses_; }
+  /// Did the last run need a cell that no round of the step has read? Its answers are
+  /// exact all the same (the cell was peeked), but it must not act on them: its next round
+  /// reads pending().
+  bool failed() const noexcept { return !pending_.empty(); }
+  std::span<CellNode* const> pending() const noexcept { return pending_; }
   std::size_t leaves_read() const noexcept { return leaves_read_; }
 
   /// What the steps' reads cost so far: rounds issued (read_many events) and cells in them.
@@ -158,61 +150,42 @@ class CellView {
 
   double margin_for(const Point<2>& c, double r) const noexcept { return dir_->margin_for(c, r); }
 
-  /// BucketTree::search on the cells read; `scale` (the search's radius, or the distance it
-  /// expects) chooses which cells to ask for when it needs unread ones.
-  /// A step's questions ask the same searches in the same order in every round until the
-  /// first one that failed (they are pure functions of the searches' answers), and a search
-  /// that did not fail saw every cell it needed; so in the next round such a search is
-  /// replayed from what it handed out, without walking the cells.
+  /// BucketTree::search on the cells as they are now. A step's questions ask the same
+  /// searches in the same order in every round (they are pure functions of the answers, and
+  /// the answers are exact), so in a kept view each search of the round before is replayed
+  /// from what it handed out, without walking the cells. `scale` is not used (the interface
+  /// of cell_questions.hpp).
   template <class Keep, class F>
-  void search(const Point<2>& focus, double scale, double margin, Keep&& keep, F&& f) const {
+  void search(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f) const {
     auto* self = const_cast<CellView*>(this);
-    self->run_search(focus, scale, margin, keep, f, false, 0.0);
+    self->run_search(focus, margin, keep, f, false, 0.0);
   }
 
   /// search() for a keep() that accepts no cell farther than radius from focus: it starts at
-  /// the smallest cell read (or known split) that holds that disc's box, not at the root.
-  /// `scale` (at least the radius) chooses which cells to ask for.
+  /// the smallest cell holding that disc's box, not at the root.
   template <class Keep, class F>
-  void search_within(const Point<2>& focus, double radius, double scale, double margin, Keep&& keep, F&& f) const {
+  void search_within(const Point<2>& focus, double radius, double /*scale*/, double margin, Keep&& keep,
+                     F&& f) const {
     auto* self = const_cast<CellView*>(this);
-    self->run_search(focus, std::max(radius, scale), margin, keep, f, true, radius + 3 * margin);
+    self->run_search(focus, margin, keep, f, true, radius + 3 * margin);
   }
 
-  /// After a run that failed: the round `self` recorded its searches for the round it issues.
+  /// After a run that needed cells: the round `self` recorded its searches for the round it
+  /// issues.
   void hand_over(const void* self) noexcept { owner_ = self; }
-
-  /// The leaf that holds grid position q, and its value; null when a cell is missing.
-  std::pair<CellNode*, const CellState*> locate(const std::array<std::uint64_t, 2>& q, double scale) {
-    CellKey k{};
-    for (;;) {
-      Slot& x = slot(k);
-      if (x.tag == Tag::Leaf) return {x.node, x.state};
-      if (x.tag == Tag::Split) {
-        k = CellDirectory::cell_at(q, k.level + 1);
-        continue;
-      }
-      if (x.tag == Tag::Absent) throw InvariantError("dynmesh: CellView: located into an absent cell");
-      failed_ = true;
-      if (x.tag == Tag::AbsentBelow) {
-        ask_above(k, x.below);
-      } else {
-        const int g = level_for(scale);
-        ask(g <= k.level ? k : CellDirectory::cell_at(q, g));
-      }
-      return {nullptr, nullptr};
-    }
+  /// The same after a step's first run: its first round names the run by the serial.
+  std::uint32_t hand_over_root() noexcept {
+    if (++serial_ == 0) serial_ = 1;
+    return owner_serial_ = serial_;
   }
 
-  // ---------------------------------------------------------------- helpers
-
-  /// The level whose cells are at least 2·scale wide (so a disc of radius scale meets at
-  /// most 2 × 2 of them).
-  int level_for(double scale) const noexcept {
-    if (!(scale > 0)) return BucketTree::kMaxLevel;
-    const double ratio = box_.side / (2 * scale);
-    if (!(ratio >= 1)) return 0;
-    return std::min(BucketTree::kMaxLevel, std::ilogb(ratio));
+  /// The leaf that holds grid position q, and its value (pending when unread).
+  std::pair<CellNode*, const CellState*> locate(const std::array<std::uint64_t, 2>& q, double /*scale*/) {
+    const CellKey k = deepest_present(CellDirectory::cell_at(q, BucketTree::kMaxLevel));
+    Slot& x = resolve(k);
+    if (x.tag != Tag::Leaf) throw InvariantError("dynmesh: CellView: a position with no leaf");
+    touch(x);
+    return {x.node, x.state};
   }
 
   /// A cell's box, widened by margin.
@@ -223,15 +196,22 @@ class CellView {
   }
 
  private:
-  enum class Tag : std::uint8_t { Unknown, Leaf, Split, Absent, AbsentBelow, Asked };
+  // Unknown: not looked at in this view; otherwise the cell's state now, read or peeked.
+  enum class Tag : std::uint8_t { Unknown, Leaf, Split, Absent };
   struct Slot {
     std::uint32_t gen = 0;
     Tag tag = Tag::Unknown;
+    bool read = false;     // a round of the step read it (or read a cell below it)
+    bool pending = false;  // a search used it unread: in pending_
     CellKey key;
-    CellKey below;  // AbsentBelow: a cell read as absent under this one
     const CellState* state = nullptr;
     CellNode* node = nullptr;
   };
+
+  static Tag tag_of(const CellState* s) noexcept {
+    if (!s || s->kind == CellState::Absent) return Tag::Absent;
+    return s->kind == CellState::Leaf ? Tag::Leaf : Tag::Split;
+  }
 
   Slot& slot(const CellKey& k) {
     if (2 * (used_ + 1) > table_.size()) grow();
@@ -240,6 +220,8 @@ class CellView {
       if (s.gen != gen_) {
         s.gen = gen_;
         s.tag = Tag::Unknown;
+        s.read = false;
+        s.pending = false;
         s.key = k;
         s.state = nullptr;
         s.node = nullptr;
@@ -250,8 +232,54 @@ class CellView {
     }
   }
 
+  const Slot* find_slot(const CellKey& k) const {
+    for (std::size_t i = k.hash() & mask_;; i = (i + 1) & mask_) {
+      const Slot& s = table_[i];
+      if (s.gen != gen_) return nullptr;
+      if (s.key == k) return &s;
+    }
+  }
+
+  /// k's slot, its state looked up now if the view does not know it: a peek, which records
+  /// nothing (the runtime's guess for a prefetch); a search that uses the cell makes it
+  /// pending, and the step reads it before it acts.
+  Slot& resolve(const CellKey& k) {
+    Slot& x = slot(k);
+    if (x.tag == Tag::Unknown) {
+      CellNode* n = dir_->find(k);
+      const CellState* s = n ? e_->peek(n->state) : nullptr;
+      x.tag = tag_of(s);
+      x.state = s;
+      x.node = n;
+    }
+    return x;
+  }
+
+  void touch(Slot& x) {
+    if (x.read || x.pending) return;
+    x.pending = true;
+    pending_.push_back(x.node);
+  }
+
+  /// The deepest cell on k's path to the root that is not absent (a leaf or a split): a
+  /// binary search over the levels, since the path is split cells, then the leaf, then
+  /// absent ones.
+  CellKey deepest_present(const CellKey& k) {
+    int lo = 0, hi = k.level;  // the root is present
+    while (lo < hi) {
+      const int mid = (lo + hi + 1) / 2;
+      const int s = k.level - mid;
+      if (resolve(CellKey{mid, k.ix >> s, k.iy >> s}).tag != Tag::Absent)
+        lo = mid;
+      else
+        hi = mid - 1;
+    }
+    const int s = k.level - lo;
+    return CellKey{lo, k.ix >> s, k.iy >> s};
+  }
+
   template <class Keep, class F>
-  void run_search(const Point<2>& focus, double scale, double margin, Keep& keep, F& f, bool bounded, double R) {
+  void run_search(const Point<2>& focus, double margin, Keep& keep, F& f, bool bounded, double R) {
     const std::size_t idx = search_idx_++;
     if (idx < rep_searches_) {
       // Replay: hand out what this search handed out last round, in order.
@@ -264,7 +292,6 @@ class CellView {
         if (f(vs[handed++])) break;
       }
       rec_n_.push_back(handed);
-      if (!failed_) ++rec_complete_;
       return;
     }
     const std::size_t first = rec_v_.size();
@@ -273,31 +300,16 @@ class CellView {
       return f(v);
     };
     bool stop = false;
-    search_node(bounded ? start_for(focus, R) : CellKey{}, focus, scale, margin, keep, g, stop);
+    search_node(bounded ? start_for(focus, R) : CellKey{}, focus, margin, keep, g, stop);
     rec_n_.push_back(static_cast<std::uint32_t>(rec_v_.size() - first));
-    if (!failed_) ++rec_complete_;
   }
 
-  /// The deepest cell holding the box [focus ± R] whose state the view knows (leaf or split),
-  /// else the root.
+  /// The deepest present cell holding the box [focus ± R].
   CellKey start_for(const Point<2>& focus, double R) {
     const auto a = dir_->position(Point<2>{focus[0] - R, focus[1] - R});
     const auto b = dir_->position(Point<2>{focus[0] + R, focus[1] + R});
     const int diff = std::max(std::bit_width(a[0] ^ b[0]), std::bit_width(a[1] ^ b[1]));
-    CellKey k = CellDirectory::cell_at(a, BucketTree::kMaxLevel - diff);
-    for (; k.level > 0; k = k.parent()) {
-      const Slot* x = find_slot(k);
-      if (x && (x->tag == Tag::Split || x->tag == Tag::Leaf)) return k;
-    }
-    return CellKey{};
-  }
-
-  const Slot* find_slot(const CellKey& k) const {
-    for (std::size_t i = k.hash() & mask_;; i = (i + 1) & mask_) {
-      const Slot& s = table_[i];
-      if (s.gen != gen_) return nullptr;
-      if (s.key == k) return &s;
-    }
+    return deepest_present(CellDirectory::cell_at(a, BucketTree::kMaxLevel - diff));
   }
 
   void grow() {
@@ -312,40 +324,19 @@ class CellView {
     }
   }
 
-  void ask(const CellKey& k) {
-    failed_ = true;
-    if (misses_.size() >= kCellsPerRead) return;  // one round reads no more
-    Slot& x = slot(k);
-    if (x.tag == Tag::Asked) return;
-    if (x.tag != Tag::Unknown && x.tag != Tag::AbsentBelow) return;  // read already
-    x.tag = Tag::Asked;
-    misses_.push_back(dir_->node(*e_, k));
-  }
-
-  /// Cells read as absent below k: ask for the next unread ancestors of one of them (up to
-  /// three, and not above k), where the leaf that holds it must be.
-  void ask_above(const CellKey& k, const CellKey& below) {
-    failed_ = true;
-    int asked = 0;
-    for (CellKey a = below.parent(); a.level >= k.level && asked < 3; a = a.parent()) {
-      const Slot* x = find_slot(a);
-      if (!x || x->tag == Tag::Unknown || x->tag == Tag::AbsentBelow || x->tag == Tag::Asked) {
-        ask(a);
-        ++asked;
-      }
-      if (a.level == 0) break;
-    }
-  }
-
+  /// A search's visit of k. Its answers depend on the leaves it hands vertices from, and on
+  /// a split cell whose children it all prunes; those cells are used (touched). Every other
+  /// cell it passes is an ancestor of a used one, known split through it.
   template <class Keep, class F>
-  void search_node(const CellKey& k, const Point<2>& focus, double scale, double margin, Keep& keep, F& f, bool& stop) {
+  void search_node(const CellKey& k, const Point<2>& focus, double margin, Keep& keep, F& f, bool& stop) {
     double x0, y0, x1, y1;
     cell_box(k, margin, x0, y0, x1, y1);
     if (!keep(x0, y0, x1, y1)) return;
-    Slot& x = slot(k);
+    Slot& x = resolve(k);
     switch (x.tag) {
       case Tag::Leaf: {
         ++leaves_read_;
+        touch(x);
         const CellState& s = *x.state;
         for (std::size_t i = 0; i < s.count; ++i)
           if (f(s.items[i])) {
@@ -358,6 +349,7 @@ class CellView {
         // Children nearest to the focus first (by their centres' distance), as BucketTree.
         // The child holding the focus's side in x and y first, then its x neighbour, its y
         // neighbour, and the opposite one: nearest first for the four equal squares.
+        const std::size_t before = leaves_read_;
         const double w = width_[k.level];
         const double mx = box_.origin[0] + (static_cast<double>(k.ix) + 0.5) * w;
         const double my = box_.origin[1] + (static_cast<double>(k.iy) + 0.5) * w;
@@ -367,69 +359,16 @@ class CellView {
         const unsigned order[4] = {near, near ^ (x_first ? 2u : 1u), near ^ (x_first ? 1u : 2u), near ^ 3u};
         for (const unsigned c : order) {
           if (stop) return;
-          search_node(k.child(c), focus, scale, margin, keep, f, stop);
+          search_node(k.child(c), focus, margin, keep, f, stop);
         }
+        if (leaves_read_ == before) touch(slot(k));  // x may have moved (the table grew)
         return;
       }
       case Tag::Absent:
         throw InvariantError("dynmesh: CellView: an absent cell under a split one");
-      case Tag::Asked:
-        failed_ = true;
-        return;
-      case Tag::AbsentBelow:
-        ask_above(k, x.below);
-        return;
       case Tag::Unknown:
-        ask_for(k, focus, scale, margin, keep);
-        return;
+        break;
     }
-  }
-
-  /// k is unread and the search needs it: read it if it is at the search's level or finer;
-  /// otherwise read its cells of that level near the focus that the search keeps.
-  template <class Keep>
-  void ask_for(const CellKey& k, const Point<2>& focus, double scale, double margin, Keep& keep) {
-    failed_ = true;
-    double s = scale;
-    for (int attempt = 0; attempt < 2; ++attempt) {
-      const int g = level_for(s);
-      if (g <= k.level) return ask(k);
-      const int shift = g - k.level;
-      const double w = width_[g];
-      const double R = 2 * s + margin;
-      const auto index = [&](double x, unsigned a, std::uint64_t lo, std::uint64_t hi) -> std::uint64_t {
-        const double u = std::floor((x - box_.origin[a]) / w);
-        if (!(u > static_cast<double>(lo))) return lo;
-        if (!(u < static_cast<double>(hi))) return hi;
-        return static_cast<std::uint64_t>(u);
-      };
-      const std::uint64_t lo_x = k.ix << shift, hi_x = ((k.ix + 1) << shift) - 1;
-      const std::uint64_t lo_y = k.iy << shift, hi_y = ((k.iy + 1) << shift) - 1;
-      // The focus box clamped to k: empty when k lies beyond it.
-      const double fx0 = focus[0] - R, fx1 = focus[0] + R, fy0 = focus[1] - R, fy1 = focus[1] + R;
-      double kx0, ky0, kx1, ky1;
-      cell_box(k, 0.0, kx0, ky0, kx1, ky1);
-      if (fx1 < kx0 || fx0 > kx1 || fy1 < ky0 || fy0 > ky1) {
-        // Beyond the focus box: scale up to k's distance and try again.
-        s = std::max(s, std::sqrt(BucketTree::box_distance2(focus, kx0, ky0, kx1, ky1)));
-        continue;
-      }
-      const std::uint64_t ax = index(fx0, 0, lo_x, hi_x), bx = index(fx1, 0, lo_x, hi_x);
-      const std::uint64_t ay = index(fy0, 1, lo_y, hi_y), by = index(fy1, 1, lo_y, hi_y);
-      bool any = false;
-      for (std::uint64_t iy = ay; iy <= by; ++iy)
-        for (std::uint64_t ix = ax; ix <= bx; ++ix) {
-          const CellKey c{g, ix, iy};
-          double c0, c1, c2, c3;
-          cell_box(c, margin, c0, c1, c2, c3);
-          if (!keep(c0, c1, c2, c3)) continue;
-          ask(c);
-          any = true;
-        }
-      if (any) return;
-      break;
-    }
-    ask(k);
   }
 
   sac::Engine* e_;
@@ -441,15 +380,16 @@ class CellView {
   std::uint32_t gen_ = 0;
   std::vector<std::pair<CellNode*, const CellState*>> read_;
   std::size_t settled_ = 0;  // read_'s prefix settle() has seen
-  std::vector<CellNode*> misses_;
-  bool failed_ = false;
+  std::vector<CellNode*> pending_;
   std::size_t leaves_read_ = 0;
   Counts counts_;
   // Search replay (search()): this round's record, and the last round's to replay.
-  const void* owner_ = nullptr;  // the round whose record rec_ holds, after it failed
+  const void* owner_ = nullptr;    // the round whose record rec_ holds, after it failed
+  std::uint32_t owner_serial_ = 0;  // or the step's first run, by its serial
+  std::uint32_t serial_ = 0;
   std::vector<const CellVertex*> rec_v_, rep_v_;
   std::vector<std::uint32_t> rec_n_, rep_n_;
-  std::size_t rec_complete_ = 0, rep_searches_ = 0, search_idx_ = 0, rep_pos_ = 0;
+  std::size_t rep_searches_ = 0, search_idx_ = 0, rep_pos_ = 0;
 };
 
 // -------------------------------------------------------------------- rounds of reads
@@ -459,6 +399,7 @@ class CellView {
 struct CellRoundHead {
   const CellRoundHead* parent;
   std::uint32_t n;
+  std::uint32_t serial;  // a first round: its step's run that issued it (CellView::hand_over)
 };
 
 template <std::size_t N>
@@ -474,7 +415,8 @@ inline CellNode* const* cells_of(const CellRoundHead* h) {
 }
 
 template <class Step>
-void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::span<CellNode* const> misses);
+void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::uint32_t serial,
+                 std::span<CellNode* const> misses);
 
 /// One round of a step: reads its cells, then runs the step on the view of all its rounds.
 template <class Step, std::size_t N>
@@ -484,7 +426,7 @@ struct CellRound {
 
   void operator()(sac::Engine& e, std::span<const CellState* const> vals) const {
     CellView& v = *step.view(e);
-    const bool kept = v.reset(c.head.parent);  // the parent's cells are still in the view
+    const bool kept = v.reset(c.head.parent, c.head.serial);  // the view before is still there
     for (std::uint32_t i = 0; i < c.head.n; ++i) v.add(c.cells[i], vals[i]);
     if (!kept)
       for (const CellRoundHead* r = c.head.parent; r; r = r->parent) {
@@ -494,16 +436,17 @@ struct CellRound {
     v.settle();
     if (!step.run(e, v)) {
       v.hand_over(&c.head);
-      issue_round(e, step, &c.head, v.misses());
+      issue_round(e, step, &c.head, 0, v.pending());
     }
   }
 };
 
 template <class Step, std::size_t N>
-void issue_round_n(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::span<CellNode* const> misses) {
+void issue_round_n(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::uint32_t serial,
+                   std::span<CellNode* const> misses) {
   static_assert(std::is_standard_layout_v<CellRoundCells<N>>);
   static_assert(offsetof(CellRoundCells<N>, cells) == offsetof(CellRoundCells<1>, cells));
-  CellRound<Step, N> r{{{parent, static_cast<std::uint32_t>(misses.size())}, {}}, step};
+  CellRound<Step, N> r{{{parent, static_cast<std::uint32_t>(misses.size()), serial}, {}}, step};
   std::array<const sac::Mod<CellState>*, N> mods;
   for (std::size_t i = 0; i < misses.size(); ++i) {
     r.c.cells[i] = misses[i];
@@ -513,18 +456,21 @@ void issue_round_n(sac::Engine& e, const Step& step, const CellRoundHead* parent
 }
 
 template <class Step>
-void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::span<CellNode* const> misses) {
+void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::uint32_t serial,
+                 std::span<CellNode* const> misses) {
   if (misses.empty()) throw InvariantError("dynmesh: a step failed without a missing cell");
   if (misses.size() > kCellsPerRead) misses = misses.first(kCellsPerRead);  // the rest next round
   step.view(e)->count_round(misses.size());
-  if (misses.size() <= 2) return issue_round_n<Step, 2>(e, step, parent, misses);
-  if (misses.size() <= 4) return issue_round_n<Step, 4>(e, step, parent, misses);
-  if (misses.size() <= 8) return issue_round_n<Step, 8>(e, step, parent, misses);
-  issue_round_n<Step, kCellsPerRead>(e, step, parent, misses);
+  if (misses.size() <= 2) return issue_round_n<Step, 2>(e, step, parent, serial, misses);
+  if (misses.size() <= 4) return issue_round_n<Step, 4>(e, step, parent, serial, misses);
+  if (misses.size() <= 8) return issue_round_n<Step, 8>(e, step, parent, serial, misses);
+  issue_round_n<Step, kCellsPerRead>(e, step, parent, serial, misses);
 }
 
-/// Runs a step: step.run(e, view) on an empty view (it fails at its first question), then
-/// on the cells it asked for, round after round, until a run does not fail. Step: copyable
+/// Runs a step: step.run(e, view) on an empty view, which peeks at every cell the step's
+/// questions use and so fails (unless they use none); then, round after round, on the
+/// cells it used, read, until a run does not fail (one round when it uses at most 16 cells,
+/// and its first round replays its searches). Step: copyable
 /// (it is each round's closure), with CellView* view(Engine&) and bool run(Engine&,
 /// CellView&). run returns false when the view failed, and has then written, allocated and
 /// issued nothing; otherwise it does the step's effects, in this order: writes and
@@ -535,7 +481,7 @@ template <class Step>
 void run_step(sac::Engine& e, const Step& step) {
   CellView& v = *step.view(e);
   v.reset();
-  if (!step.run(e, v)) issue_round(e, step, nullptr, v.misses());
+  if (!step.run(e, v)) issue_round(e, step, nullptr, v.hand_over_root(), v.pending());
 }
 
 }  // namespace dynmesh::detail

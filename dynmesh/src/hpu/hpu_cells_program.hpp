@@ -515,9 +515,9 @@ struct HpuCellsProgram {
       for (std::size_t i = 0; i < s.count; ++i) {
         HV a = s.items[i];
         pg->q.triangles_of(a, scale, pg->tris);
-        if (v.failed()) return false;
         for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
       }
+      if (v.failed()) return false;
       ++pg->steps.done[HcStepCounts::Final];
       if (!pg->block.empty()) e.make<HpuTriBlock>(pg->feed, std::span<const Triangle>(pg->block));
       return true;

@@ -17,6 +17,8 @@
 //                           propagated, execution jumps to its end).
 //   rt.memo_read(m, fn)     read(m, fn) memoized on (m, fn) with no extra record.
 //   rt.read_many(ms, body)  k nested reads as one record and one interval: body(values).
+//   rt.current(m)           the value of m an enclosing read already depends on, unrecorded.
+//   rt.peek(m)              the value of m visible now, unrecorded: a guess for a prefetch.
 //
 // Execution is trampolined, so deep recursion (a read chain a million long) never grows the
 // C++ stack: read/memo_read/memo calls are recorded when issued and run after the issuing
@@ -154,6 +156,15 @@ class Engine {
   /// UsageError if m has no value now.
   template <class T>
   const T& current(const Mod<T>& m);
+
+  /// The value of m visible now, or null when m has no version visible now (a modifiable
+  /// made with init_default then has the value T{}). Records nothing and makes nothing, so
+  /// it is a guess, never a dependency: a body may use it only to choose which modifiables
+  /// to read, and its effects must depend on the values it reads. The use is a prefetch: a
+  /// search runs on the values visible now to learn which cells it needs, then reads them
+  /// all as one read_many. O(versions of m newer than now).
+  template <class T>
+  const T* peek(const Mod<T>& m);
 
   /// Adds a version of m holding value at the current time; readers later in the trace see
   /// it. A write equal to the value it replaces is cut off: its readers are not affected.
@@ -528,6 +539,14 @@ const T& Engine::current(const Mod<T>& m) {
   const detail::VersionBase* v = visible_or_default(m, now_, &detail::VersionOpsFor<T>::ops);
   if (!v) throw UsageError("sac::Engine::current: the modifiable has no value now");
   return static_cast<const detail::Version<T>*>(v)->value;
+}
+
+template <class T>
+const T* Engine::peek(const Mod<T>& m) {
+  require_computation("peek");
+  flush_if_pending();  // as current(): calls issued earlier in this body come first
+  const detail::VersionBase* v = visible(m, now_);
+  return v ? &static_cast<const detail::Version<T>*>(v)->value : nullptr;
 }
 
 template <class T, class F>
