@@ -7,8 +7,8 @@
 // is looked up with Engine::peek (its value now, recorded nothing), so every answer is
 // exact, and the cell becomes pending: the run "fails" and must not act. run_step() then
 // reads the pending cells as one Engine::read_many (one trace event, up to 16 cells), nested
-// in the reads before, and runs the step again; that run replays the searches from what they
-// handed out and does the step's writes. So a step is one read of exactly the cells its
+// in the reads before, and runs the step again; that run takes the answers of the run
+// before (the same values: kept()) and does the step's writes. So a step is one read of exactly the cells its
 // answers depend on (1.01 rounds per step measured: bench/RESULTS.md), and it re-runs only
 // when one of them changes (cut-off: a write of an equal vertex set is no change).
 // Which cells a step depends on: the leaves a search hands vertices from, a split cell whose
@@ -23,8 +23,8 @@
 // outer rounds' values up with Engine::current. A failed run writes, allocates and issues
 // nothing but the next round; a run that did not fail answers as the static tree on the same
 // vertices.
-// Complexity: a step's questions once on peeked cells (each peek a directory lookup and a
-// version walk), then once more replayed; O(1) cells per question in a graded mesh.
+// Complexity: a step's questions once, on peeked cells (each peek a directory lookup and a
+// version walk); O(1) cells per question in a graded mesh.
 // Paper: Acar & Hudson, Section 4; Hammer, Acar & Chen (CEAL, 2009) for reads as the unit of
 // re-execution.
 #pragma once
@@ -68,24 +68,13 @@ class CellView {
   /// A new round. `parent`: the round this one is nested in (null for a step's first run).
   /// When the view's last run was that round's (it needed cells and issued this one), the
   /// view keeps its cells, peeked ones included (no write between), and returns true: the
-  /// caller adds only this round's, and the parent's searches are replayed (see search()).
-  /// Otherwise it forgets every cell and returns false.
+  /// caller adds only this round's, and kept() tells the step that its last run's answers
+  /// stand (see kept()). Otherwise it forgets every cell and returns false.
   bool reset(const void* parent = nullptr, std::uint32_t serial = 0) {
-    const bool replay = parent != nullptr ? parent == owner_ : serial != 0 && serial == owner_serial_;
+    kept_ = parent != nullptr ? parent == owner_ : serial != 0 && serial == owner_serial_;
     owner_ = nullptr;
     owner_serial_ = 0;
-    if (replay) {
-      rep_v_.swap(rec_v_);
-      rep_n_.swap(rec_n_);
-      rep_searches_ = rec_n_.size();
-    } else {
-      rep_searches_ = 0;
-    }
-    rec_v_.clear();
-    rec_n_.clear();
-    search_idx_ = 0;
-    rep_pos_ = 0;
-    if (replay) return true;
+    if (kept_) return true;
     pending_.clear();
     if (++gen_ == 0) {
       for (Slot& s : table_) s.gen = 0;
@@ -131,10 +120,14 @@ class CellView {
 
   // ---------------------------------------------------------------- the store interface
 
-  /// Did the last run need a cell that no round of the step has read? Its answers are
-  /// exact all the same (the cell was peeked), but it must not act on them: its next round
-  /// reads pending().
+  /// Did the run need a cell that no round of the step has read? Its answers are exact all
+  /// the same (the cell was peeked), but it must not act on them: its next round reads
+  /// pending().
   bool failed() const noexcept { return !pending_.empty(); }
+  /// Is this run's view the one the step's last run had, the cells it peeked now read? Then
+  /// that run's answers are this run's (the same values at the same time: nothing ran
+  /// between), and the step takes them from its scratch instead of asking again.
+  bool kept() const noexcept { return kept_; }
   std::span<CellNode* const> pending() const noexcept { return pending_; }
   std::size_t leaves_read() const noexcept { return leaves_read_; }
 
@@ -150,11 +143,8 @@ class CellView {
 
   double margin_for(const Point<2>& c, double r) const noexcept { return dir_->margin_for(c, r); }
 
-  /// BucketTree::search on the cells as they are now. A step's questions ask the same
-  /// searches in the same order in every round (they are pure functions of the answers, and
-  /// the answers are exact), so in a kept view each search of the round before is replayed
-  /// from what it handed out, without walking the cells. `scale` is not used (the interface
-  /// of cell_questions.hpp).
+  /// BucketTree::search on the cells as they are now. `scale` is not used (the interface of
+  /// cell_questions.hpp).
   template <class Keep, class F>
   void search(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f) const {
     auto* self = const_cast<CellView*>(this);
@@ -170,8 +160,7 @@ class CellView {
     self->run_search(focus, margin, keep, f, true, radius + 3 * margin);
   }
 
-  /// After a run that needed cells: the round `self` recorded its searches for the round it
-  /// issues.
+  /// After a run that needed cells: it was the run of round `self`, which issues the next.
   void hand_over(const void* self) noexcept { owner_ = self; }
   /// The same after a step's first run: its first round names the run by the serial.
   std::uint32_t hand_over_root() noexcept {
@@ -280,28 +269,8 @@ class CellView {
 
   template <class Keep, class F>
   void run_search(const Point<2>& focus, double margin, Keep& keep, F& f, bool bounded, double R) {
-    const std::size_t idx = search_idx_++;
-    if (idx < rep_searches_) {
-      // Replay: hand out what this search handed out last round, in order.
-      const std::uint32_t k = rep_n_[idx];
-      const CellVertex* const* vs = rep_v_.data() + rep_pos_;
-      rep_pos_ += k;
-      std::uint32_t handed = 0;
-      while (handed < k) {
-        rec_v_.push_back(vs[handed]);
-        if (f(vs[handed++])) break;
-      }
-      rec_n_.push_back(handed);
-      return;
-    }
-    const std::size_t first = rec_v_.size();
-    auto g = [&](const CellVertex* v) {
-      rec_v_.push_back(v);
-      return f(v);
-    };
     bool stop = false;
-    search_node(bounded ? start_for(focus, R) : CellKey{}, focus, margin, keep, g, stop);
-    rec_n_.push_back(static_cast<std::uint32_t>(rec_v_.size() - first));
+    search_node(bounded ? start_for(focus, R) : CellKey{}, focus, margin, keep, f, stop);
   }
 
   /// The deepest present cell holding the box [focus ± R].
@@ -383,13 +352,11 @@ class CellView {
   std::vector<CellNode*> pending_;
   std::size_t leaves_read_ = 0;
   Counts counts_;
-  // Search replay (search()): this round's record, and the last round's to replay.
-  const void* owner_ = nullptr;    // the round whose record rec_ holds, after it failed
+  // The run the view was last filled for, when it failed (see reset()).
+  const void* owner_ = nullptr;     // a round, by its closure
   std::uint32_t owner_serial_ = 0;  // or the step's first run, by its serial
   std::uint32_t serial_ = 0;
-  std::vector<const CellVertex*> rec_v_, rep_v_;
-  std::vector<std::uint32_t> rec_n_, rep_n_;
-  std::size_t rep_searches_ = 0, search_idx_ = 0, rep_pos_ = 0;
+  bool kept_ = false;
 };
 
 // -------------------------------------------------------------------- rounds of reads
@@ -469,8 +436,9 @@ void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, 
 
 /// Runs a step: step.run(e, view) on an empty view, which peeks at every cell the step's
 /// questions use and so fails (unless they use none); then, round after round, on the
-/// cells it used, read, until a run does not fail (one round when it uses at most 16 cells,
-/// and its first round replays its searches). Step: copyable
+/// cells it used, read, until a run does not fail (one round when it uses at most 16
+/// cells). A run in a kept view (CellView::kept()) takes the answers of the run before from
+/// the step's scratch. Step: copyable
 /// (it is each round's closure), with CellView* view(Engine&) and bool run(Engine&,
 /// CellView&). run returns false when the view failed, and has then written, allocated and
 /// issued nothing; otherwise it does the step's effects, in this order: writes and

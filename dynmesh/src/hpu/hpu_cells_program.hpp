@@ -168,8 +168,14 @@ struct HpuCellsProgram {
   CellQuestionStats stats;
   HcStepCounts steps;
   Questions q;
-  // Scratch of the running step.
+  // Scratch of the running step: its answers, which a run in a kept view takes as they are
+  // (CellView::kept()).
+  int first_class = 0;
+  bool go_on = false;
   std::vector<std::array<HV, 2>> pairs, tris;
+  CellDecision<HV> decision;
+  CellNode* at_node = nullptr;
+  const CellState* at_state = nullptr;
   std::vector<Triangle> block;
 
   const Box<2>& box() const noexcept { return dir->box(); }
@@ -213,8 +219,9 @@ struct HpuCellsProgram {
     CellView* view(sac::Engine&) const { return &pg->view; }
     bool run(sac::Engine& e, CellView& v) const {
       const double scale = hint == INT_MAX ? pg->box().side / 4 : scale_of(hint);
-      const int c = pg->q.first_class(cell->v, scale);
+      if (!v.kept()) pg->first_class = pg->q.first_class(cell->v, scale);
       if (v.failed()) return false;
+      const int c = pg->first_class;
       ++pg->steps.done[HcStepCounts::FirstClass];
       e.write(cell->cls, c);
       e.memo_read(cell->next, sac::fn<&class_step>(pg, std::min(mn, c), c));
@@ -310,8 +317,9 @@ struct HpuCellsProgram {
     CellView* view(sac::Engine&) const { return &pg->view; }
     bool run(sac::Engine& e, CellView& v) const {
       const int j = cs->j;
-      const bool go_on = pg->q.collect(ent->v, j, ent->birth, pg->pairs);
+      if (!v.kept()) pg->go_on = pg->q.collect(ent->v, j, ent->birth, pg->pairs);
       if (v.failed()) return false;
+      const bool go_on = pg->go_on;
       ++pg->steps.done[HcStepCounts::Collect];
       // The entry's own list: no tail threads through the round, so a change in one
       // entry's pairs does not change the keys of the (mostly pairless) entries after it.
@@ -398,8 +406,9 @@ struct HpuCellsProgram {
     CellView* view(sac::Engine&) const { return &c.pg->view; }
     bool run(sac::Engine& e, CellView& v) const {
       HpuCellsProgram* pg = c.pg;
-      const CellDecision<HV> d = pg->q.decide(c.pc->p, c.pc->q, c.cs->j);
+      if (!v.kept()) pg->decision = pg->q.decide(c.pc->p, c.pc->q, c.cs->j);
       if (v.failed()) return false;
+      const CellDecision<HV> d = pg->decision;  // a copy: the steps it issues use the scratch
       ++pg->steps.done[HcStepCounts::Try];
       switch (d.kind) {
         case CellDecision<HV>::Done:
@@ -452,9 +461,10 @@ struct HpuCellsProgram {
     K k;
     CellView* view(sac::Engine&) const { return &pg->view; }
     bool run(sac::Engine& e, CellView& v) const {
-      const auto at = pg->dir->position(x->p);
-      const auto [node, s] = v.locate(at, scale_of(j));
+      if (!v.kept()) std::tie(pg->at_node, pg->at_state) = v.locate(pg->dir->position(x->p), scale_of(j));
       if (v.failed()) return false;
+      CellNode* const node = pg->at_node;
+      const CellState* const s = pg->at_state;
       ++pg->steps.done[HcStepCounts::Insert];
       std::array<HV, CellState::kCapacity + 1> items;
       std::size_t n = 0;
@@ -511,11 +521,13 @@ struct HpuCellsProgram {
     bool run(sac::Engine& e, CellView& v) const {
       const CellState& s = e.current(n->state);  // read by final_node, the enclosing read
       const double scale = std::ldexp(pg->box().side, -n->key.level) / 4;
-      pg->block.clear();
-      for (std::size_t i = 0; i < s.count; ++i) {
-        HV a = s.items[i];
-        pg->q.triangles_of(a, scale, pg->tris);
-        for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
+      if (!v.kept()) {
+        pg->block.clear();
+        for (std::size_t i = 0; i < s.count; ++i) {
+          HV a = s.items[i];
+          pg->q.triangles_of(a, scale, pg->tris);
+          for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
+        }
       }
       if (v.failed()) return false;
       ++pg->steps.done[HcStepCounts::Final];
