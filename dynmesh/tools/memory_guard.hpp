@@ -66,11 +66,13 @@ inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};
 //   /usr/bin/time -v dynmesh mesh unif1e5.txt -o o --min-angle 30          101,860 KiB: 987 B/point
 //   /usr/bin/time -v dynmesh mesh unif1e5.txt -o o --min-angle 30 --check  147,524 KiB: +468 B/point
 inline constexpr MemoryCost kHpuMeshCost{1'300, 650};
-// The self-adjusting hpu mesh (DynamicMesh, Postprocess::Hpu: the tree and the hpu trace;
-// --edits selects it), on unif1e5, at its largest, 30 degrees (20.7 degrees: 4,759,144 KiB,
-// 48,735 B/point; --check +5,875 B/point):
-//   /usr/bin/time -v dynmesh mesh unif1e5.txt --min-angle 30 --edits e10.txt -o o   6,981,172 KiB: 71,487 B/point
-inline constexpr MemoryCost kHpuDynamicCost{80'000, 8'000};
+// The self-adjusting hpu mesh (DynamicMesh, Postprocess::Hpu: the program on cells and its
+// trace; --edits selects it), on unif1e5, at its largest, 30 degrees (20.7 degrees: 939,524
+// KiB, 9,549 B/point; --check +2,820 B/point). (The triangulation-based program before issue
+// 20: 71,487 B/point at 30 degrees, and 80,000 here.)
+//   /usr/bin/time -v dynmesh mesh unif1e5.txt --min-angle 30 --edits e10.txt -o o          1,448,392 KiB: 14,760 B/point
+//   /usr/bin/time -v dynmesh mesh unif1e5.txt --min-angle 30 --edits e10.txt -o o --check  1,959,208 KiB: +5,230 B/point
+inline constexpr MemoryCost kHpuDynamicCost{19'500, 7'000};
 // The program before any point: 7-8 MB resident, more address space (libraries, a thread stack).
 inline constexpr std::uint64_t kFixedBytes = std::uint64_t{32} << 20;
 

@@ -47,13 +47,10 @@
 // Every decision is a predicate on the current vertex set, or a key made of coordinates,
 // never insertion order or addresses, so the mesh is a function of (box, point set, θ); the
 // tests shuffle and reverse the input and compare bits. The triangulation only answers the
-// questions quickly (stars, neighbours, cavities): the self-adjusting version answers the
-// same questions from its own self-adjusting triangulation, not from the quadtree's cells
-// as the seed's Figure 5 does (line 12's cell for an off-center, "active" points), and must
-// reach the same mesh. That choice keeps one algorithm and one oracle; its cost is that the
-// work near an update is bounded by the triangulation's locality rather than by cells
-// (docs/EXPERIMENTS.md: flat in n on uniform, clustered and shrinking inputs, growing on a
-// spiral).
+// questions quickly (stars, neighbours, cavities). The self-adjusting version answers the
+// same questions from the cells of a bucket tree of the vertices instead (each question
+// reads O(1) cells near its pair or vertex, docs/HPU_ON_CELLS.md), and must reach the same
+// mesh: one algorithm and one oracle.
 //
 // The self-adjusting version: DynamicMesh with Postprocess::Hpu (dynamic_mesh.hpp) runs
 // this algorithm on the runtime (src/hpu/hpu_cells_program.hpp: every question answered from
