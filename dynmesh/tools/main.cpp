@@ -166,7 +166,9 @@ int main(int argc, char** argv) {
       "               [--min-angle DEG] [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F]\n"
       "               [--msh F] [--svg F [--svg-point-radius PX] [--svg-max-points N]] [--check]\n"
       "               [--stats] [--force]\n\n" +
-      memory_note(cost_text("quadtree mesh", kQuadtreeMeshCost, "with --check")));
+      memory_note(cost_text("hpu mesh with --edits (self-adjusting)", kHpuDynamicCost, "with --check") + "; " +
+                  cost_text("hpu mesh without --edits", kHpuMeshCost, "with --check") + "; " +
+                  cost_text("quadtree mesh", kQuadtreeMeshCost, "with --check")));
 
   StabilityOptions s;
   CLI::App* stability = app.add_subcommand(
@@ -235,7 +237,8 @@ int main(int argc, char** argv) {
       "                    [--plot OUT.svg] [--force]\n\n" +
       memory_note(cost_text("quadtree (2D)", kQuadtree2dCost, "for the final check") + "; " +
                   cost_text("octree (3D)", kOctree3dCost, "for the final check") + "; " +
-                  cost_text("quadtree mesh", kQuadtreeMeshCost, "for the final check") +
+                  cost_text("quadtree mesh", kQuadtreeMeshCost, "for the final check") + "; " +
+                  cost_text("hpu mesh", kHpuDynamicCost, "for the final check") +
                   "; the structure holds at most N + U/2 points (--dist), or the points of POINTS and the '+' "
                   "lines of FILE (--points)"));
 
