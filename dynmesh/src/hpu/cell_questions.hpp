@@ -137,10 +137,17 @@ class CellQuestions {
   void visit_disc(const Point<2>& c, double r, F&& f, double scale = 0) const {
     const double margin = store_->margin_for(c, r);
     const double r2 = (r + margin) * (r + margin);
+    // A vertex farther than r in doubles is outside the disc (every caller's r has a relative
+    // slack far above the rounding of the squares): not handed to f, which saves its exact
+    // predicates.
+    const double rr = r * r;
     store_->search_within(
         c, r, scale, margin,
         [&](double x0, double y0, double x1, double y1) { return BucketTree::box_distance2(c, x0, y0, x1, y1) <= r2; },
-        f);
+        [&](V v) {
+          const double dx = P_(v)[0] - c[0], dy = P_(v)[1] - c[1];
+          return dx * dx + dy * dy > rr ? false : f(v);
+        });
   }
 
   /// The vertex at p, if any. `scale`: the size of the cells expected there.
@@ -265,6 +272,10 @@ class CellQuestions {
             return meets(x0, y0, x1, y1, pc, pr) && (best == none_ || meets(x0, y0, x1, y1, bc, br));
           },
           [&](V w) {
+            // Outside the probe's disc in doubles (its radius has a relative slack): outside
+            // the circle at height h, so pencil() > 0, without the exact predicates.
+            const double ex = P_(w)[0] - pc[0], ey = P_(w)[1] - pc[1];
+            if (ex * ex + ey * ey > pr * pr) return false;
             if (w == p || w == q || orient2d(a, b, P_(w)) <= 0 || pencil(a, b, h, P_(w)) > 0) return false;
             if (best == none_ || perturbed_incircle(a, b, P_(best), P_(w))) {
               best = w;
