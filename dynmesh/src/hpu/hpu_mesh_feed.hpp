@@ -9,11 +9,14 @@
 // triangle over an update is its change (a block re-made unchanged nets 0).
 // Invariants (check_invariants): every live block is on the live list once; the live count
 // is the sum of the live blocks' sizes; after an update every triangle nets −1, 0 or +1.
-// Complexity: O(t) per block made or destroyed; take_change O(e log e) for e logged.
+// Complexity: O(t) per block made or destroyed; take_change O(e log e) for e logged. A
+// block's triangles come from the feed's pool (std::pmr::unsynchronized_pool_resource), not
+// from a heap allocation per block.
 // Paper: Acar & Hudson, Section 4 (the output as the trace's allocations).
 #pragma once
 
 #include <algorithm>
+#include <memory_resource>
 #include <cstddef>
 #include <span>
 #include <string>
@@ -39,7 +42,7 @@ class HpuTriBlock {
  private:
   friend class HpuMeshFeed;
   HpuMeshFeed* feed_;
-  std::vector<Triangle> tris_;
+  std::pmr::vector<Triangle> tris_;  // from the feed's pool
   HpuTriBlock* prev_ = nullptr;
   HpuTriBlock* next_ = nullptr;
 };
@@ -122,6 +125,8 @@ class HpuMeshFeed {
     }
   }
 
+  // Declared first, so destroyed last: the blocks' triangle arrays come from it.
+  std::pmr::unsynchronized_pool_resource pool_;
   HpuTriBlock* head_ = nullptr;
   std::size_t live_ = 0, blocks_ = 0;
   bool closing_ = false;
@@ -129,7 +134,7 @@ class HpuMeshFeed {
 };
 
 inline HpuTriBlock::HpuTriBlock(HpuMeshFeed* feed, std::span<const Triangle> tris)
-    : feed_(feed), tris_(tris.begin(), tris.end()) {
+    : feed_(feed), tris_(tris.begin(), tris.end(), &feed->pool_) {
   feed_->born(this);
 }
 inline HpuTriBlock::~HpuTriBlock() { feed_->died(this); }
