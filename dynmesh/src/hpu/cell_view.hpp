@@ -270,15 +270,41 @@ class CellView {
   template <class Keep, class F>
   void run_search(const Point<2>& focus, double margin, Keep& keep, F& f, bool bounded, double R) {
     bool stop = false;
-    search_node(bounded ? start_for(focus, R) : CellKey{}, focus, margin, keep, f, stop);
+    if (!bounded) return search_node(CellKey{}, focus, margin, keep, f, stop);
+    std::array<CellKey, 4> starts;
+    const std::size_t n = starts_for(focus, R, starts);
+    for (std::size_t i = 0; i < n && !stop; ++i) search_node(starts[i], focus, margin, keep, f, stop);
   }
 
-  /// The deepest present cell holding the box [focus ± R].
-  CellKey start_for(const Point<2>& focus, double R) {
+  /// Where a search of the box [focus ± R] starts: the cells of the finest level as wide as
+  /// the box (at most 2 × 2 of them cover it), each replaced by its deepest present ancestor
+  /// (itself when present), without repeats, nearest to the focus first. Starting at the
+  /// smallest cell holding the whole box instead walked down from the root whenever the box
+  /// straddled a coarse cell's boundary.
+  std::size_t starts_for(const Point<2>& focus, double R, std::array<CellKey, 4>& out) {
     const auto a = dir_->position(Point<2>{focus[0] - R, focus[1] - R});
     const auto b = dir_->position(Point<2>{focus[0] + R, focus[1] + R});
-    const int diff = std::max(std::bit_width(a[0] ^ b[0]), std::bit_width(a[1] ^ b[1]));
-    return deepest_present(CellDirectory::cell_at(a, BucketTree::kMaxLevel - diff));
+    const int g = BucketTree::kMaxLevel - std::bit_width(std::max(b[0] - a[0], b[1] - a[1]));
+    const int s = BucketTree::kMaxLevel - g;
+    std::array<double, 4> dist{};
+    std::size_t n = 0;
+    for (std::uint64_t iy = a[1] >> s; iy <= b[1] >> s; ++iy)
+      for (std::uint64_t ix = a[0] >> s; ix <= b[0] >> s; ++ix) {
+        const CellKey k = deepest_present(CellKey{g, ix, iy});
+        if (std::find(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n), k) != out.begin() + static_cast<std::ptrdiff_t>(n))
+          continue;
+        double x0, y0, x1, y1;
+        cell_box(k, 0.0, x0, y0, x1, y1);
+        const double d = BucketTree::box_distance2(focus, x0, y0, x1, y1);
+        std::size_t i = n++;
+        for (; i > 0 && dist[i - 1] > d; --i) {  // insertion: stable, so ties keep the scan order
+          out[i] = out[i - 1];
+          dist[i] = dist[i - 1];
+        }
+        out[i] = k;
+        dist[i] = d;
+      }
+    return n;
   }
 
   void grow() {
