@@ -255,14 +255,32 @@ class CellView {
   /// absent ones.
   CellKey deepest_present(const CellKey& k) {
     int lo = 0, hi = k.level;  // the root is present
+    const auto present = [&](int level) {
+      const int s = k.level - level;
+      return resolve(CellKey{level, k.ix >> s, k.iy >> s}).tag != Tag::Absent;
+    };
+    // The last answer's level first: a step's searches are mostly in one region, so its
+    // leaves' level and the one below usually settle it in two lookups.
+    if (const int g = std::min(guess_level_, k.level); g > 0) {
+      if (present(g)) {
+        lo = g;
+        if (g < hi) {
+          if (present(g + 1)) lo = g + 1;
+          else hi = g;
+        }
+      } else {
+        hi = g - 1;
+        if (present(hi)) lo = hi;
+      }
+    }
     while (lo < hi) {
       const int mid = (lo + hi + 1) / 2;
-      const int s = k.level - mid;
-      if (resolve(CellKey{mid, k.ix >> s, k.iy >> s}).tag != Tag::Absent)
+      if (present(mid))
         lo = mid;
       else
         hi = mid - 1;
     }
+    guess_level_ = lo;
     const int s = k.level - lo;
     return CellKey{lo, k.ix >> s, k.iy >> s};
   }
@@ -376,6 +394,7 @@ class CellView {
   std::vector<std::pair<CellNode*, const CellState*>> read_;
   std::size_t settled_ = 0;  // read_'s prefix settle() has seen
   std::vector<CellNode*> pending_;
+  int guess_level_ = 0;  // deepest_present's last answer (a hint only)
   std::size_t leaves_read_ = 0;
   Counts counts_;
   // The run the view was last filled for, when it failed (see reset()).
