@@ -8,14 +8,15 @@
 // exact, and the cell becomes pending: the run "fails" and must not act. run_step() then
 // reads the pending cells as one Engine::read_many (one trace event, up to 16 cells), nested
 // in the reads before, and runs the step again; that run takes the answers of the run
-// before (the same values: kept()) and does the step's writes. So a step is one read of exactly the cells its
-// answers depend on (1.01 rounds per step measured: bench/RESULTS.md), and it re-runs only
-// when one of them changes (cut-off: a write of an equal vertex set is no change).
+// before (the same values: kept()) and does the step's writes. So a step is one read of
+// exactly the cells its answers depend on (1.01 rounds per step measured: bench/RESULTS.md),
+// and it re-runs only when one of them changes (cut-off: a write of an equal vertex set is
+// no change).
 // Which cells a step depends on: the leaves a search hands vertices from, a split cell whose
 // children it all prunes, and the leaf an insertion locates. The leaves tile the region the
 // search covers, so any change there (a vertex, a split, a merge) changes one of them; the
-// cells above them are split, implied by the leaves. A bounded search starts at the deepest
-// cell holding its disc that is present now (a binary search over the levels).
+// cells above them are split, implied by the leaves. A bounded search starts at the cells as
+// wide as its box (at most 2 × 2), each at its deepest present ancestor.
 // Invariants: a view's read cells are read by the step's enclosing reads; a run that did
 // not fail used no cell beyond them. A round that runs right after the run it was issued by
 // keeps that run's view, peeked cells included (no write between: a step writes only in its
@@ -309,8 +310,8 @@ class CellView {
     for (std::uint64_t iy = a[1] >> s; iy <= b[1] >> s; ++iy)
       for (std::uint64_t ix = a[0] >> s; ix <= b[0] >> s; ++ix) {
         const CellKey k = deepest_present(CellKey{g, ix, iy});
-        if (std::find(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(n), k) != out.begin() + static_cast<std::ptrdiff_t>(n))
-          continue;
+        const auto end = out.begin() + static_cast<std::ptrdiff_t>(n);
+        if (std::find(out.begin(), end, k) != end) continue;
         double x0, y0, x1, y1;
         cell_box(k, 0.0, x0, y0, x1, y1);
         const double d = BucketTree::box_distance2(focus, x0, y0, x1, y1);
