@@ -502,15 +502,47 @@ class CellQuestions {
 
   /// v's triangles of the final mesh, those whose (x, y)-smallest corner v is, as (a, b):
   /// the triangle (v, a, b) counter-clockwise. `scale`: v's expected nearest distance.
+  /// Only the arc of v's star that is (x, y)-greater than v is walked: those neighbours lie
+  /// in a half-plane through v, so they are consecutive around it. From the sure neighbour
+  /// the walk goes counter-clockwise until it has left that arc, then, if it started inside
+  /// the arc or met a box side before reaching it, clockwise the same way.
   void triangles_of(V v, double scale, std::vector<std::array<V, 2>>& out) {
     out.clear();
-    star_of(v, scale);
-    const std::size_t d = star_.size();
-    const bool cycle = !on_boundary(v);
-    for (std::size_t i = 0; i < d; ++i) {
-      if (i + 1 == d && !cycle) break;
-      const V a = star_[i], b = star_[(i + 1) % d];
-      if (xy_less(P_(v), P_(a)) && xy_less(P_(v), P_(b))) out.push_back({a, b});
+    ++stats_.stars;
+    const V q0 = sure_neighbour(v, scale);
+    if (q0 == none_) return;
+    const auto greater = [&](V q) { return xy_less(P_(v), P_(q)); };
+    const bool started_in = greater(q0);
+    bool seen_in = started_in;
+    // Counter-clockwise: the next neighbour of q is the left neighbour of v→q.
+    bool closed = false;
+    std::size_t steps = 0;
+    for (V q = q0;; ++steps) {
+      if (outside_left(v, q)) break;  // a box side
+      const V t = left_search(v, q, std::numeric_limits<double>::infinity());
+      if (t == none_) break;
+      if (greater(q) && greater(t)) out.push_back({q, t});
+      if (t == q0) {
+        closed = true;
+        break;
+      }
+      if (greater(t)) seen_in = true;
+      else if (seen_in) break;  // past the arc
+      if (steps > 4096) throw InvariantError("dynmesh: a star walk that does not close");
+      q = t;
+    }
+    // Done when the cycle closed, or when the walk entered the arc from its clockwise end.
+    if (closed || (seen_in && !started_in)) return;
+    // Clockwise from q0: the next neighbour of q is the left neighbour of q→v.
+    for (V q = q0;;) {
+      if (outside_left(q, v)) return;
+      const V t = left_search(q, v, std::numeric_limits<double>::infinity());
+      if (t == none_ || t == q0) return;
+      if (greater(q) && greater(t)) out.push_back({t, q});
+      if (greater(t)) seen_in = true;
+      else if (seen_in) return;
+      if (++steps > 8192) throw InvariantError("dynmesh: a star walk that does not close");
+      q = t;
     }
   }
 
