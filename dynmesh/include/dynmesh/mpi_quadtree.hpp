@@ -75,6 +75,8 @@ struct MpiRankStats {
   std::size_t trace_bytes = 0;     // of this rank's DynamicQuadtree
   std::size_t propagations = 0;    // apply() calls that changed this rank's tree
   double propagate_seconds = 0;    // their total wall time (the local propagate)
+  double propagate_cpu_seconds = 0;  // their total CPU time (this thread's: not the time
+                                     // the rank waited for a core)
   std::size_t repartitions = 0;
 };
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstring>
 #include <optional>
 #include <string>
@@ -320,6 +321,12 @@ std::optional<Failure> locate_all(const Box<d>& box, std::span<const Point<d>> p
   return std::nullopt;
 }
 
+inline double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
 inline std::uint64_t exclusive_offset(MPI_Comm comm, std::uint64_t mine, std::uint64_t& total) {
   std::uint64_t before = 0;
   MPI_Exscan(&mine, &before, 1, MPI_UINT64_T, MPI_SUM, comm);
@@ -443,6 +450,7 @@ void MpiQuadtree<d>::apply(std::span<const Edit<d>> edits) {
   bool applied = false;
   if (!batch.empty()) {
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = thread_cpu_seconds();
     try {
       s.tree->apply(batch);
       applied = true;
@@ -452,6 +460,7 @@ void MpiQuadtree<d>::apply(std::span<const Edit<d>> edits) {
     }
     if (applied) {
       s.stats.propagate_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      s.stats.propagate_cpu_seconds += thread_cpu_seconds() - c0;
       ++s.stats.propagations;
     }
   }
