@@ -90,7 +90,8 @@ template <std::size_t d>
 class MpiQuadtree {
  public:
   /// Collective. Each rank passes any part of the initial points (rank 0 all of them, or each
-  /// rank its own share); the point set is their union. `comm` is duplicated.
+  /// rank its own share); the point set is their union. `comm` is duplicated; the destructor
+  /// frees the duplicate, so it too is collective and must run before MPI_Finalize.
   MpiQuadtree(MPI_Comm comm, const Box<d>& box, std::span<const Point<d>> points,
               const MpiQuadtreeOptions& options = {});
   ~MpiQuadtree();

@@ -152,13 +152,13 @@ struct MpiState {
     }
   }
 
-  /// The ranks that hold root cell m: its owner and every rank holding it as a ghost, sorted.
-  std::vector<int> holders(std::uint64_t m) const {
-    std::vector<int> out;
+  /// The ranks that hold root cell m: its owner and every rank holding it as a ghost, sorted,
+  /// into `out` (reused by the caller: no allocation per edit once it has grown).
+  void holders(std::uint64_t m, std::vector<int>& out) const {
+    out.clear();
     for_each_in_ring(m, options.ghost_ring, [&](std::uint64_t x) { out.push_back(owner(x)); });
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
   }
 
   /// Contiguous Morton runs balanced by point count: rank r starts at the first root cell
@@ -273,8 +273,11 @@ struct MpiState {
     std::vector<Routed<d>> mine = owned_routed();
     partition();
     std::vector<std::vector<Routed<d>>> out(static_cast<std::size_t>(nranks));
-    for (const Routed<d>& p : mine)
-      for (const int r : holders(root_of(dynmesh::locate(box, p.point)))) out[static_cast<std::size_t>(r)].push_back(p);
+    std::vector<int> to;
+    for (const Routed<d>& p : mine) {
+      holders(root_of(dynmesh::locate(box, p.point)), to);
+      for (const int r : to) out[static_cast<std::size_t>(r)].push_back(p);
+    }
     std::vector<Routed<d>> in = detail::alltoall(comm, out);
     // Order by position: the tree does not depend on it, the ids do.
     std::sort(in.begin(), in.end(), [&](const Routed<d>& a, const Routed<d>& b) {
@@ -398,9 +401,11 @@ MpiQuadtree<d>::MpiQuadtree(MPI_Comm comm, const Box<d>& box, std::span<const Po
   s.partition();
 
   std::vector<std::vector<Routed<d>>> out(static_cast<std::size_t>(s.nranks));
-  for (std::size_t i = 0; i < located.size(); ++i)
-    for (const int r : s.holders(s.root_of(located[i])))
-      out[static_cast<std::size_t>(r)].push_back(Routed<d>{offset + i, 0, points[i]});
+  std::vector<int> to;
+  for (std::size_t i = 0; i < located.size(); ++i) {
+    s.holders(s.root_of(located[i]), to);
+    for (const int r : to) out[static_cast<std::size_t>(r)].push_back(Routed<d>{offset + i, 0, points[i]});
+  }
   located.clear();
   std::vector<Routed<d>> in = detail::alltoall(s.comm, out);
   out.clear();
@@ -434,10 +439,13 @@ void MpiQuadtree<d>::apply(std::span<const Edit<d>> edits) {
 
   // Route the edits that located (those before a failure); the tree validates the rest.
   std::vector<std::vector<Routed<d>>> out(static_cast<std::size_t>(s.nranks));
-  for (std::size_t i = 0; i < located.size(); ++i)
-    for (const int r : s.holders(s.root_of(located[i])))
+  std::vector<int> to;
+  for (std::size_t i = 0; i < located.size(); ++i) {
+    s.holders(s.root_of(located[i]), to);
+    for (const int r : to)
       out[static_cast<std::size_t>(r)].push_back(
           Routed<d>{offset + i, static_cast<std::uint64_t>(edits[i].op), edits[i].point});
+  }
   std::vector<Routed<d>> in = detail::alltoall(s.comm, out);
   std::sort(in.begin(), in.end(), [](const Routed<d>& a, const Routed<d>& b) { return a.index < b.index; });
   std::vector<Edit<d>> batch;
