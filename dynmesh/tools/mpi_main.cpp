@@ -212,7 +212,7 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
       if (root) app.exit(e);
       return 0;
     }
-    if (root) print_error(e.what());
+    if (root) print_error(std::string(e.what()) + " (see dynmesh-mpi --help)");
     return 2;
   }
   o.dim_given = dim->count() > 0;
