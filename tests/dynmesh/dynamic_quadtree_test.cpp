@@ -1488,3 +1488,36 @@ TYPED_TEST(DynamicQuadtreeCheckers, UpdatesRunTheCheckersUnderSacDebugChecks) {
 }
 
 }  // namespace
+
+namespace {
+
+// is_split and leaves_in (what MpiQuadtree reads of each rank's tree) agree with the static
+// oracle and with leaves(): for every cell of levels 0 to 4, including cells strictly inside
+// a leaf (no leaves) and leaves themselves (just the cell).
+TYPED_TEST(DynamicQuadtreeApi, IsSplitAndLeavesInAgreeWithTheOracle) {
+  constexpr std::size_t d = TypeParam::value;
+  const std::vector<Point<d>> pts = generate<d>(Distribution::Clusters, d == 2 ? 200 : 60, 17);
+  const Box<d> box = derive_box<d>(pts);
+  DynamicQuadtree<d> tree(box, pts);
+  const auto oracle = StaticQuadtree<d>::from_points(box, pts);
+  const std::vector<Leaf<d>> all = tree.leaves();
+  for (int level = 0; level <= 4; ++level) {
+    const std::uint64_t n = cells_per_axis(level);
+    for (std::uint64_t code = 0; code < (d == 2 ? n * n : n * n * n); ++code) {
+      CellId<d> c;
+      c.level = level;
+      std::uint64_t rest = code;
+      for (std::size_t a = 0; a < d; ++a) {
+        c.index[a] = rest % n;
+        rest /= n;
+      }
+      ASSERT_EQ(tree.is_split(c), oracle.is_split(c)) << to_string(c);
+      std::vector<Leaf<d>> want;
+      for (const Leaf<d>& leaf : all)
+        if (contains(c, leaf.cell)) want.push_back(leaf);
+      ASSERT_EQ(tree.leaves_in(c), want) << to_string(c);
+    }
+  }
+}
+
+}  // namespace

@@ -25,7 +25,8 @@
 // nothing depends on pointer values or hash iteration order.
 // Complexity: construction O(n·h + |T*|) trace events (h = mean depth at which a point is
 // isolated, O(lg L/s)); insert/erase O(lg L/s) expected trace distance (the stability
-// experiments measure it); leaves() O(|T*| lg |T*|); locate O(depth); neighbours O(3^d·2^d).
+// experiments measure it); leaves() O(|T*| lg |T*|); leaves_in(c) O(leaves in c · lg); is_split
+// O(1); locate O(depth); neighbours O(3^d·2^d).
 // Paper: Acar & Hudson, "Optimal-time dynamic mesh refinement", Section 2 (QuadTreeRefine),
 // Section 4 (dynamization, keyed work-queue entries, monotonicity).
 #pragma once
@@ -130,6 +131,11 @@ class DynamicQuadtree {
   std::vector<Leaf<d>> leaves() const;
   /// The leaves with the ids of their points, same order.
   std::vector<LeafPoints<d>> leaves_with_points() const;
+  /// The leaves of T* inside cell c (c itself when it is a leaf), sorted; empty when c lies
+  /// strictly inside a leaf. O(leaves inside c · lg).
+  std::vector<Leaf<d>> leaves_in(const CellId<d>& c) const;
+  /// Is c split in T*? O(1) directory probe.
+  bool is_split(const CellId<d>& c) const noexcept;
   /// The leaf containing p (any point of the box). InputError for NaN or outside the box.
   CellId<d> locate(const Point<d>& p) const;
   /// The leaves touching leaf c (closed boxes intersect), sorted, c excluded.

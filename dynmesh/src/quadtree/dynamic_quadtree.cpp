@@ -154,6 +154,34 @@ std::vector<Leaf<d>> DynamicQuadtree<d>::leaves() const {
 
 template <std::size_t d>
   requires SupportedDim<d>
+std::vector<Leaf<d>> DynamicQuadtree<d>::leaves_in(const CellId<d>& c) const {
+  const auto& s = *s_;
+  std::vector<Leaf<d>> out;
+  if (!valid(c) || (c.level > 0 && !s.is_split(parent(c)) && !s.is_split(c))) return out;
+  std::vector<CellId<d>> stack{c};
+  while (!stack.empty()) {
+    const CellId<d> x = stack.back();
+    stack.pop_back();
+    if (s.is_split(x)) {
+      for (unsigned w = kChildren<d>; w-- > 0;) stack.push_back(child(x, w));
+      continue;
+    }
+    std::uint32_t k = 0;
+    for (const detail::PNode<d>* p = s.points_in(x); p; p = p->next.get()) ++k;
+    out.push_back(Leaf<d>{x, k});
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+template <std::size_t d>
+  requires SupportedDim<d>
+bool DynamicQuadtree<d>::is_split(const CellId<d>& c) const noexcept {
+  return s_->is_split(c);
+}
+
+template <std::size_t d>
+  requires SupportedDim<d>
 std::vector<LeafPoints<d>> DynamicQuadtree<d>::leaves_with_points() const {
   std::vector<LeafPoints<d>> out;
   s_->for_each_leaf([&](const CellId<d>& c, const detail::PNode<d>* p) {

@@ -1,0 +1,248 @@
+// dynmesh-mpi — `dynmesh quadtree` on MPI ranks (docs/FORMATS.md, docs/DISTRIBUTED.md):
+//   mpirun -np P dynmesh-mpi quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L]
+//                [--duplicates error|skip] [--edits FILE] [--batch K] --cells OUT [--stats]
+// Same inputs, box and edit semantics as `dynmesh quadtree`, through the same readers and
+// labels (initial_points.hpp, input_labels.hpp): rank 0 reads the files and hands the points
+// and the edits to MpiQuadtree, which routes them to their ranks. OUT is written once, by
+// rank 0, and equals `dynmesh quadtree`'s `.cells` for every P. --stats prints, per rank, on
+// stderr (gathered to rank 0, in rank order): points owned, ghost points, trace bytes, mean
+// time per propagation.
+// Errors: one line `dynmesh-mpi: <message>` from rank 0 and exit status 1 on every rank (2 for
+// a malformed command line); every failure is agreed by all ranks before the next
+// collective, so none waits forever. Hidden test options: --partition-level L (l0),
+// --ghost-ring W (a narrower ring must break exactness), --rebalance F.
+// No memory guard: the memory is spread over the ranks, which one process cannot see.
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <exception>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <mpi.h>
+
+#include "atomic_file.hpp"
+#include "distinct_paths.hpp"
+#include "dynmesh/io.hpp"
+#include "dynmesh/mpi_quadtree.hpp"
+#include "initial_points.hpp"
+#include "input_labels.hpp"
+#include "number_options.hpp"
+#include "verify.hpp"
+
+namespace {
+
+using namespace dynmesh;
+using namespace dynmesh::tool;
+
+struct Options {
+  std::string points;
+  int dim = 2;
+  bool dim_given = false;
+  std::vector<double> box;
+  bool skip_duplicates = false;
+  std::string edits;
+  std::size_t batch = 0;
+  std::string cells;
+  bool stats = false;
+  int partition_level = -1;
+  int ghost_ring = 1;
+  double rebalance = 1.5;
+};
+
+int rank_of(MPI_Comm comm) {
+  int r = 0;
+  MPI_Comm_rank(comm, &r);
+  return r;
+}
+
+/// Rank 0's message (empty: none) to every rank; true when there is one.
+bool shared_failure(MPI_Comm comm, std::string& message) {
+  std::uint64_t n = message.size();
+  MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm);
+  message.resize(n);
+  MPI_Bcast(message.data(), static_cast<int>(n), MPI_CHAR, 0, comm);
+  return n != 0;
+}
+
+void print_error(const std::string& message) {
+  std::fflush(stdout);
+  std::fprintf(stderr, "dynmesh-mpi: %s\n", one_line(message).c_str());
+}
+
+/// Per-rank --stats lines, printed by rank 0 in rank order.
+template <std::size_t d>
+void print_stats(MPI_Comm comm, const MpiQuadtree<d>& tree) {
+  const MpiRankStats st = tree.rank_stats();
+  char line[512];
+  const double mean = st.propagations ? st.propagate_seconds / static_cast<double>(st.propagations) : 0.0;
+  std::snprintf(line, sizeof line,
+                "[dynmesh-mpi] rank %d: owned %zu points in %zu root cells, ghost %zu points, trace %zu bytes, "
+                "%zu propagations, mean %.6f s, %zu repartitions",
+                rank_of(comm), st.owned_points, st.owned_roots, st.ghost_points, st.trace_bytes, st.propagations, mean,
+                st.repartitions);
+  int nranks = 1;
+  MPI_Comm_size(comm, &nranks);
+  std::vector<char> all(static_cast<std::size_t>(nranks) * sizeof line);
+  MPI_Gather(line, sizeof line, MPI_CHAR, all.data(), sizeof line, MPI_CHAR, 0, comm);
+  if (rank_of(comm) != 0) return;
+  std::fflush(stdout);
+  std::fprintf(stderr, "[dynmesh-mpi] %d ranks, partition level %d\n", nranks, tree.partition_level());
+  for (int r = 0; r < nranks; ++r) std::fprintf(stderr, "%s\n", all.data() + static_cast<std::size_t>(r) * sizeof line);
+}
+
+template <std::size_t d>
+int run(MPI_Comm comm, const Options& o) {
+  const bool root = rank_of(comm) == 0;
+  std::optional<InitialPoints<d>> initial;
+  EditScript<d> script;
+  std::string message;
+  if (root) {
+    try {
+      initial.emplace(read_initial_points<d>(o.points, o.box, o.skip_duplicates));
+      if (!o.edits.empty()) script = read_edits_file<d>(o.edits);
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
+  }
+  if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
+
+  Box<d> box;
+  if (root) box = initial->box;
+  double words[d + 1];
+  for (std::size_t a = 0; a < d; ++a) words[a] = box.origin[a];
+  words[d] = box.side;
+  MPI_Bcast(words, d + 1, MPI_DOUBLE, 0, comm);
+  for (std::size_t a = 0; a < d; ++a) box.origin[a] = words[a];
+  box.side = words[d];
+  std::uint64_t nedits = script.edits.size();
+  MPI_Bcast(&nedits, 1, MPI_UINT64_T, 0, comm);
+
+  MpiQuadtreeOptions options;
+  options.partition_level = o.partition_level;
+  options.ghost_ring = o.ghost_ring;
+  options.rebalance_factor = o.rebalance;
+  std::optional<MpiQuadtree<d>> tree;
+  try {
+    tree.emplace(comm, box, root ? std::span<const Point<d>>(initial->file.points) : std::span<const Point<d>>{},
+                 options);
+  } catch (const InputError& e) {
+    // Every rank has the same error; rank 0 labels it with the file's lines.
+    if (!root) return 1;
+    try {
+      rethrow_construction_error<d>(e, *initial);
+    } catch (const std::exception& labelled) {
+      print_error(labelled.what());
+    }
+    return 1;
+  }
+
+  const std::size_t step = o.batch == 0 ? 1 : o.batch;
+  const std::span<const Edit<d>> all(script.edits);
+  for (std::uint64_t i = 0; i < nedits; i += step) {
+    const std::size_t k = static_cast<std::size_t>(std::min<std::uint64_t>(step, nedits - i));
+    try {
+      tree->apply(root ? all.subspan(static_cast<std::size_t>(i), k) : std::span<const Edit<d>>{});
+    } catch (const InputError& err) {
+      if (!root) return 1;
+      const std::size_t at = err.point_indices().empty() ? 0 : err.point_indices().back();
+      print_error(edit_error<d>(script, static_cast<std::size_t>(i) + at, err).what());
+      return 1;
+    }
+  }
+  if (o.stats) print_stats<d>(comm, *tree);
+
+  // Free the trees before the leaves meet on rank 0: the trace is most of the memory.
+  const std::vector<Leaf<d>> local = tree->local_leaves();
+  tree.reset();
+  const std::vector<Leaf<d>> leaves = gather_leaves<d>(comm, local, 0);
+  if (root) {
+    try {
+      AtomicOutputs out;
+      out.add(o.cells, format_cells<d>(box, leaves));
+      out.commit();
+      if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", initial->duplicates_skipped);
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
+  }
+  if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
+  return 0;
+}
+
+int parse_and_run(MPI_Comm comm, int argc, char** argv) {
+  const bool root = rank_of(comm) == 0;
+  CLI::App app{"dynmesh-mpi: the dynamic quadtree T* on MPI ranks, equal to `dynmesh quadtree` "
+               "(docs/FORMATS.md, docs/DISTRIBUTED.md)"};
+  app.require_subcommand(1);
+  Options o;
+  CLI::App* q = app.add_subcommand("quadtree", "Build T* of a point file on the ranks, apply an edit script, write the leaves");
+  q->add_option("POINTS", o.points, "point file: .node, the vertices of a .poly, or plain text; read by rank 0")->required();
+  CLI::Option* dim = q->add_option("--dim", o.dim, "dimension of plain-text points")->check(CLI::IsMember({2, 3}));
+  q->add_option("--box", o.box, "domain box: origin and side length (default: derived from the initial points)")
+      ->expected(3, 4)
+      ->type_name("o1 o2 [o3] L");
+  q->add_option_function<std::string>(
+       "--duplicates", [&o](const std::string& v) { o.skip_duplicates = v == "skip"; },
+       "error (the default) or skip: drop later copies of a point")
+      ->check(CLI::IsMember({"error", "skip"}));
+  q->add_option("--edits", o.edits, "edit script: '+ x y [z]' inserts, '- x y [z]' deletes");
+  q->add_option("--batch", o.batch, "propagate K consecutive edits together on all ranks (default: each alone)")
+      ->check(whole_number(1, std::numeric_limits<std::size_t>::max()));
+  q->add_option("--cells", o.cells, "output: the final leaves as .cells (written by rank 0)")->required();
+  q->add_flag("--stats", o.stats, "per rank on stderr: points owned, ghost points, trace bytes, mean propagation time");
+  // Test and experiment knobs, not part of the contract: hidden from --help.
+  q->add_option("--partition-level", o.partition_level)->check(CLI::Range(0, 10))->group("");
+  q->add_option("--ghost-ring", o.ghost_ring)->check(CLI::Range(0, 3))->group("");
+  q->add_option("--rebalance", o.rebalance)->check(CLI::Range(0.0, 1e9))->group("");
+  q->parse_complete_callback([&o] {
+    const std::string clash = output_overwrites_input({{"POINTS", o.points}, {"--edits", o.edits}}, {{"--cells", o.cells}});
+    if (!clash.empty()) throw CLI::ValidationError(clash);
+  });
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // Every rank parses the same arguments and fails alike; rank 0 speaks.
+    if (e.get_exit_code() == 0) {
+      if (root) app.exit(e);
+      return 0;
+    }
+    if (root) print_error(std::string(e.what()) + " (see dynmesh-mpi --help)");
+    return 2;
+  }
+  o.dim_given = dim->count() > 0;
+  int d = o.dim;
+  // As `dynmesh quadtree`: a .node header decides the dimension unless --dim does. Rank 0
+  // reads it; a bad header is left for the reader to report.
+  int announced = 0;
+  if (root && !o.dim_given && format_for_path(o.points) == PointFormat::Node) {
+    try {
+      announced = node_file_dimension(o.points);
+    } catch (const std::exception&) {
+      announced = 0;
+    }
+  }
+  MPI_Bcast(&announced, 1, MPI_INT, 0, comm);
+  if (announced != 0) d = announced == 3 ? 3 : 2;
+  try {
+    return d == 3 ? run<3>(comm, o) : run<2>(comm, o);
+  } catch (const std::exception& e) {
+    // Only agreed failures reach here (MpiQuadtree throws on every rank alike).
+    if (root) print_error(e.what());
+    return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  const int status = parse_and_run(MPI_COMM_WORLD, argc, argv);
+  MPI_Finalize();
+  return status;
+}

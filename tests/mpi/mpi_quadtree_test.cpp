@@ -1,0 +1,191 @@
+// mpi_quadtree_test — the differential test of MpiQuadtree, run under mpiexec on 2 and 3
+// ranks (tests/mpi/CMakeLists.txt). A plain main: GoogleTest's output from several ranks
+// would interleave. Every rank draws the same random batches (fixed seeds, printed on
+// failure) and passes its own contiguous slice of each batch, so the global order is the
+// batch's order; after every batch the gathered leaves must equal StaticQuadtree's on the
+// current point set, and check_invariants() must pass. Also: a failing batch (an absent
+// deletion in the last rank's slice) throws the same InputError on every rank and changes
+// nothing; a ghost ring one narrower than docs/DISTRIBUTED.md derives gives a wrong tree on
+// some input; repartitioning keeps the tree exact.
+// Exit status 0 when every check passed on every rank, 1 otherwise.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <mpi.h>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/errors.hpp"
+#include "dynmesh/mpi_quadtree.hpp"
+#include "dynmesh/static_quadtree.hpp"
+
+namespace {
+
+using namespace dynmesh;
+
+int g_rank = 0, g_ranks = 1, g_failures = 0;
+
+void check(bool ok, const std::string& what) {
+  if (ok) return;
+  ++g_failures;
+  std::fprintf(stderr, "FAIL (rank %d): %s\n", g_rank, what.c_str());
+}
+
+/// Rank r's contiguous share of v.
+template <class T>
+std::span<const T> share(const std::vector<T>& v) {
+  const std::size_t lo = v.size() * static_cast<std::size_t>(g_rank) / static_cast<std::size_t>(g_ranks);
+  const std::size_t hi = v.size() * static_cast<std::size_t>(g_rank + 1) / static_cast<std::size_t>(g_ranks);
+  return std::span<const T>(v).subspan(lo, hi - lo);
+}
+
+/// The gathered leaves equal the static oracle's on `points` (checked on rank 0, agreed).
+template <std::size_t d>
+bool exact(const MpiQuadtree<d>& tree, const std::vector<Point<d>>& points) {
+  const std::vector<Leaf<d>> leaves = tree.gather_leaves(0);
+  int ok = 1;
+  if (g_rank == 0) {
+    const auto oracle = StaticQuadtree<d>::from_points(tree.box(), points);
+    ok = std::equal(leaves.begin(), leaves.end(), oracle.leaves().begin(), oracle.leaves().end()) ? 1 : 0;
+  }
+  MPI_Bcast(&ok, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  return ok != 0;
+}
+
+/// Random batches of insertions and deletions on `dist`, checked after every batch.
+template <std::size_t d>
+void differential(Distribution dist, std::uint64_t seed, const MpiQuadtreeOptions& options) {
+  const std::string label = std::string(distribution_name(dist)) + " " + std::to_string(d) + "D seed " +
+                            std::to_string(seed);
+  std::vector<Point<d>> pool = generate<d>(dist, 900, seed, 0x1p24);
+  std::vector<Point<d>> points(pool.begin(), pool.begin() + 500), spare(pool.begin() + 500, pool.end());
+  const Box<d> box = derive_box<d>(pool);
+  MpiQuadtree<d> tree(MPI_COMM_WORLD, box, share(points), options);
+  check(exact(tree, points), label + ": after construction");
+  Rng rng(seed * 31 + 7);
+  for (int b = 0; b < 25; ++b) {
+    std::vector<Edit<d>> batch;
+    const std::size_t k = 1 + static_cast<std::size_t>(rng.below(b % 5 == 0 ? 40 : 6));
+    for (std::size_t i = 0; i < k; ++i) {
+      if ((rng.below(2) == 0 || spare.empty()) && !points.empty()) {
+        const std::size_t j = static_cast<std::size_t>(rng.below(points.size()));
+        batch.push_back(Edit<d>{EditOp::Delete, points[j]});
+        spare.push_back(points[j]);
+        points[j] = points.back();
+        points.pop_back();
+      } else if (!spare.empty()) {
+        // Not the point just deleted in this batch (that is allowed, but rare by chance).
+        const std::size_t j = static_cast<std::size_t>(rng.below(spare.size()));
+        batch.push_back(Edit<d>{EditOp::Insert, spare[j]});
+        points.push_back(spare[j]);
+        spare[j] = spare.back();
+        spare.pop_back();
+      }
+    }
+    tree.apply(share(batch));
+    if (!exact(tree, points)) {
+      check(false, label + ": batch " + std::to_string(b) + " differs from StaticQuadtree");
+      return;
+    }
+    if (b % 8 == 0) tree.check_invariants();
+  }
+  tree.check_invariants();
+
+  // A bad batch: every rank gets the same error naming the global edit index; nothing changes.
+  std::vector<Edit<d>> bad;
+  for (std::size_t i = 0; i < 6 && i < points.size(); ++i) bad.push_back(Edit<d>{EditOp::Delete, points[i]});
+  Point<d> absent = points[0];
+  absent[0] = std::nextafter(absent[0], 1e9);
+  bad.push_back(Edit<d>{EditOp::Delete, absent});
+  std::string message;
+  std::size_t index = 0;
+  try {
+    tree.apply(share(bad));
+  } catch (const InputError& e) {
+    message = e.text();
+    index = e.point_indices().empty() ? 999 : e.point_indices().back();
+  }
+  check(!message.empty() && index == bad.size() - 1, label + ": the bad batch was not refused at its last edit");
+  std::vector<char> all(static_cast<std::size_t>(g_ranks) * 512, 0);
+  message.resize(511);
+  MPI_Allgather(message.data(), 512, MPI_CHAR, all.data(), 512, MPI_CHAR, MPI_COMM_WORLD);
+  for (int r = 0; r < g_ranks; ++r)
+    check(std::string(all.data() + 512 * r) == std::string(message.c_str()), label + ": ranks disagree on the error");
+  check(exact(tree, points), label + ": a refused batch changed the tree");
+}
+
+/// Some input on which a ghost ring of width 0 gives a tree other than T*.
+bool narrow_ring_fails() {
+  for (std::uint64_t seed = 1; seed <= 10; ++seed) {
+    const std::vector<Point<2>> points = generate<2>(Distribution::Uniform, 400, seed);
+    MpiQuadtreeOptions narrow;
+    narrow.ghost_ring = 0;
+    MpiQuadtree<2> tree(MPI_COMM_WORLD, derive_box<2>(points), share(points), narrow);
+    if (!exact(tree, points)) return true;
+  }
+  return false;
+}
+
+/// Emptying half of the box makes the ranks repartition; the tree stays exact throughout.
+void repartition() {
+  std::vector<Point<2>> points = generate<2>(Distribution::Uniform, 800, 11);
+  const Box<2> box{{0.0, 0.0}, 1.0};
+  MpiQuadtreeOptions options;
+  options.rebalance_factor = 1.2;
+  MpiQuadtree<2> tree(MPI_COMM_WORLD, box, share(points), options);
+  std::vector<Edit<2>> moves;
+  for (Point<2>& p : points)
+    if (p[1] < 0.5) {  // the last axis: the Morton order's first halving
+      moves.push_back(Edit<2>{EditOp::Delete, p});
+      p[1] = p[1] / 2 + 0.5;
+      moves.push_back(Edit<2>{EditOp::Insert, p});
+    }
+  std::vector<Point<2>> now = generate<2>(Distribution::Uniform, 800, 11);
+  for (std::size_t i = 0; i < moves.size(); i += 60) {
+    const std::vector<Edit<2>> batch(moves.begin() + static_cast<std::ptrdiff_t>(i),
+                                     moves.begin() + static_cast<std::ptrdiff_t>(std::min(moves.size(), i + 60)));
+    for (const Edit<2>& e : batch) {
+      if (e.op == EditOp::Delete)
+        now.erase(std::find(now.begin(), now.end(), e.point));
+      else
+        now.push_back(e.point);
+    }
+    tree.apply(share(batch));
+    check(exact(tree, now), "repartition: batch at edit " + std::to_string(i) + " differs from StaticQuadtree");
+  }
+  tree.check_invariants();
+  unsigned long mine = tree.rank_stats().repartitions, most = 0;
+  MPI_Allreduce(&mine, &most, 1, MPI_UNSIGNED_LONG, MPI_MAX, MPI_COMM_WORLD);
+  check(g_ranks == 1 || most > 0, "repartition: no repartition happened");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  MPI_Init(&argc, &argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &g_ranks);
+  try {
+    for (const Distribution dist : {Distribution::Uniform, Distribution::Clusters, Distribution::Shrinking}) {
+      differential<2>(dist, 1, {});
+      differential<3>(dist, 2, {});
+    }
+    MpiQuadtreeOptions fine;
+    fine.partition_level = 5;  // many small root cells: most leaves' neighbours are ghosts
+    differential<2>(Distribution::Spiral, 3, fine);
+    differential<2>(Distribution::Boundary, 4, fine);
+    check(g_ranks == 1 || narrow_ring_fails(), "a ghost ring of width 0 gave T* on every input tried");
+    repartition();
+  } catch (const std::exception& e) {
+    check(false, std::string("exception: ") + e.what());
+  }
+  int mine = g_failures, total = 0;
+  MPI_Allreduce(&mine, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
+  if (g_rank == 0) std::printf("mpi_quadtree_test on %d ranks: %s\n", g_ranks, total ? "FAILED" : "passed");
+  MPI_Finalize();
+  return total ? 1 : 0;
+}
