@@ -10,11 +10,13 @@ JOBS="${JOBS:-$(nproc 2>/dev/null || echo 2)}"
 # build and test the Python module (pybind11, NumPy; pytest, meshio and matplotlib for its
 # tests and example; venv and pip for the README's install command); pkg-config tests the
 # installed dynmesh.pc. libopenmpi-dev and openmpi-bin build and run dynmesh-mpi (the quadtree
-# on MPI ranks) and its tests.
+# on MPI ranks) and its tests. gnuplot-doc ships world.dat, a world coastline: real data the
+# project did not write, which the MPI tests mesh on 1 to 4 ranks.
 DEPS=(cmake g++ ninja-build libgtest-dev libgmock-dev libbenchmark-dev libcli11-dev libgmp-dev
       libmpfr-dev libcgal-dev gnuplot gnuplot-nox clang libclang-rt-14-dev pkg-config
       python3 python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest python3-meshio
-      python3-matplotlib python3-venv python3-pip libopenmpi-dev openmpi-bin)
+      python3-matplotlib python3-venv python3-pip libopenmpi-dev openmpi-bin
+      gnuplot-doc)
 
 deps() {
   local missing=() p

@@ -143,6 +143,19 @@ case $case_name in
     expect_error "exceeds the resolution" s.xyz --edits res.edits --batch 2
     expect_error "cannot open" missing.xyz
     ;;
+  real_world) # data the project did not write: gnuplot's world coastline (gnuplot-doc, dev.sh deps)
+    world=/usr/share/doc/gnuplot/examples/world.dat
+    [[ -r $world ]] || fail "$world is missing (bash dev.sh deps installs gnuplot-doc)"
+    # Its "lon lat" rows, without comments and the blank lines between coastlines; the
+    # coastlines repeat some points, hence --duplicates skip.
+    grep -v '^#' "$world" | awk 'NF >= 2 { print $1, $2 }' >w.xyz
+    (($(wc -l <w.xyz) > 1000)) || fail "world.dat: too few points"
+    # Delete every 7th distinct point, then insert every other of those back.
+    awk '!seen[$0]++' w.xyz | awk 'NR % 7 == 1 { print "- " $0 } NR % 14 == 1 { keep[++k] = $0 }
+      END { for (i = 1; i <= k; i++) print "+ " keep[i] }' >w.edits
+    "$dynmesh" quadtree w.xyz --duplicates skip --edits w.edits --cells ref.cells 2>/dev/null || fail "dynmesh on world.dat"
+    for p in 1 2 3 4; do same "$p" w.xyz --duplicates skip --edits w.edits --batch 10; done
+    ;;
   *) fail "unknown case" ;;
 esac
 exit 0
