@@ -21,6 +21,14 @@ std::vector<Edit<d>> inserts_of(std::span<const Point<d>> points) {
   return edits;
 }
 
+/// The length of a leaf's point list.
+template <std::size_t d>
+std::uint32_t count_points(const PNode<d>* p) noexcept {
+  std::uint32_t k = 0;
+  for (; p; p = p->next.get()) ++k;
+  return k;
+}
+
 /// The tree's rules: every leaf's list holds exactly the points located in it, and the
 /// leaves are those of T* (check_tree).
 template <std::size_t d>
@@ -143,11 +151,8 @@ std::vector<Leaf<d>> DynamicQuadtree<d>::leaves() const {
   });
   std::vector<Leaf<d>> out;
   out.reserve(1 + static_cast<std::size_t>(kChildren<d> - 1) * split);
-  s_->for_each_leaf([&](const CellId<d>& c, const detail::PNode<d>* p) {
-    std::uint32_t k = 0;
-    for (; p; p = p->next.get()) ++k;
-    out.push_back(Leaf<d>{c, k});
-  });
+  s_->for_each_leaf(
+      [&](const CellId<d>& c, const detail::PNode<d>* p) { out.push_back(Leaf<d>{c, detail::count_points(p)}); });
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -155,21 +160,10 @@ std::vector<Leaf<d>> DynamicQuadtree<d>::leaves() const {
 template <std::size_t d>
   requires SupportedDim<d>
 std::vector<Leaf<d>> DynamicQuadtree<d>::leaves_in(const CellId<d>& c) const {
-  const auto& s = *s_;
   std::vector<Leaf<d>> out;
-  if (!valid(c) || (c.level > 0 && !s.is_split(parent(c)) && !s.is_split(c))) return out;
-  std::vector<CellId<d>> stack{c};
-  while (!stack.empty()) {
-    const CellId<d> x = stack.back();
-    stack.pop_back();
-    if (s.is_split(x)) {
-      for (unsigned w = kChildren<d>; w-- > 0;) stack.push_back(child(x, w));
-      continue;
-    }
-    std::uint32_t k = 0;
-    for (const detail::PNode<d>* p = s.points_in(x); p; p = p->next.get()) ++k;
-    out.push_back(Leaf<d>{x, k});
-  }
+  if (!valid(c) || !(s_->is_split(c) || s_->is_leaf(c))) return out;  // inside a leaf
+  s_->for_each_leaf(
+      [&](const CellId<d>& x, const detail::PNode<d>* p) { out.push_back(Leaf<d>{x, detail::count_points(p)}); }, c);
   std::sort(out.begin(), out.end());
   return out;
 }

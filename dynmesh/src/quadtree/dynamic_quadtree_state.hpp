@@ -21,10 +21,12 @@ template <std::size_t d>
 struct DynamicState : QuadtreeCore<d> {
   using QuadtreeCore<d>::QuadtreeCore;
 
+  /// f(leaf, its point list) for the leaves of T* under `from` (the root by default; a
+  /// leaf or a split cell of T*).
   template <class F>
-  void for_each_leaf(F&& f) const {
+  void for_each_leaf(F&& f, const CellId<d>& from = CellId<d>::root()) const {
     this->for_each_leaf_of([&](const CellId<d>& c) { return this->is_split(c); },
-                           [&](const CellId<d>& c) { f(c, this->points_in(c)); });
+                           [&](const CellId<d>& c) { f(c, this->points_in(c)); }, from);
   }
   bool is_leaf(const CellId<d>& c) const {
     return valid(c) && (c.level == 0 || this->is_split(parent(c))) && !this->is_split(c);

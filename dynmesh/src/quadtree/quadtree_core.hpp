@@ -469,10 +469,11 @@ class QuadtreeCore {
     const Slot<d>* s = dir.find(c);
     return s && s->pts.written() ? s->pts.get() : nullptr;
   }
-  /// Leaves of the tree whose split cells satisfy `split`, depth first.
+  /// Leaves of the tree whose split cells satisfy `split`, depth first, under `from` (the
+  /// whole tree by default; `from` itself when it is not split).
   template <class IsSplit, class F>
-  void for_each_leaf_of(IsSplit&& split, F&& f) const {
-    std::vector<CellId<d>> stack{CellId<d>::root()};
+  void for_each_leaf_of(IsSplit&& split, F&& f, const CellId<d>& from = CellId<d>::root()) const {
+    std::vector<CellId<d>> stack{from};
     while (!stack.empty()) {
       const CellId<d> c = stack.back();
       stack.pop_back();
