@@ -1,9 +1,10 @@
 // cell_refiner.hpp (private) — the hpu mesh's refinement with every question answered from
 // the cells near it (bucket_tree.hpp), never from a triangulation of all vertices.
 //
-// Purpose: the static form of the self-adjusting hpu program (hpu_cells_program.hpp): the same
-// questions (cell_questions.hpp) on a static BucketTree. It takes the static twin's decisions (hpu_mesh.cpp, rules 1-6 of dynmesh/hpu_mesh.hpp) in the twin's order and
-// must reach the twin's mesh bit for bit; what differs is only where each answer comes from,
+// Purpose: the static form of the self-adjusting hpu program (hpu_cells_program.hpp): the
+// same questions (cell_questions.hpp) on a static BucketTree. It takes the static twin's
+// decisions (hpu_mesh.cpp, rules 1-6 of dynmesh/hpu_mesh.hpp) in the twin's order and must
+// reach the twin's mesh bit for bit; what differs is only where each answer comes from,
 // exact searches of the cells (docs/HPU_ON_CELLS.md has the arguments):
 //   - the left search: the Delaunay neighbour of p→q on its left (the twin's perturbation
 //     breaks ties) is the vertex whose circle through p and q is lowest in their pencil;

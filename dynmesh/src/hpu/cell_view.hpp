@@ -153,7 +153,7 @@ class CellView {
   }
 
   /// search() for a keep() that accepts no cell farther than radius from focus: it starts at
-  /// the smallest cell holding that disc's box, not at the root.
+  /// the cells around that disc's box (starts_for), not at the root.
   template <class Keep, class F>
   void search_within(const Point<2>& focus, double radius, double /*scale*/, double margin, Keep&& keep,
                      F&& f) const {
@@ -471,7 +471,7 @@ void issue_round_n(sac::Engine& e, const Step& step, const CellRoundHead* parent
 template <class Step>
 void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::uint32_t serial,
                  std::span<CellNode* const> misses) {
-  if (misses.empty()) throw InvariantError("dynmesh: a step failed without a missing cell");
+  if (misses.empty()) throw InvariantError("dynmesh: a step failed without a pending cell");
   if (misses.size() > kCellsPerRead) misses = misses.first(kCellsPerRead);  // the rest next round
   step.view(e)->count_round(misses.size());
   if (misses.size() <= 2) return issue_round_n<Step, 2>(e, step, parent, serial, misses);

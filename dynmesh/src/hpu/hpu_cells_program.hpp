@@ -319,7 +319,6 @@ struct HpuCellsProgram {
       const int j = cs->j;
       if (!v.kept()) pg->go_on = pg->q.collect(ent->v, j, ent->birth, pg->pairs);
       if (v.failed()) return false;
-      const bool go_on = pg->go_on;
       ++pg->steps.done[HcStepCounts::Collect];
       // The entry's own list: no tail threads through the round, so a change in one
       // entry's pairs does not change the keys of the (mostly pairless) entries after it.
@@ -331,7 +330,7 @@ struct HpuCellsProgram {
       }
       e.write(*pd, nullptr);
       sac::Mod<HcEntry*>* cd = cdest;
-      if (go_on) {
+      if (pg->go_on) {
         HcEntry* c = e.alloc<HcEntry>(std::tuple{ent->v, j + 1, false}, ent->v, false);
         e.write(*cd, c);
         cd = &c->next;

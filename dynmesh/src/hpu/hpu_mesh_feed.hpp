@@ -16,8 +16,8 @@
 #pragma once
 
 #include <algorithm>
-#include <memory_resource>
 #include <cstddef>
+#include <memory_resource>
 #include <span>
 #include <string>
 #include <utility>
@@ -125,7 +125,9 @@ class HpuMeshFeed {
     }
   }
 
-  // Declared first, so destroyed last: the blocks' triangle arrays come from it.
+  // The live blocks' triangle arrays come from it: the blocks die with the engine's trace,
+  // so the feed must outlive the engine (its owner declares it, in HpuCellsState, before
+  // the engine).
   std::pmr::unsynchronized_pool_resource pool_;
   HpuTriBlock* head_ = nullptr;
   std::size_t live_ = 0, blocks_ = 0;
