@@ -216,7 +216,7 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
       if (order_.less(&v->stamp, &owner_of(r)->start)) {  // a slot's time is its multi-read's
         detach(r);
         attach(r, v);
-        if (!same) enqueue(r, m);
+        if (!same && affects(r, older, v)) enqueue(r, m);
       }
       r = nx;
     }
@@ -230,10 +230,13 @@ void Engine::set_base(ModBase& m, VersionBase* fresh,
   VersionBase* last = nullptr;
   for (VersionBase* v = m.newest(); v; v = v->older()) last = v;
   if (VersionBase* base = last && last->is_base() ? last : nullptr) {
-    const bool changed = assign_if_changed(base, fresh);
+    // The readers are asked before the assignment, while both values exist; an equal value
+    // affects none of them.
+    if (base->readers && !base->ops->equal(base, fresh))
+      for (ReaderLink* r = base->readers; r; r = r->rnext)
+        if (affects(r, base, fresh)) enqueue(r, m);
+    assign_if_changed(base, fresh);
     destroy(fresh);
-    if (changed)
-      for (ReaderLink* r = base->readers; r; r = r->rnext) enqueue(r, m);
     return;
   }
   // A new base version: it precedes every computation write, so nobody saw "nothing" here
@@ -462,6 +465,13 @@ void Engine::enqueue(ReaderLink* l, const ModBase& m) {
   ++stats_.queue_pushes;
 }
 
+bool Engine::affects(ReaderLink* l, const VersionBase* before, const VersionBase* after) {
+  const ReadNode* r = owner_of(l);
+  if (r->link.qpos != kNotQueued) return false;  // it re-runs anyway
+  const auto f = r->ops()->affected;
+  return !f || f(r, detail::is_slot(l) ? l->qpos : 0, before, after);
+}
+
 void Engine::rerun(ReadNode* r, const ModBase* mp) {
   reruns_.push_back(RerunContext{now_, window_end_});
   tasks_.push_back(Task{TaskKind::FinishRerun, r});
@@ -659,7 +669,7 @@ void Engine::undo(Stamp* s) {
           r->rnext = nullptr;
           if (older) attach(r, older);
           else if (defaulted) attach_default(r, *m);
-          if (!same) enqueue(r, *m);
+          if (!same && (!seen || affects(r, v, seen))) enqueue(r, *m);
           r = nx;
         }
       }

@@ -565,11 +565,7 @@ void timed_build(Distribution dist, std::size_t n, double spread = 0x1p20) {
   const double check = std::chrono::duration<double>(t2 - t1).count();
   std::printf("    [%s d=%zu n=%zu] %zu leaves, depth %d: build %.3f s, check %.3f s\n",
               std::string(distribution_name(dist)).c_str(), d, n, tree.leaves().size(), tree.depth(), build, check);
-#ifdef NDEBUG
-  // Generous bounds (shared, noisy machines); the target is well under a second.
-  EXPECT_LT(build, d == 2 ? 1.5 : 4.0);
-  EXPECT_LT(check, d == 2 ? 2.0 : 6.0);
-#endif
+  // Printed, not asserted: the machines are shared (bench/ measures the build's speed).
 }
 
 TEST(StaticQuadtree, HundredThousandPoints) {

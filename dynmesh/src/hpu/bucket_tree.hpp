@@ -141,6 +141,11 @@ class BucketTree {
     search(focus, margin, keep, f);
   }
 
+  /// After a search(): what its answer depended on (the cell-store interface; a static tree
+  /// records no dependencies).
+  void used_within(const Point<2>& /*c*/, double /*r*/) const noexcept {}
+  void used_all() const noexcept {}
+
   /// The widening of cells that keeps every vertex of a cell inside it despite the rounding
   /// of point location, for a query of radius r around c.
   double margin_for(const Point<2>& c, double r) const noexcept {

@@ -21,7 +21,11 @@
 // The store is anything with search(focus, scale, margin, keep, f) (nearest-first pruned
 // leaf visits: keep(x0, y0, x1, y1) asked of every cell, stop = f(v) for a leaf's vertices),
 // search_within(focus, radius, scale, margin, keep, f) (the same, keep() bounded by that disc),
-// margin_for(c, r) and leaves_read(). Every store answers exactly: a step's view
+// margin_for(c, r) and leaves_read(). After every search() the question says what its answer
+// used of the leaves it read: used_within(c, r) (the vertices within r of c) or used_all().
+// A search_within's answer uses only the vertices within its radius (plus the margins): f
+// rejects every other one without an effect. A step's reads re-run only when what it used
+// changes (cell_view.hpp). Every store answers exactly: a step's view
 // (cell_view.hpp) looks a cell the step has not read up as it is now and notes it for the
 // step's next round of reads.
 // Invariants: a question reads nothing but the store; given a store that does not fail, the
@@ -197,6 +201,9 @@ class CellQuestions {
           if (w != v) best = std::min(best, cellq::length(P_(w)[0] - p[0], P_(w)[1] - p[1]));
           return false;
         });
+    // The minimum is that of the vertices within best: one farther cannot lower it.
+    if (std::isfinite(best)) store_->used_within(p, best);
+    else store_->used_all();
     return best;
   }
 
@@ -587,6 +594,7 @@ class CellQuestions {
             }
             return false;
           });
+      store_->used_all();  // which side vertices count depends on the ones found
     };
     scan(-std::numeric_limits<double>::infinity(), false);
     if (holding) {

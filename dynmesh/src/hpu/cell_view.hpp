@@ -52,6 +52,50 @@ namespace dynmesh::detail {
 
 inline constexpr std::size_t kCellsPerRead = 16;  // Engine::read_many's most
 
+/// What a step's answers used of a cell it read: the vertices inside a box of the cell, in
+/// 256ths of its width on each axis (inclusive; x0 > x1: none, only the cell's kind). The
+/// default is all of it. A vertex's 256th is found by one fixed sequence of double operations,
+/// monotone in its coordinate, so a vertex inside a box is inside the box's 256ths.
+struct CellInterest {
+  std::uint8_t x0 = 0, y0 = 0, x1 = 255, y1 = 255;
+  static constexpr CellInterest none() noexcept { return {1, 1, 0, 0}; }
+};
+
+/// A cell's frame for CellInterest: its lower corner and 256 over its width.
+struct CellFrame {
+  double ox, oy, inv;
+  CellFrame(const Box<2>& box, const CellKey& k) {
+    const double w = std::ldexp(box.side, -k.level);
+    ox = box.origin[0] + static_cast<double>(k.ix) * w;
+    oy = box.origin[1] + static_cast<double>(k.iy) * w;
+    inv = 256.0 / w;
+  }
+  static std::uint8_t part(double x, double o, double inv) noexcept {
+    const double t = std::floor((x - o) * inv);
+    return static_cast<std::uint8_t>(t <= 0 ? 0 : t >= 255 ? 255 : t);  // NaN-free: x, o finite
+  }
+  bool inside(const CellInterest& in, const Point<2>& p) const noexcept {
+    const std::uint8_t x = part(p[0], ox, inv), y = part(p[1], oy, inv);
+    return x >= in.x0 && x <= in.x1 && y >= in.y0 && y <= in.y1;
+  }
+};
+
+/// Does replacing a cell's value `before` by `after` change what `in` used of it? A change of
+/// kind always does; for two leaves, the vertices inside the box, in order, must be the same.
+inline bool interest_changed(const Box<2>& box, const CellKey& k, const CellInterest& in, const CellState& before,
+                             const CellState& after) {
+  if (before.kind != after.kind) return true;
+  if (before.kind != CellState::Leaf) return before != after;
+  const CellFrame f(box, k);
+  std::size_t i = 0, j = 0;
+  for (;; ++i, ++j) {
+    while (i < before.count && !f.inside(in, before.items[i]->p)) ++i;
+    while (j < after.count && !f.inside(in, after.items[j]->p)) ++j;
+    if (i == before.count || j == after.count) return (i == before.count) != (j == after.count);
+    if (before.items[i] != after.items[j]) return true;
+  }
+}
+
 class CellView {
  public:
   using V = const CellVertex*;
@@ -84,27 +128,28 @@ class CellView {
     used_ = 0;
     read_.clear();
     settled_ = 0;
+    visited_.clear();
     return false;
   }
 
-  /// A cell the step has read, with its value now.
-  void add(CellNode* n, const CellState* s) { read_.push_back({n, s}); }
+  /// A cell the step has read, with its value now, and where the step's read keeps what the
+  /// step used of it (CellInterest; written by done()).
+  void add(CellNode* n, const CellState* s, CellInterest* used) { read_.push_back({n, s, used}); }
 
   /// After the adds: the cells added since the last call become read, and so do their
   /// ancestors, as splits (a read leaf or split has a split parent); the cells still
   /// pending are those no round has read yet.
   void settle() {
-    const std::span<const std::pair<CellNode*, const CellState*>> fresh(read_.data() + settled_,
-                                                                        read_.size() - settled_);
+    const std::span<const ReadCell> fresh(read_.data() + settled_, read_.size() - settled_);
     settled_ = read_.size();
-    for (const auto& [n, s] : fresh) {
+    for (const auto& [n, s, used] : fresh) {
       Slot& x = slot(n->key);
       x.tag = tag_of(s);
       x.state = s;
       x.node = n;
       x.read = true;
     }
-    for (const auto& [n, s] : fresh) {
+    for (const auto& [n, s, used] : fresh) {
       if (s->kind == CellState::Absent || n->key.level == 0) continue;
       for (CellKey k = n->key.parent();; k = k.parent()) {
         Slot& x = slot(k);
@@ -125,6 +170,27 @@ class CellView {
   /// the same (the cell was peeked), but it must not act on them: its next round reads
   /// pending().
   bool failed() const noexcept { return !pending_.empty(); }
+  /// After a step's questions: !failed(), and then the step's reads learn what it used of
+  /// each cell (CellInterest), so that a change elsewhere in a cell does not re-run it. A
+  /// step calls it once its answers stand, before it acts.
+  bool done() {
+    if (failed()) return false;
+    if (!visited_.empty()) throw InvariantError("dynmesh: CellView: a search's use was not stated");
+    for (const ReadCell& r : read_) {
+      if (!r.used) continue;
+      const Slot& x = *find_slot(r.node->key);
+      CellInterest in = CellInterest::none();
+      if (x.all) {
+        in = CellInterest{};
+      } else if (x.bx0 <= x.bx1) {
+        const CellFrame f(box_, x.key);
+        in = {CellFrame::part(x.bx0, f.ox, f.inv), CellFrame::part(x.by0, f.oy, f.inv),
+              CellFrame::part(x.bx1, f.ox, f.inv), CellFrame::part(x.by1, f.oy, f.inv)};
+      }
+      *r.used = in;
+    }
+    return true;
+  }
   /// Is this run's view the one the step's last run had, the cells it peeked now read? Then
   /// that run's answers are this run's (the same values at the same time: nothing ran
   /// between), and the step takes them from its scratch instead of asking again.
@@ -146,10 +212,25 @@ class CellView {
 
   /// BucketTree::search on the cells as they are now. `scale` is not used (the interface of
   /// cell_questions.hpp).
+  /// The question then says what its answer used of the leaves it met: used_within() or
+  /// used_all().
   template <class Keep, class F>
   void search(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f) const {
     auto* self = const_cast<CellView*>(this);
     self->run_search(focus, margin, keep, f, false, 0.0);
+  }
+  /// The last search()'s answer used the vertices within r of c only (of the leaves it met).
+  void used_within(const Point<2>& c, double r) const {
+    auto* self = const_cast<CellView*>(this);
+    const double R = r * (1 + 0x1p-20) + cellq::ulp_room(c);
+    for (const CellKey& k : visited_) self->widen(self->slot(k), c, R);
+    self->visited_.clear();
+  }
+  /// The last search()'s answer may depend on any vertex of the leaves it met.
+  void used_all() const {
+    auto* self = const_cast<CellView*>(this);
+    for (const CellKey& k : visited_) self->slot(k).all = true;
+    self->visited_.clear();
   }
 
   /// search() for a keep() that accepts no cell farther than radius from focus: it starts at
@@ -175,6 +256,7 @@ class CellView {
     Slot& x = resolve(k);
     if (x.tag != Tag::Leaf) throw InvariantError("dynmesh: CellView: a position with no leaf");
     touch(x);
+    x.all = true;  // the insertion writes the leaf's next value: all its vertices
     return {x.node, x.state};
   }
 
@@ -193,6 +275,9 @@ class CellView {
     Tag tag = Tag::Unknown;
     bool read = false;     // a round of the step read it (or read a cell below it)
     bool pending = false;  // a search used it unread: in pending_
+    bool all = false;      // the step used every vertex of it
+    // The box whose vertices the step's searches used, when not all (x0 > x1: none).
+    double bx0, by0, bx1, by1;
     CellKey key;
     const CellState* state = nullptr;
     CellNode* node = nullptr;
@@ -212,6 +297,9 @@ class CellView {
         s.tag = Tag::Unknown;
         s.read = false;
         s.pending = false;
+        s.all = false;
+        s.bx0 = s.by0 = std::numeric_limits<double>::infinity();
+        s.bx1 = s.by1 = -std::numeric_limits<double>::infinity();
         s.key = k;
         s.state = nullptr;
         s.node = nullptr;
@@ -288,11 +376,26 @@ class CellView {
 
   template <class Keep, class F>
   void run_search(const Point<2>& focus, double margin, Keep& keep, F& f, bool bounded, double R) {
+    if (!visited_.empty()) throw InvariantError("dynmesh: CellView: a search's use was not stated");
     bool stop = false;
-    if (!bounded) return search_node(CellKey{}, focus, margin, keep, f, stop);
+    if (!bounded) {
+      region_ = false;
+      return search_node(CellKey{}, focus, margin, keep, f, stop);
+    }
+    // The answer uses the vertices within R of the focus only (cell_questions.hpp): the box
+    // around that disc, widened past the rounding of the questions' distances.
+    region_ = true;
+    region_c_ = focus;
+    region_r_ = R * (1 + 0x1p-20) + cellq::ulp_room(focus);
     std::array<CellKey, 4> starts;
     const std::size_t n = starts_for(focus, R, starts);
     for (std::size_t i = 0; i < n && !stop; ++i) search_node(starts[i], focus, margin, keep, f, stop);
+  }
+
+  /// x's box of used vertices grows by the box around the disc (c, R).
+  static void widen(Slot& x, const Point<2>& c, double R) noexcept {
+    x.bx0 = std::min(x.bx0, c[0] - R), x.by0 = std::min(x.by0, c[1] - R);
+    x.bx1 = std::max(x.bx1, c[0] + R), x.by1 = std::max(x.by1, c[1] + R);
   }
 
   /// Where a search of the box [focus ± R] starts: the cells of the finest level as wide as
@@ -351,6 +454,8 @@ class CellView {
       case Tag::Leaf: {
         ++leaves_read_;
         touch(x);
+        if (region_) widen(x, region_c_, region_r_);
+        else visited_.push_back(k);
         const CellState& s = *x.state;
         for (std::size_t i = 0; i < s.count; ++i)
           if (f(s.items[i])) {
@@ -392,9 +497,20 @@ class CellView {
   std::vector<Slot> table_;
   std::size_t mask_ = 0, used_ = 0;
   std::uint32_t gen_ = 0;
-  std::vector<std::pair<CellNode*, const CellState*>> read_;
+  struct ReadCell {
+    CellNode* node;
+    const CellState* state;
+    CellInterest* used;  // in the closure of the round that read it
+  };
+  std::vector<ReadCell> read_;
   std::size_t settled_ = 0;  // read_'s prefix settle() has seen
   std::vector<CellNode*> pending_;
+  // The running search's disc of used vertices (region_), or, for a search() without one,
+  // the leaves it met, until the question states its use.
+  bool region_ = false;
+  Point<2> region_c_{};
+  double region_r_ = 0;
+  std::vector<CellKey> visited_;
   int guess_level_ = 0;  // deepest_present's last answer (a hint only)
   std::size_t leaves_read_ = 0;
   Counts counts_;
@@ -411,20 +527,27 @@ class CellView {
 /// many cells this one read (the cells follow it in CellRound).
 struct CellRoundHead {
   const CellRoundHead* parent;
-  std::uint32_t n;
+  std::uint16_t n;    // cells read
+  std::uint16_t cap;  // N
   std::uint32_t serial;  // a first round: its step's run that issued it (CellView::hand_over)
 };
 
+/// A round's cells, and what the step used of each (the read's own state: the step's last
+/// run that did not fail wrote it, CellView::done(); the read asks it on every change).
 template <std::size_t N>
 struct CellRoundCells {
   CellRoundHead head;
   std::array<CellNode*, N> cells;
+  mutable std::array<CellInterest, N> used;
 };
 
 inline CellNode* const* cells_of(const CellRoundHead* h) {
   // Every CellRound<Step, N> starts with a CellRoundCells<N> (standard layout), whose cells
-  // follow the head at the same offset for every N.
+  // follow the head at the same offset for every N, and whose `used` follows the N cells.
   return reinterpret_cast<const CellRoundCells<1>*>(h)->cells.data();
+}
+inline CellInterest* used_of(const CellRoundHead* h) {
+  return const_cast<CellInterest*>(reinterpret_cast<const CellInterest*>(cells_of(h) + h->cap));
 }
 
 template <class Step>
@@ -432,6 +555,8 @@ void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, 
                  std::span<CellNode* const> misses);
 
 /// One round of a step: reads its cells, then runs the step on the view of all its rounds.
+/// A read of a projection (sac::Engine::read_many): a change of a cell re-runs it only when
+/// it changes what the step used of that cell.
 template <class Step, std::size_t N>
 struct CellRound {
   CellRoundCells<N> c;
@@ -440,17 +565,22 @@ struct CellRound {
   void operator()(sac::Engine& e, std::span<const CellState* const> vals) const {
     CellView& v = *step.view(e);
     const bool kept = v.reset(c.head.parent, c.head.serial);  // the view before is still there
-    for (std::uint32_t i = 0; i < c.head.n; ++i) v.add(c.cells[i], vals[i]);
+    for (std::uint32_t i = 0; i < c.head.n; ++i) v.add(c.cells[i], vals[i], &c.used[i]);
     if (!kept)
       for (const CellRoundHead* r = c.head.parent; r; r = r->parent) {
         CellNode* const* cells = cells_of(r);
-        for (std::uint32_t i = 0; i < r->n; ++i) v.add(cells[i], &e.current(cells[i]->state));
+        CellInterest* used = used_of(r);
+        for (std::uint32_t i = 0; i < r->n; ++i) v.add(cells[i], &e.current(cells[i]->state), &used[i]);
       }
     v.settle();
     if (!step.run(e, v)) {
       v.hand_over(&c.head);
       issue_round(e, step, &c.head, 0, v.pending());
     }
+  }
+
+  bool affected(std::size_t i, const CellState& before, const CellState& after) const {
+    return interest_changed(step.box(), c.cells[i]->key, c.used[i], before, after);
   }
 };
 
@@ -459,7 +589,9 @@ void issue_round_n(sac::Engine& e, const Step& step, const CellRoundHead* parent
                    std::span<CellNode* const> misses) {
   static_assert(std::is_standard_layout_v<CellRoundCells<N>>);
   static_assert(offsetof(CellRoundCells<N>, cells) == offsetof(CellRoundCells<1>, cells));
-  CellRound<Step, N> r{{{parent, static_cast<std::uint32_t>(misses.size()), serial}, {}}, step};
+  static_assert(offsetof(CellRoundCells<N>, used) == offsetof(CellRoundCells<N>, cells) + N * sizeof(CellNode*));
+  CellRound<Step, N> r{{{parent, static_cast<std::uint16_t>(misses.size()), static_cast<std::uint16_t>(N), serial}, {}, {}},
+                       step};
   std::array<const sac::Mod<CellState>*, N> mods;
   for (std::size_t i = 0; i < misses.size(); ++i) {
     r.c.cells[i] = misses[i];
@@ -484,10 +616,10 @@ void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, 
 /// questions use and so fails (unless they use none); then, round after round, on the
 /// cells it used, read, until a run does not fail (one round when it uses at most 16
 /// cells). A run in a kept view (CellView::kept()) takes the answers of the run before from
-/// the step's scratch. Step: copyable
-/// (it is each round's closure), with CellView* view(Engine&) and bool run(Engine&,
-/// CellView&). run returns false when the view failed, and has then written, allocated and
-/// issued nothing; otherwise it does the step's effects, in this order: writes and
+/// the step's scratch. Step: copyable (it is each round's closure), with CellView*
+/// view(Engine&), const Box<2>& box() (the store's) and bool run(Engine&, CellView&). run
+/// returns false when CellView::done() does (the view failed), and has then written,
+/// allocated and issued nothing; otherwise it does the step's effects, in this order: writes and
 /// allocations first (they use the view and the program's scratch), then the reads, memo
 /// calls and run_step calls that continue the program (a write after an issued call would
 /// run that call on the spot, and it would reuse the view).

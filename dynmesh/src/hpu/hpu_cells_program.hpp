@@ -217,10 +217,11 @@ struct HpuCellsProgram {
     HcCell* cell;
     int mn, hint;
     CellView* view(sac::Engine&) const { return &pg->view; }
+    const Box<2>& box() const noexcept { return pg->box(); }
     bool run(sac::Engine& e, CellView& v) const {
       const double scale = hint == INT_MAX ? pg->box().side / 4 : scale_of(hint);
       if (!v.kept()) pg->first_class = pg->q.first_class(cell->v, scale);
-      if (v.failed()) return false;
+      if (!v.done()) return false;
       const int c = pg->first_class;
       ++pg->steps.done[HcStepCounts::FirstClass];
       e.write(cell->cls, c);
@@ -315,10 +316,11 @@ struct HpuCellsProgram {
     HcEntry* before;  // the entry before ent (null: ent is first)
     sac::Mod<HcEntry*>* cdest;
     CellView* view(sac::Engine&) const { return &pg->view; }
+    const Box<2>& box() const noexcept { return pg->box(); }
     bool run(sac::Engine& e, CellView& v) const {
       const int j = cs->j;
       if (!v.kept()) pg->go_on = pg->q.collect(ent->v, j, ent->birth, pg->pairs);
-      if (v.failed()) return false;
+      if (!v.done()) return false;
       ++pg->steps.done[HcStepCounts::Collect];
       // The entry's own list: no tail threads through the round, so a change in one
       // entry's pairs does not change the keys of the (mostly pairless) entries after it.
@@ -403,10 +405,11 @@ struct HpuCellsProgram {
   struct TryStep {
     Ctx c;
     CellView* view(sac::Engine&) const { return &c.pg->view; }
+    const Box<2>& box() const noexcept { return c.pg->box(); }
     bool run(sac::Engine& e, CellView& v) const {
       HpuCellsProgram* pg = c.pg;
       if (!v.kept()) pg->decision = pg->q.decide(c.pc->p, c.pc->q, c.cs->j);
-      if (v.failed()) return false;
+      if (!v.done()) return false;
       const CellDecision<HV> d = pg->decision;  // a copy: the steps it issues use the scratch
       ++pg->steps.done[HcStepCounts::Try];
       switch (d.kind) {
@@ -459,9 +462,10 @@ struct HpuCellsProgram {
     int j;
     K k;
     CellView* view(sac::Engine&) const { return &pg->view; }
+    const Box<2>& box() const noexcept { return pg->box(); }
     bool run(sac::Engine& e, CellView& v) const {
       if (!v.kept()) std::tie(pg->at_node, pg->at_state) = v.locate(pg->dir->position(x->p), scale_of(j));
-      if (v.failed()) return false;
+      if (!v.done()) return false;
       CellNode* const node = pg->at_node;
       const CellState* const s = pg->at_state;
       ++pg->steps.done[HcStepCounts::Insert];
@@ -517,6 +521,7 @@ struct HpuCellsProgram {
     HpuCellsProgram* pg;
     CellNode* n;
     CellView* view(sac::Engine&) const { return &pg->view; }
+    const Box<2>& box() const noexcept { return pg->box(); }
     bool run(sac::Engine& e, CellView& v) const {
       const CellState& s = e.current(n->state);  // read by final_node, the enclosing read
       const double scale = std::ldexp(pg->box().side, -n->key.level) / 4;
@@ -528,7 +533,7 @@ struct HpuCellsProgram {
           for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
         }
       }
-      if (v.failed()) return false;
+      if (!v.done()) return false;
       ++pg->steps.done[HcStepCounts::Final];
       if (!pg->block.empty()) e.make<HpuTriBlock>(pg->feed, std::span<const Triangle>(pg->block));
       return true;

@@ -16,7 +16,8 @@
 //                           reused (trace between is undone, affected reads inside it are
 //                           propagated, execution jumps to its end).
 //   rt.memo_read(m, fn)     read(m, fn) memoized on (m, fn) with no extra record.
-//   rt.read_many(ms, body)  k nested reads as one record and one interval: body(values).
+//   rt.read_many(ms, body)  k nested reads as one record and one interval: body(values);
+//                           with body.affected(i, before, after), a read of a projection.
 //   rt.current(m)           the value of m an enclosing read already depends on, unrecorded.
 //   rt.peek(m)              the value of m visible now, unrecorded: a guess for a prefetch.
 //
@@ -141,6 +142,17 @@ class Engine {
   /// writes excepted), propagate() re-runs body once, seeing all k current values. The
   /// pointers to vals are valid during the call only. Not memoized (no memo_read analogue).
   /// UsageError for k outside [1, 16]. O(k) plus the version walks of the k modifiables.
+  ///
+  /// A read of a projection: when body's closure has
+  ///   bool affected(std::size_t i, const T& before, const T& after) const,
+  /// a change of the value mods[i] shows (a write, a set() or an undone write; before !=
+  /// after) re-runs body only if affected() says so. false promises that body, run on after,
+  /// would have the same effects as it had on before: the read then sees after without
+  /// re-running. The closure states what body depends on in each value, typically in members
+  /// body narrows as it runs (mutable: they are the read's own state, not part of its
+  /// identity), and affected() must answer from them as they were when body last ran. It
+  /// runs during propagate() and in set(), so it must not call the engine. O(1) per changed
+  /// slot, plus affected().
   template <class T, class F>
   void read_many(std::span<const Mod<T>* const> mods, F&& body);
   template <class T, class F>
@@ -330,6 +342,9 @@ class Engine {
   /// Queues the read of l, which reads m through l, for re-execution (no-op if queued).
   /// A multi-read waits with no modifiable: its slots name theirs.
   void enqueue(detail::ReaderLink* l, const ModBase& m);
+  /// Does a change of the value reader l sees from `before` to `after` (not equal) affect
+  /// it? Always, unless l's read is a read of a projection that says no, or it is queued.
+  static bool affects(detail::ReaderLink* l, const detail::VersionBase* before, const detail::VersionBase* after);
   /// Re-executes r, a read of m (null for a multi-read), inside its own interval (an
   /// affected read just popped).
   void rerun(detail::ReadNode* r, const ModBase* m);

@@ -113,6 +113,12 @@ struct ReadOpsFor {
   }
 };
 
+/// Does closure F of a multi-read of T values narrow what it depends on (Engine::read_many)?
+template <class F, class T>
+concept ProjectedRead = requires(const F& f, std::size_t i, const T& a, const T& b) {
+  { f.affected(i, a, b) } -> std::convertible_to<bool>;
+};
+
 /// A multi-read of k modifiables of type T with closure F (ReadManyHeader): the body gets
 /// (Engine&,) std::span<const T* const> of the k values, in the order of the modifiables.
 template <class T, class F>
@@ -136,9 +142,20 @@ struct ReadManyOpsFor {
     for (std::uint32_t i = 0; i < many_of(r)->k; ++i) s[i].~ReadSlot();
     many_of(r)->~ReadManyHeader();
   }
-  static constexpr ReadOps ops{nullptr, &destroy, nullptr, &VersionOpsFor<T>::ops,
+  static bool affected(const ReadNode* r, std::uint32_t i, const VersionBase* before, const VersionBase* after) {
+    if constexpr (ProjectedRead<F, T>)
+      return closure(const_cast<ReadNode*>(r))
+          ->affected(i, static_cast<const Version<T>*>(before)->value, static_cast<const Version<T>*>(after)->value);
+    else
+      return true;
+  }
+  static constexpr ReadOps ops{nullptr,
+                               &destroy,
+                               nullptr,
+                               &VersionOpsFor<T>::ops,
                                static_cast<std::uint32_t>(sizeof(ReadManyHeader) + sizeof(F)),
-                               &invoke_many};
+                               &invoke_many,
+                               ProjectedRead<F, T> ? &affected : nullptr};
   static std::uint32_t id() {
     static const std::uint32_t i = register_read_ops(&ops);
     return i;

@@ -91,6 +91,10 @@ struct ReadOps {
   std::uint32_t size;
   /// A multi-read's body, given the k versions it sees in slot order; null for a plain read.
   void (*invoke_many)(Engine&, ReadNode*, const VersionBase* const*) = nullptr;
+  /// A read of a projection (Engine::read_many with a closure that has affected()): does
+  /// replacing the value slot i sees, `before`, by `after` change what the body depends on?
+  /// Null: every change does.
+  bool (*affected)(const ReadNode*, std::uint32_t slot, const VersionBase* before, const VersionBase* after) = nullptr;
 };
 
 /// The read ops tables by number, so that a read stores 4 bytes for its ops instead of 8.
