@@ -1,0 +1,79 @@
+// Tests of cell_view.hpp's record of what a step used of a cell (CellInterest): the 256ths
+// of a box hold every vertex inside the box, whatever the cell and the rounding, and a change
+// of a leaf counts exactly when it changes the vertices inside the used box (or the kind).
+// The program's reads that rely on it are checked end to end by hpu_cells_program_test.cpp
+// (every update against the twin).
+#include "hpu/cell_view.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <random>
+#include <vector>
+
+#include "dynmesh/box.hpp"
+#include "dynmesh/point.hpp"
+#include "hpu/cell_store.hpp"
+
+namespace {
+
+using dynmesh::Box;
+using dynmesh::Point;
+using namespace dynmesh::detail;
+
+// The 256ths of [x0, x1] × [y0, y1] in cell k, as CellView::done() makes them.
+CellInterest interest_of(const Box<2>& box, const CellKey& k, double x0, double y0, double x1, double y1) {
+  const CellFrame f(box, k);
+  return {CellFrame::part(x0, f.ox, f.inv), CellFrame::part(y0, f.oy, f.inv), CellFrame::part(x1, f.ox, f.inv),
+          CellFrame::part(y1, f.oy, f.inv)};
+}
+
+TEST(CellInterest, EveryVertexInsideABoxIsInsideItsParts) {
+  std::mt19937_64 rng(20261127);
+  std::printf("seed 20261127\n");
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int t = 0; t < 20000; ++t) {
+    // A box of awkward origin and side, a cell of some level, a used box near the cell, and
+    // points on and inside its edges (the rounding cases).
+    const Box<2> box{{-3.7 + u(rng), 1e3 * u(rng)}, 0.1 + 100 * u(rng)};
+    const int level = static_cast<int>(rng() % 30);
+    const std::uint64_t n = std::uint64_t{1} << level;
+    const CellKey k{level, rng() % n, rng() % n};
+    const CellFrame f(box, k);
+    const double w = std::ldexp(box.side, -level);
+    const double x0 = f.ox + w * (1.4 * u(rng) - 0.2), x1 = x0 + w * u(rng);
+    const double y0 = f.oy + w * (1.4 * u(rng) - 0.2), y1 = y0 + w * u(rng);
+    const CellInterest in = interest_of(box, k, x0, y0, x1, y1);
+    const Point<2> corners[] = {{x0, y0}, {x1, y1}, {x0, y1}, {x1, y0}};
+    for (const Point<2>& p : corners) ASSERT_TRUE(f.inside(in, p)) << "try " << t;
+    const Point<2> mid{x0 + (x1 - x0) * u(rng), y0 + (y1 - y0) * u(rng)};
+    if (mid[0] >= x0 && mid[0] <= x1 && mid[1] >= y0 && mid[1] <= y1) {
+      ASSERT_TRUE(f.inside(in, mid)) << "try " << t;
+    }
+  }
+}
+
+TEST(CellInterest, ALeafChangesForAReadOnlyInsideWhatItUsed) {
+  const Box<2> box{{0, 0}, 16};
+  const CellKey k{2, 1, 1};  // [4, 8] × [4, 8]
+  std::deque<CellVertex> vs;
+  const auto v = [&](double x, double y) { return &vs.emplace_back(Point<2>{x, y}); };
+  const CellVertex *a = v(4.5, 4.5), *b = v(5, 7), *c = v(7.5, 7.5), *d = v(7.6, 4.2), *e = v(4.4, 4.6);
+  const auto leaf = [](std::vector<const CellVertex*> xs) { return CellState::leaf(xs.begin(), xs.end()); };
+  const CellState before = leaf({a, b, c});
+  const CellInterest lower_left = interest_of(box, k, 4, 4, 5.5, 5.5);  // holds a, not b or c
+
+  EXPECT_FALSE(interest_changed(box, k, lower_left, before, leaf({a, b})));     // c left: outside
+  EXPECT_FALSE(interest_changed(box, k, lower_left, before, leaf({a, b, c, d})));  // d came: outside
+  EXPECT_TRUE(interest_changed(box, k, lower_left, before, leaf({b, c})));      // a left
+  EXPECT_TRUE(interest_changed(box, k, lower_left, before, leaf({a, b, c, e})));  // e came: inside
+  EXPECT_TRUE(interest_changed(box, k, lower_left, before, CellState::split()));  // a kind change
+  // All of it: any other vertex set changes it; none of it: only the kind does.
+  EXPECT_TRUE(interest_changed(box, k, CellInterest{}, before, leaf({a, b, c, d})));
+  EXPECT_FALSE(interest_changed(box, k, CellInterest::none(), before, leaf({d})));
+  EXPECT_TRUE(interest_changed(box, k, CellInterest::none(), before, CellState{}));  // absent
+}
+
+}  // namespace
