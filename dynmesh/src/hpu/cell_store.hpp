@@ -120,24 +120,25 @@ struct CellNode {
 /// (absent), and lives as long as the directory.
 class CellDirectory {
  public:
-  explicit CellDirectory(const Box<2>& box) : grid_(box), box_(box) {}
+  explicit CellDirectory(const Box<2>& box) : grid_(box), box_(box), table_(1024) {}
   CellDirectory(const CellDirectory&) = delete;
   CellDirectory& operator=(const CellDirectory&) = delete;
 
   /// The cell's node, made (with the default value) if new. Mutator or computation.
   CellNode* node(sac::Engine& e, const CellKey& k) {
-    const auto [it, fresh] = map_.try_emplace(k, nullptr);
-    if (fresh) {
-      it->second = &nodes_.emplace_back(k);
-      e.init_default(it->second->state);
-    }
-    return it->second;
+    const std::uint64_t h = k.hash();
+    Entry* x = probe(k, h);
+    if (x->node) return x->node;
+    CellNode* n = &nodes_.emplace_back(k);
+    e.init_default(n->state);
+    *x = Entry{h, n};
+    if (2 * nodes_.size() > table_.size()) grow();
+    return n;
   }
-  /// The cell's node if it was ever made, else null.
-  CellNode* find(const CellKey& k) const {
-    const auto it = map_.find(k);
-    return it == map_.end() ? nullptr : it->second;
-  }
+  /// The cell's node if it was ever made, else null. O(1) expected: the questions ask it for
+  /// every cell they look at, so it is an open-addressing table whose entries carry the
+  /// key's hash (a miss or a collision costs no visit to a node).
+  CellNode* find(const CellKey& k) const { return const_cast<CellDirectory*>(this)->probe(k, k.hash())->node; }
 
   /// The exact grid position of x (bucket_tree.hpp's).
   std::array<std::uint64_t, 2> position(const Point<2>& x) const noexcept { return grid_.position(x); }
@@ -151,7 +152,7 @@ class CellDirectory {
   const Box<2>& box() const noexcept { return box_; }
   /// Bytes held outside the trace (nodes and the map).
   std::size_t bytes() const noexcept {
-    return nodes_.size() * (sizeof(CellNode) + sizeof(void*) * 3 + sizeof(CellKey));
+    return nodes_.size() * sizeof(CellNode) + table_.size() * sizeof(Entry);
   }
 
   /// The newest values' non-empty leaves (the bucket tree after the last run or
@@ -185,9 +186,34 @@ class CellDirectory {
     out.push_back(std::move(leaf));
   }
 
+  struct Entry {
+    std::uint64_t hash = 0;
+    CellNode* node = nullptr;  // null: free (nodes are never removed)
+  };
+
+  /// k's entry: its node's, or the free one where it would go (linear probing).
+  Entry* probe(const CellKey& k, std::uint64_t h) {
+    const std::size_t mask = table_.size() - 1;
+    for (std::size_t i = h & mask;; i = (i + 1) & mask) {
+      Entry& x = table_[i];
+      if (!x.node || (x.hash == h && x.node->key == k)) return &x;
+    }
+  }
+  void grow() {
+    std::vector<Entry> old(table_.size() * 2);
+    old.swap(table_);
+    const std::size_t mask = table_.size() - 1;
+    for (const Entry& x : old) {
+      if (!x.node) continue;
+      std::size_t i = x.hash & mask;
+      while (table_[i].node) i = (i + 1) & mask;
+      table_[i] = x;
+    }
+  }
+
   BucketTree grid_;  // only its position() and margin_for() are used
   Box<2> box_;
-  std::unordered_map<CellKey, CellNode*, CellKeyHash> map_;
+  std::vector<Entry> table_;  // a power of two, at most half full
   std::deque<CellNode> nodes_;
 };
 
