@@ -322,18 +322,15 @@ void BM_EngineRead4FromScratch(benchmark::State& state) {
 BENCHMARK_TEMPLATE(BM_EngineRead4FromScratch, true)->Arg(1 << 10)->Arg(1 << 18);
 BENCHMARK_TEMPLATE(BM_EngineRead4FromScratch, false)->Arg(1 << 10)->Arg(1 << 18);
 
-template <bool kMany>
-void BM_EngineRead4Propagate(benchmark::State& state) {
-  const auto n = static_cast<std::size_t>(state.range(0));
-  Engine e;
-  Flat f(n);
-  for (std::size_t i = 0; i < n; ++i) e.set(f.in[i], static_cast<int>(i));
-  e.run([&](Engine& en) { run_steps<kMany>(en, f); });
+/// The timed loop of the propagate benchmarks: each iteration adds delta to a random input
+/// and propagates.
+void propagate_changes(benchmark::State& state, Engine& e, Flat& f, int delta) {
+  const std::size_t n = f.in.size();
   std::mt19937_64 rng(7);
   std::uint64_t propagations = 0, reexecuted = 0;
   for (auto _ : state) {
     const std::size_t i = static_cast<std::size_t>(rng() % n);
-    e.set(f.in[i], f.in[i].get() + 1);  // always a change: 4 steps read it
+    e.set(f.in[i], f.in[i].get() + delta);
     e.propagate();
     ++propagations;
     reexecuted += e.stats().last_reexecuted;
@@ -341,6 +338,16 @@ void BM_EngineRead4Propagate(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(propagations));
   state.counters["reexecuted_per_propagate"] =
       propagations ? static_cast<double>(reexecuted) / static_cast<double>(propagations) : 0.0;
+}
+
+template <bool kMany>
+void BM_EngineRead4Propagate(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  Engine e;
+  Flat f(n);
+  for (std::size_t i = 0; i < n; ++i) e.set(f.in[i], static_cast<int>(i));
+  e.run([&](Engine& en) { run_steps<kMany>(en, f); });
+  propagate_changes(state, e, f, 1);  // always a change: 4 steps read it
   state.counters["trace_bytes_per_step"] = static_cast<double>(e.trace_bytes()) / static_cast<double>(n);
   state.counters["record_bytes_per_step"] = static_cast<double>(e.record_bytes()) / static_cast<double>(n);
 }
@@ -377,18 +384,7 @@ void BM_EngineRead4ProjectionPropagate(benchmark::State& state) {
       en.read_many({&f.in[i], &f.in[(i + 1) % n], &f.in[(i + 2) % n], &f.in[(i + 3) % n]},
                    SumLow<kProjected>{{&f.out[i]}});
   });
-  std::mt19937_64 rng(7);
-  std::uint64_t propagations = 0, reexecuted = 0;
-  for (auto _ : state) {
-    const std::size_t i = static_cast<std::size_t>(rng() % n);
-    e.set(f.in[i], f.in[i].get() + delta);
-    e.propagate();
-    ++propagations;
-    reexecuted += e.stats().last_reexecuted;
-  }
-  state.SetItemsProcessed(static_cast<std::int64_t>(propagations));
-  state.counters["reexecuted_per_propagate"] =
-      propagations ? static_cast<double>(reexecuted) / static_cast<double>(propagations) : 0.0;
+  propagate_changes(state, e, f, delta);
 }
 BENCHMARK_TEMPLATE(BM_EngineRead4ProjectionPropagate, true)->Args({1 << 16, 16})->Args({1 << 16, 1});
 BENCHMARK_TEMPLATE(BM_EngineRead4ProjectionPropagate, false)->Args({1 << 16, 16})->Args({1 << 16, 1});
