@@ -10,8 +10,10 @@
 // in the reads before, and runs the step again; that run takes the answers of the run
 // before (the same values: kept()) and does the step's writes. So a step is one read of
 // exactly the cells its answers depend on (1.01 rounds per step measured: bench/RESULTS.md),
-// and it re-runs only when one of them changes (cut-off: a write of an equal vertex set is
-// no change).
+// and it re-runs only when what it used of one of them changes: each read is a read of a
+// projection (Engine::read_many with affected()) that keeps, per cell, the box of the
+// vertices the step's searches could see (CellInterest); a vertex entering or leaving the
+// cell outside it is no change, a split or a merge always is.
 // Which cells a step depends on: the leaves a search hands vertices from, a split cell whose
 // children it all prunes, and the leaf an insertion locates. The leaves tile the region the
 // search covers, so any change there (a vertex, a split, a merge) changes one of them; the
@@ -23,7 +25,8 @@
 // last run); any other (a round re-run by change propagation) rebuilds the view, looking the
 // outer rounds' values up with Engine::current. A failed run writes, allocates and issues
 // nothing but the next round; a run that did not fail answers as the static tree on the same
-// vertices.
+// vertices, and done() has then given every cell of every round its used box: a vertex the
+// answers depend on lies inside the used box of the leaf that holds it.
 // Complexity: a step's questions once, on peeked cells (each peek a directory lookup and a
 // version walk); O(1) cells per question in a graded mesh.
 // Paper: Acar & Hudson, Section 4; Hammer, Acar & Chen (CEAL, 2009) for reads as the unit of
