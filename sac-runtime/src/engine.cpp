@@ -223,19 +223,19 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
   }
 }
 
-void Engine::set_base(ModBase& m, VersionBase* fresh,
-                      bool (*assign_if_changed)(VersionBase*, VersionBase*)) {
+void Engine::set_base(ModBase& m, VersionBase* fresh, void (*assign)(VersionBase*, VersionBase*)) {
   // set() on a default that reads saw: make it a base version, then assign to it.
-  if (assign_if_changed && m.default_readers()) default_base(m, true, fresh->ops);
+  if (assign && m.default_readers()) default_base(m, true, fresh->ops);
   VersionBase* last = nullptr;
   for (VersionBase* v = m.newest(); v; v = v->older()) last = v;
   if (VersionBase* base = last && last->is_base() ? last : nullptr) {
-    // The readers are asked before the assignment, while both values exist; an equal value
-    // affects none of them.
-    if (base->readers && !base->ops->equal(base, fresh))
+    // An equal value changes nothing. Otherwise the readers are asked before the
+    // assignment, while both values exist.
+    if (!base->ops->equal(base, fresh)) {
       for (ReaderLink* r = base->readers; r; r = r->rnext)
         if (affects(r, base, fresh)) enqueue(r, m);
-    assign_if_changed(base, fresh);
+      assign(base, fresh);
+    }
     destroy(fresh);
     return;
   }

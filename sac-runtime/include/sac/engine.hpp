@@ -322,8 +322,10 @@ class Engine {
   void unlink_version(ModBase* m, detail::VersionBase* v);  // v a version of m
   void link_alloc(detail::AllocNode* n, std::size_t h);
   void link_memo(detail::MemoNode* n, std::size_t h);
-  void set_base(ModBase& m, detail::VersionBase* fresh,
-                bool (*assign_if_changed)(detail::VersionBase*, detail::VersionBase*));
+  /// Makes fresh m's base value: a new base version, or, with `assign`, moved into the base
+  /// version m has (nothing happens when the values are equal, and readers the change
+  /// affects are queued).
+  void set_base(ModBase& m, detail::VersionBase* fresh, void (*assign)(detail::VersionBase*, detail::VersionBase*));
   detail::ReadNode* find_read_match(const ModBase& m, std::uint32_t ops_id,
                                     const void* closure) const;
   detail::AllocNode* find_alloc_match(const detail::AllocOps* ops, std::size_t h,
@@ -453,18 +455,16 @@ void Engine::set(Mod<T>& m, U&& value) {
   using V = detail::Version<T>;
   V* v = construct<V>(std::forward<U>(value));
   v->ops = &detail::VersionOpsFor<T>::ops;
+  // set_base compares the values first (VersionOps::equal): this only moves.
   set_base(m, v, [](detail::VersionBase* old_base, detail::VersionBase* fresh) {
     auto* o = static_cast<V*>(old_base);
     auto* f = static_cast<V*>(fresh);
-    if constexpr (std::equality_comparable<T>)
-      if (o->value == f->value) return false;
     if constexpr (std::is_move_assignable_v<T>) {
       o->value = std::move(f->value);
     } else {
       o->value.~T();
       new (&o->value) T(std::move(f->value));
     }
-    return true;
   });
 }
 
