@@ -23,13 +23,6 @@ using dynmesh::Box;
 using dynmesh::Point;
 using namespace dynmesh::detail;
 
-// The 256ths of [x0, x1] × [y0, y1] in cell k, as CellView::done() makes them.
-CellInterest interest_of(const Box<2>& box, const CellKey& k, double x0, double y0, double x1, double y1) {
-  const CellFrame f(box, k);
-  return {CellFrame::part(x0, f.ox, f.inv), CellFrame::part(y0, f.oy, f.inv), CellFrame::part(x1, f.ox, f.inv),
-          CellFrame::part(y1, f.oy, f.inv)};
-}
-
 TEST(CellInterest, EveryVertexInsideABoxIsInsideItsParts) {
   std::mt19937_64 rng(20261127);
   std::printf("seed 20261127\n");
@@ -45,7 +38,7 @@ TEST(CellInterest, EveryVertexInsideABoxIsInsideItsParts) {
     const double w = std::ldexp(box.side, -level);
     const double x0 = f.ox + w * (1.4 * u(rng) - 0.2), x1 = x0 + w * u(rng);
     const double y0 = f.oy + w * (1.4 * u(rng) - 0.2), y1 = y0 + w * u(rng);
-    const CellInterest in = interest_of(box, k, x0, y0, x1, y1);
+    const CellInterest in = f.interest(x0, y0, x1, y1);
     const Point<2> corners[] = {{x0, y0}, {x1, y1}, {x0, y1}, {x1, y0}};
     for (const Point<2>& p : corners) ASSERT_TRUE(f.inside(in, p)) << "try " << t;
     const Point<2> mid{x0 + (x1 - x0) * u(rng), y0 + (y1 - y0) * u(rng)};
@@ -63,7 +56,7 @@ TEST(CellInterest, ALeafChangesForAReadOnlyInsideWhatItUsed) {
   const CellVertex *a = v(4.5, 4.5), *b = v(5, 7), *c = v(7.5, 7.5), *d = v(7.6, 4.2), *e = v(4.4, 4.6);
   const auto leaf = [](std::vector<const CellVertex*> xs) { return CellState::leaf(xs.begin(), xs.end()); };
   const CellState before = leaf({a, b, c});
-  const CellInterest lower_left = interest_of(box, k, 4, 4, 5.5, 5.5);  // holds a, not b or c
+  const CellInterest lower_left = CellFrame(box, k).interest(4, 4, 5.5, 5.5);  // holds a, not b or c
 
   EXPECT_FALSE(interest_changed(box, k, lower_left, before, leaf({a, b})));     // c left: outside
   EXPECT_FALSE(interest_changed(box, k, lower_left, before, leaf({a, b, c, d})));  // d came: outside

@@ -77,6 +77,10 @@ struct CellFrame {
     const double t = std::floor((x - o) * inv);
     return static_cast<std::uint8_t>(t <= 0 ? 0 : t >= 255 ? 255 : t);  // NaN-free: x, o finite
   }
+  /// The 256ths of the box [x0, x1] × [y0, y1] (any box: parts outside the cell clamp).
+  CellInterest interest(double x0, double y0, double x1, double y1) const noexcept {
+    return {part(x0, ox, inv), part(y0, oy, inv), part(x1, ox, inv), part(y1, oy, inv)};
+  }
   bool inside(const CellInterest& in, const Point<2>& p) const noexcept {
     const std::uint8_t x = part(p[0], ox, inv), y = part(p[1], oy, inv);
     return x >= in.x0 && x <= in.x1 && y >= in.y0 && y <= in.y1;
@@ -186,9 +190,7 @@ class CellView {
       if (x.all) {
         in = CellInterest{};
       } else if (x.bx0 <= x.bx1) {
-        const CellFrame f(box_, x.key);
-        in = {CellFrame::part(x.bx0, f.ox, f.inv), CellFrame::part(x.by0, f.oy, f.inv),
-              CellFrame::part(x.bx1, f.ox, f.inv), CellFrame::part(x.by1, f.oy, f.inv)};
+        in = CellFrame(box_, x.key).interest(x.bx0, x.by0, x.bx1, x.by1);
       }
       *r.used = in;
     }
