@@ -590,44 +590,31 @@ TEST(ReadManyProjection, ReRunsOnlyWhenTheProjectionChanges) {
   });
   EXPECT_EQ(out.get(), 12);
   EXPECT_EQ(runs, 1);
+  // Sets m to v and propagates: the body has then run `want_runs` times in all and written
+  // `want_out`.
+  const auto change = [&](Mod<int>& m, int v, int want_runs, int want_out) {
+    e.set(m, v);
+    e.propagate();
+    EXPECT_EQ(runs, want_runs) << "after setting " << v;
+    EXPECT_EQ(out.get(), want_out) << "after setting " << v;
+  };
   // set(): a new base value with the same last digit does not re-run it ...
-  e.set(a, 41);
-  e.propagate();
-  EXPECT_EQ(runs, 1);
+  change(a, 41, 1, 12);
   EXPECT_EQ(e.stats().last_reexecuted, 0u);
   // ... one with another does, and it sees the newest value.
-  e.set(a, 43);
-  e.propagate();
-  EXPECT_EQ(runs, 2);
-  EXPECT_EQ(out.get(), 32);
+  change(a, 43, 2, 32);
   // A write inserted before it (link_write): 72 ends in 2, as b's 22 does.
-  e.set(sel, 72);
-  e.propagate();
-  EXPECT_EQ(runs, 2);
-  EXPECT_EQ(out.get(), 32);
+  change(sel, 72, 2, 32);
   e.check_invariants();
   // The write replaced by one ending in 5: a change.
-  e.set(sel, 75);
-  e.propagate();
-  EXPECT_EQ(runs, 3);
-  EXPECT_EQ(out.get(), 35);
+  change(sel, 75, 3, 35);
   // The write undone: b's base 22 ends in 2, not 5: a change.
-  e.set(sel, 0);
-  e.propagate();
-  EXPECT_EQ(runs, 4);
-  EXPECT_EQ(out.get(), 32);
+  change(sel, 0, 4, 32);
   // Written again with 2 at the end, then undone: neither re-runs it.
-  e.set(sel, 92);
-  e.propagate();
-  e.set(sel, 0);
-  e.propagate();
-  EXPECT_EQ(runs, 4);
-  EXPECT_EQ(out.get(), 32);
+  change(sel, 92, 4, 32);
+  change(sel, 0, 4, 32);
   // The base value b sees changes its digit while the read is attached to it.
-  e.set(b, 28);
-  e.propagate();
-  EXPECT_EQ(runs, 5);
-  EXPECT_EQ(out.get(), 38);
+  change(b, 28, 5, 38);
   e.check_invariants();
 }
 
