@@ -396,11 +396,22 @@ class CellQuestions {
     const std::size_t d = star_.size();
     const bool cycle = !on_boundary(v) && whole;
     bool go_on = !whole;
-    const auto take = [&](V q) {
+    // Is p→q loose, given its left and right neighbours when the walk met both triangles
+    // (none_: the outside of the box)? For a Delaunay edge they are the vertices nearest the
+    // leaf on either side, so they decide, as in the twin, without a search of the leaf's
+    // disc; otherwise the cells answer. So a collect reads what its star walk read, plus the
+    // cells of the gap's pairs only.
+    const auto loose_pair = [&](V p, V q, const V* t, const V* u) {
+      if (!t || !u) return loose(p, q);
+      ++stats_.leaf_tests;
+      return detail::loose(P_(p), P_(q), leaf_height_, *t == none_ ? nullptr : &P_(*t),
+                           *u == none_ ? nullptr : &P_(*u));
+    };
+    const auto take = [&](V q, const V* left, const V* right) {
       const int c = edge_class(P_(v), P_(q));
       if (birth ? c > j : c != j) return;
-      if (loose(v, q)) pairs.push_back({v, q});
-      if (loose(q, v)) pairs.push_back({q, v});
+      if (loose_pair(v, q, left, right)) pairs.push_back({v, q});
+      if (loose_pair(q, v, right, left)) pairs.push_back({q, v});
     };
     for (std::size_t i = 0; i < d; ++i) {
       const V q = star_[i];
@@ -408,7 +419,12 @@ class CellQuestions {
       // only in a whole cycle (otherwise the gap lies there).
       if (i + 1 < d || cycle) go_on = go_on || circumradius_above(P_(v), P_(q), P_(star_[(i + 1) % d]), j);
       if (edge_class(P_(v), P_(q)) > j) go_on = true;
-      take(q);
+      // q's neighbours around v: the next vertex of star_ is on the left of v→q, the one
+      // before on its right. At the ends of a walk that stopped at the box's sides, the
+      // outside; at a gap, unknown.
+      const V* left = i + 1 < d ? &star_[i + 1] : cycle ? &star_[0] : whole ? &none_ : nullptr;
+      const V* right = i > 0 ? &star_[i - 1] : cycle ? &star_[d - 1] : whole ? &none_ : nullptr;
+      take(q, left, right);
     }
     if (!whole && d > 0) {
       // Edges inside the gap have both triangles beyond 2^(j+1); those of class ≤ j end
@@ -452,7 +468,7 @@ class CellQuestions {
             near_.push_back(w);
             return false;
           });
-      for (const V q : near_) take(q);
+      for (const V q : near_) take(q, nullptr, nullptr);
     }
     std::sort(pairs.begin(), pairs.end(), [&](const auto& x, const auto& y) {
       if (P_(x[0]) != P_(y[0])) return xy_less(P_(x[0]), P_(y[0]));
