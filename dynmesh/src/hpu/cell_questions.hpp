@@ -189,22 +189,60 @@ class CellQuestions {
 
   /// The distance from v to its nearest vertex, in doubles (nearest-first: only the cells
   /// nearer than the best found so far are read). `scale`: the distance expected.
+  ///
+  /// It also keeps, in near_all_, every vertex within the distance found plus a relative
+  /// 2^-19 (and twice ulp_room): a superset of the vertices within d·(1 + 2^-20) that
+  /// sure_neighbour and first_class choose from, and of every vertex nearer than those
+  /// (a diametral intruder is). So those questions need no search of their own.
   double nearest_distance(V v, double scale) const {
     const Point<2>& p = P_(v);
+    const double room = 2 * cellq::ulp_room(p);
+    const auto reach = [&](double d) { return d * (1 + 0x1p-19) + room; };
     double best = std::numeric_limits<double>::infinity();
+    near_all_.clear();
     store_->search(
         p, scale, store_->margin_for(p, 0.0),
         [&](double x0, double y0, double x1, double y1) {
-          return std::sqrt(BucketTree::box_distance2(p, x0, y0, x1, y1)) <= best;
+          // By length(), which does not overflow: near the largest doubles every squared
+          // distance would be infinite, and the search must still prune by best only.
+          const double dx = p[0] < x0 ? x0 - p[0] : p[0] > x1 ? p[0] - x1 : 0.0;
+          const double dy = p[1] < y0 ? y0 - p[1] : p[1] > y1 ? p[1] - y1 : 0.0;
+          return cellq::length(dx, dy) <= reach(best);
         },
         [&](V w) {
-          if (w != v) best = std::min(best, cellq::length(P_(w)[0] - p[0], P_(w)[1] - p[1]));
+          if (w == v) return false;
+          const double l = cellq::length(P_(w)[0] - p[0], P_(w)[1] - p[1]);
+          if (l <= reach(best)) near_all_.push_back(w);
+          best = std::min(best, l);
           return false;
         });
-    // The minimum is that of the vertices within best: one farther cannot lower it.
-    if (std::isfinite(best)) store_->used_within(p, best);
+    // The minimum is that of the vertices within best, and the kept ones lie within
+    // reach(best): one farther changes neither.
+    if (std::isfinite(best)) store_->used_within(p, reach(best));
     else store_->used_all();
     return best;
+  }
+
+  /// The vertices of near_all_ (the last nearest_distance(v)) within r of v, by the same
+  /// test as visit_disc's, in the order found.
+  void kept_within(V v, double r, std::vector<V>& out) const {
+    out.clear();
+    const Point<2>& p = P_(v);
+    const double rr = r * r;
+    for (const V w : near_all_) {
+      const double dx = P_(w)[0] - p[0], dy = P_(w)[1] - p[1];
+      if (dx * dx + dy * dy <= rr) out.push_back(w);
+    }
+  }
+
+  /// A vertex other than v and q inside or on the closed diametral disc of v and q, or
+  /// none(), among near_all_ (the last nearest_distance(v)), for q within its reach: such a
+  /// vertex is strictly nearer to v than q is, so it was kept.
+  V kept_intruder(V v, V q) const {
+    const Point<2>&a = P_(v), &b = P_(q);
+    for (const V w : near_all_)
+      if (w != q && pencil(a, b, 0.0, P_(w)) <= 0) return w;
+    return none_;
   }
 
   /// Some vertex that v has an edge to in every Delaunay triangulation: the nearest one whose
@@ -215,32 +253,17 @@ class CellQuestions {
     if (!std::isfinite(d)) return none_;
     V a = none_;
     const Point<2>& p = P_(v);
-    visit_disc(p, d * (1 + cellq::kSlack) + cellq::ulp_room(p), [&](V w) {
-      if (w != v && (a == none_ || std::hypot(P_(w)[0] - p[0], P_(w)[1] - p[1]) <
-                                       std::hypot(P_(a)[0] - p[0], P_(a)[1] - p[1])))
+    kept_within(v, d * (1 + cellq::kSlack) + cellq::ulp_room(p), near_);
+    for (const V w : near_)
+      if (a == none_ || std::hypot(P_(w)[0] - p[0], P_(w)[1] - p[1]) < std::hypot(P_(a)[0] - p[0], P_(a)[1] - p[1]))
         a = w;
-      return false;
-    });
     // Each step moves strictly nearer to v, so the loop ends.
     while (a != none_) {
-      const V inside = diametral_intruder(v, a);
+      const V inside = kept_intruder(v, a);
       if (inside == none_) return a;
       a = inside;
     }
     return none_;
-  }
-
-  /// A vertex other than v and q inside or on the closed diametral disc of v and q (one is
-  /// strictly nearer to v than q is), or none().
-  V diametral_intruder(V v, V q) const {
-    const Point<2>&a = P_(v), &b = P_(q);
-    const Point<2> m{0.5 * a[0] + 0.5 * b[0], 0.5 * a[1] + 0.5 * b[1]};
-    V inside = none_;
-    visit_disc(m, 0.5 * cellq::length(b[0] - a[0], b[1] - a[1]) * (1 + cellq::kSlack) + cellq::ulp_room(m), [&](V w) {
-      if (w != v && w != q && pencil(a, b, 0.0, P_(w)) <= 0) inside = w;
-      return inside != none_;
-    });
-    return inside;
   }
 
   /// The Delaunay neighbour of p→q on its left (the third corner of the triangle on its
@@ -363,17 +386,13 @@ class CellQuestions {
   int first_class(V v, double scale) {
     const double d = nearest_distance(v, scale);
     if (!std::isfinite(d)) return INT_MAX;  // no other vertex
-    near_.clear();
-    visit_disc(P_(v), d * (1 + 0x1p-39) + cellq::ulp_room(P_(v)), [&](V w) {
-      if (w != v) near_.push_back(w);
-      return false;
-    });
+    kept_within(v, d * (1 + 0x1p-39) + cellq::ulp_room(P_(v)), near_);
     stats_.gathered_first += near_.size();
     int best = INT_MAX, unsure = INT_MAX;
     for (const V q : near_) {
       const int c = edge_class(P_(v), P_(q));
       if (c >= best) continue;
-      if (diametral_intruder(v, q) == none_) best = c;
+      if (kept_intruder(v, q) == none_) best = c;
       else unsure = std::min(unsure, c);
     }
     if (best != INT_MAX && unsure >= best) return best;
@@ -658,7 +677,8 @@ class CellQuestions {
   CellQuestionStats& stats_;
   double lo_[2], hi_[2];
   double apex_height_ = 0, leaf_height_ = 0;
-  std::vector<V> star_, back_, near_;
+  std::vector<V> star_, back_;
+  mutable std::vector<V> near_, near_all_;
   int gap_ends_ = 0;  // star_of's walks that stopped at its cap (0, 1 or 2)
 };
 
