@@ -134,6 +134,12 @@ class BucketTree {
   void search(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f) const {
     search(focus, margin, keep, f);
   }
+  /// search() of the cells that cover [focus ± R] (the cell-store interface): a static tree
+  /// searches from the root, which covers them.
+  template <class Keep, class F>
+  void search_from(const Point<2>& focus, double /*R*/, double margin, Keep&& keep, F&& f) const {
+    search(focus, margin, keep, f);
+  }
   /// search() for a keep() bounded by the disc (focus, radius): the same on a static tree.
   template <class Keep, class F>
   void search_within(const Point<2>& focus, double /*radius*/, double /*scale*/, double margin, Keep&& keep,

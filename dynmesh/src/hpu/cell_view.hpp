@@ -224,16 +224,26 @@ class CellView {
     auto* self = const_cast<CellView*>(this);
     self->run_search(focus, margin, keep, f, false, 0.0);
   }
+  /// search() over the cells that cover the box [focus ± R] only (starts_for), for a
+  /// keep() that accepts no cell beyond it. Unlike search_within(), the question states
+  /// afterwards what its answer used, as after search(); more search_from()s may come first.
+  template <class Keep, class F>
+  void search_from(const Point<2>& focus, double R, double margin, Keep&& keep, F&& f) const {
+    auto* self = const_cast<CellView*>(this);
+    self->run_search(focus, margin, keep, f, false, R);
+  }
   /// The last search()'s answer used the vertices within r of c only (of the leaves it met).
   void used_within(const Point<2>& c, double r) const {
     auto* self = const_cast<CellView*>(this);
     const double R = r * (1 + 0x1p-20) + cellq::ulp_room(c);
+    self->searched_from_ = false;
     for (const CellKey& k : visited_) self->widen(self->slot(k), c, R);
     self->visited_.clear();
   }
   /// The last search()'s answer may depend on any vertex of the leaves it met.
   void used_all() const {
     auto* self = const_cast<CellView*>(this);
+    self->searched_from_ = false;
     for (const CellKey& k : visited_) self->slot(k).all = true;
     self->visited_.clear();
   }
@@ -381,17 +391,24 @@ class CellView {
 
   template <class Keep, class F>
   void run_search(const Point<2>& focus, double margin, Keep& keep, F& f, bool bounded, double R) {
-    if (!visited_.empty()) throw InvariantError("dynmesh: CellView: a search's use was not stated");
+    // Only a search_from() may come between a search and the statement of its use.
+    if (!visited_.empty() && !(searched_from_ && !bounded && R != 0))
+      throw InvariantError("dynmesh: CellView: a search's use was not stated");
+    searched_from_ = !bounded && R != 0;
     bool stop = false;
-    if (!bounded) {
+    if (!bounded && R == 0) {
       region_ = false;
       return search_node(CellKey{}, focus, margin, keep, f, stop);
     }
-    // The answer uses the vertices within R of the focus only (cell_questions.hpp): the box
-    // around that disc, widened past the rounding of the questions' distances.
-    region_ = true;
-    region_c_ = focus;
-    region_r_ = R * (1 + 0x1p-20) + cellq::ulp_room(focus);
+    // search_from() records the leaves it meets until the question states its use. A
+    // bounded search's answer uses the vertices within R of the focus only
+    // (cell_questions.hpp): the box around that disc, widened past the rounding of the
+    // questions' distances.
+    region_ = bounded;
+    if (bounded) {
+      region_c_ = focus;
+      region_r_ = R * (1 + 0x1p-20) + cellq::ulp_room(focus);
+    }
     std::array<CellKey, 4> starts;
     const std::size_t n = starts_for(focus, R, starts);
     for (std::size_t i = 0; i < n && !stop; ++i) search_node(starts[i], focus, margin, keep, f, stop);
@@ -516,6 +533,7 @@ class CellView {
   Point<2> region_c_{};
   double region_r_ = 0;
   std::vector<CellKey> visited_;
+  bool searched_from_ = false;  // the last search was a search_from()
   int guess_level_ = 0;  // deepest_present's last answer (a hint only)
   std::size_t leaves_read_ = 0;
   Counts counts_;
