@@ -7,13 +7,16 @@
 // of the store's cells (docs/HPU_ON_CELLS.md has the exactness arguments):
 //   - left_search: the Delaunay neighbour of p→q on its left (the twin's perturbation breaks
 //     ties), the vertex whose circle through p and q is lowest in their pencil, asked of the
-//     circles at heights 1/4, 1/2, 1, ... up to a cap, narrowing to the best circle found;
-//   - star_of: walked by left searches from a sure neighbour (empty closed diametral disc);
+//     circles at heights 1/2, 1, 2, ... up to a cap, narrowing to the best circle found (its
+//     answer uses that circle's disc only);
+//   - star_of: walked by left searches from a sure neighbour (empty closed diametral disc),
+//     chosen among the vertices the nearest search kept (no search of its own);
 //     a collect of class j caps the circles at radius 2^(j+1), and the edges of class ≤ j in
 //     such a gap are found among the vertices within 2^(j+1) in its angle;
 //   - first_class: the nearest vertices only, unless rounding at a power of two makes the
 //     star decide;
-//   - loose: no vertex strictly inside the leaf;
+//   - loose: no vertex strictly inside the leaf; in a collect, for a pair whose two
+//     triangles the walk met, decided by those triangles' third corners, as the twin does;
 //   - decide: one try of the twin's process(p, q, j) — not loose, split these box edges, or
 //     insert the off-center (its neighbour by the left search capped at the apex);
 //   - triangles_of: a vertex's triangles of the final mesh (it is their (x, y)-smallest

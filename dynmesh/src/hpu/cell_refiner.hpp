@@ -8,7 +8,7 @@
 // exact searches of the cells (docs/HPU_ON_CELLS.md has the arguments):
 //   - the left search: the Delaunay neighbour of p→q on its left (the twin's perturbation
 //     breaks ties) is the vertex whose circle through p and q is lowest in their pencil;
-//     the cells are asked for the circles at heights 1/4, 1/2, 1, ... up to a cap, and
+//     the cells are asked for the circles at heights 1/2, 1, 2, ... up to a cap, and
 //     within the first that holds a vertex the search narrows to the best circle found;
 //   - a star: walked by left searches from a sure neighbour (empty closed diametral
 //     disc). A collect of class j caps the circles at radius 2^(j+1): a step beyond the
