@@ -271,17 +271,17 @@ class CellQuestions {
     return none_;
   }
 
+  /// The left search's first probe: the circle at height 1/2 (its third corner sees pq at
+  /// 45° or more) holds most neighbours of a quality mesh, and probes below it mostly came
+  /// back empty.
+  static constexpr double kFirstHeight = 0.5;
+
   /// The Delaunay neighbour of p→q on its left (the third corner of the triangle on its
   /// left, under the triangulations' perturbation): of the vertices on the left, the one
   /// whose circle through p and q lies lowest in the pencil of circles through p and q,
   /// searched among the circles centred at most h_max·|pq| along J(q − p) from pq's
   /// midpoint, smallest first. none() when none lies that low (or the left is outside the
   /// box).
-  /// The left search's first probe: the circle at height 1/2 (its third corner sees pq at
-  /// 45° or more) holds most neighbours of a quality mesh, and probes below it mostly came
-  /// back empty.
-  static constexpr double kFirstHeight = 0.5;
-
   V left_search(V p, V q, double h_max) const {
     ++stats_.neighbour_asks;
     if (outside_left(p, q)) return none_;  // a box edge seen from outside: no triangle there
