@@ -236,14 +236,12 @@ class CellView {
   void used_within(const Point<2>& c, double r) const {
     auto* self = const_cast<CellView*>(this);
     const double R = r * (1 + 0x1p-20) + cellq::ulp_room(c);
-    self->searched_from_ = false;
     for (const CellKey& k : visited_) self->widen(self->slot(k), c, R);
     self->visited_.clear();
   }
   /// The last search()'s answer may depend on any vertex of the leaves it met.
   void used_all() const {
     auto* self = const_cast<CellView*>(this);
-    self->searched_from_ = false;
     for (const CellKey& k : visited_) self->slot(k).all = true;
     self->visited_.clear();
   }
