@@ -454,12 +454,15 @@ class CellQuestions {
       // Consecutive vertices of star_ bound a walked (true) triangle; the wrap-around does
       // only in a whole cycle (otherwise the gap lies there).
       if (i + 1 < d || cycle) go_on = go_on || circumradius_above(P_(v), P_(q), P_(star_[(i + 1) % d]), j);
-      if (edge_class(P_(v), P_(q)) > j) go_on = true;
       // q's neighbours around v: the next vertex of star_ is on the left of v→q, the one
       // before on its right. At the ends of a walk that stopped at the box's sides, the
       // outside; at a gap, unknown.
       const V* left = i + 1 < d ? &star_[i + 1] : cycle ? &star_[0] : whole ? &none_ : nullptr;
       const V* right = i > 0 ? &star_[i - 1] : cycle ? &star_[d - 1] : whole ? &none_ : nullptr;
+      // A longer edge continues v only while loose (the twin's rule). Without a gap both its
+      // triangles were walked, so the walk decides; with one, go_on is already set.
+      if (!go_on && edge_class(P_(v), P_(q)) > j)
+        go_on = loose_pair(v, q, left, right) || loose_pair(q, v, right, left);
       take(q, left, right);
     }
     if (!whole && d > 0) {

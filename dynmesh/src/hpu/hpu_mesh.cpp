@@ -117,9 +117,10 @@ class Refiner {
   }
 
   /// Figure 5, line 7, for one vertex: its loose pairs of class j (≤ j at its first entry),
-  /// in (x, y) order of their ends. v enters Q_{j+1} unless it has no edge of a class above j
-  /// and no triangle whose circumradius exceeds 2^{j+1}: a rule that reads only the vertices
-  /// within 2^{j+2} of v, so that the self-adjusting version decides it from nearby cells.
+  /// in (x, y) order of their ends. v enters Q_{j+1} unless it has no loose edge of a class
+  /// above j and no triangle whose circumradius exceeds 2^{j+1}: a rule that reads only the
+  /// vertices within 2^{j+2} of v (without the large triangle, the longer edges' neighbours
+  /// are in the star), so that the self-adjusting version decides it from nearby cells.
   void collect(Vid v, int j, bool birth) {
     ++stats_.entries;
     dt_.star(v, star_);
@@ -131,10 +132,12 @@ class Refiner {
       const Vid q = star_[i];
       const int c = edge_class(v, q);
       if (i + 1 < d || cycle) go_on = go_on || circumradius_above(v, q, star_[(i + 1) % d], j);
-      if (c > j) go_on = true;
-      if (birth ? c > j : c != j) continue;
       const Vid left = i + 1 < d ? star_[i + 1] : cycle ? star_[0] : kNone;
       const Vid right = i > 0 ? star_[i - 1] : cycle ? star_[d - 1] : kNone;
+      // A longer edge matters only while loose: looseness never returns, and a later edge
+      // of v has a newer end whose own entries collect it.
+      if (c > j && !go_on) go_on = loose(v, q, left, right) || loose(q, v, right, left);
+      if (birth ? c > j : c != j) continue;
       if (loose(v, q, left, right)) local_.push_back({v, q});
       if (loose(q, v, right, left)) local_.push_back({q, v});
     }
