@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <cstdio>
+#include <iostream>
 #include <random>
 #include <set>
 #include <string>
@@ -73,12 +74,14 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   double angle = kHpuDefaultMinAngle;
   bool verify = false;
+  bool breakdown = false;
   app.add_option("--dist", dists, "distributions, comma-separated")->delimiter(',');
   app.add_option("--n", sizes, "sizes, comma-separated")->delimiter(',');
   app.add_option("--updates", updates, "delete-insert pairs measured");
   app.add_option("--seed", seed, "random seed");
   app.add_option("--angle", angle, "angle bound");
   app.add_flag("--verify", verify, "compare the final mesh with HpuMesh's");
+  app.add_flag("--breakdown", breakdown, "after each build, print where the trace's bytes go (sac::MemoryBreakdown)");
   CLI11_PARSE(app, argc, argv);
 
   std::printf("%-8s %7s | %9s %8s %31s %6s %6s | %8s %8s %8s %31s %7s\n", "dist", "n", "events", "B/pt",
@@ -99,6 +102,7 @@ int main(int argc, char** argv) {
       const double scratch_events = static_cast<double>(st.events_created);
       const double bytes = static_cast<double>(run.engine.record_bytes()) / static_cast<double>(n);
       const HcStepCounts s0 = run.program.steps;
+      if (breakdown) std::cout << run.engine.memory_breakdown() << std::flush;
       const auto c0 = run.program.view.counts();
       const double steps0 = static_cast<double>(s0.total());
       std::mt19937_64 rng(seed * 7919 + n);
