@@ -11,8 +11,9 @@
 //     answer uses that circle's disc only);
 //   - star_of: walked by left searches from a sure neighbour (empty closed diametral disc),
 //     chosen among the vertices the nearest search kept (no search of its own);
-//     a collect of class j caps the circles at radius 2^(j+1), and the edges of class ≤ j in
-//     such a gap are found among the vertices within 2^(j+1) in its angle;
+//     a collect of class j caps the circles at radius 2^(j+2) (hpu_geometry.hpp's
+//     kGoOnReach), and the edges of class ≤ j in such a gap are found among the vertices
+//     within 2^(j+1) in its angle;
 //   - first_class: the nearest vertices only, unless rounding at a power of two makes the
 //     star decide;
 //   - loose: no vertex strictly inside the leaf; in a collect, for a pair whose two
@@ -424,10 +425,12 @@ class CellQuestions {
   /// Q_{j+1}.
   bool collect(V v, int j, bool birth, std::vector<std::array<V, 2>>& pairs) {
     pairs.clear();
-    // The continuation needs the triangles of circumradius up to 2^(j+1) only: a star
-    // triangle beyond it (the walk's gap) already says "go on". The slack keeps a triangle
-    // at the rule's edge on the walked side.
-    const double reach = std::ldexp(1.0 + 0x1p-20, j + 1);
+    // The continuation needs the triangles of circumradius up to 2^(j+1+kGoOnReach) only: a
+    // star triangle beyond it (the walk's gap) already says "go on". The slack keeps a
+    // triangle at the rule's edge on the walked side. The pairs of class ≤ j in a gap end
+    // within 2^(j+1) of v.
+    const double reach = std::ldexp(1.0 + 0x1p-20, j + 1 + kGoOnReach);
+    const double gap_reach = std::ldexp(1.0 + 0x1p-20, j + 1);
     const bool whole = star_of(v, std::ldexp(1.0, j), reach);
     const std::size_t d = star_.size();
     const bool cycle = !on_boundary(v) && whole;
@@ -453,7 +456,7 @@ class CellQuestions {
       const V q = star_[i];
       // Consecutive vertices of star_ bound a walked (true) triangle; the wrap-around does
       // only in a whole cycle (otherwise the gap lies there).
-      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(P_(v), P_(q), P_(star_[(i + 1) % d]), j);
+      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(P_(v), P_(q), P_(star_[(i + 1) % d]), j + kGoOnReach);
       // q's neighbours around v: the next vertex of star_ is on the left of v→q, the one
       // before on its right. At the ends of a walk that stopped at the box's sides, the
       // outside; at a gap, unknown.
@@ -466,14 +469,14 @@ class CellQuestions {
       take(q, left, right);
     }
     if (!whole && d > 0) {
-      // Edges inside the gap have both triangles beyond 2^(j+1); those of class ≤ j end
+      // Edges inside the gap have both triangles beyond the cap; those of class ≤ j end
       // within 2^(j+1) of v, and a loose one is an edge (its leaf is empty): ask each vertex
       // there that the walk did not reach. When both walks stopped at the gap, it is the
       // angle from the counter-clockwise run's last vertex a to the clockwise run's last
       // vertex b (counter-clockwise), and only the cells that meet that angle are read.
       near_.clear();
       const Point<2>& c = P_(v);
-      const double r = reach + cellq::ulp_room(c);
+      const double r = gap_reach + cellq::ulp_room(c);
       const bool angle = gap_ends_ == 2;
       const Point<2>&a = P_(star_.back()), &b = P_(star_.front());
       const bool reflex = angle && orient2d(c, a, b) <= 0;

@@ -11,7 +11,7 @@
 //     the cells are asked for the circles at heights 1/2, 1, 2, ... up to a cap, and
 //     within the first that holds a vertex the search narrows to the best circle found;
 //   - a star: walked by left searches from a sure neighbour (empty closed diametral
-//     disc). A collect of class j caps the circles at radius 2^(j+1): a step beyond the
+//     disc). A collect of class j caps the circles at radius 2^(j+2): a step beyond the
 //     cap is a triangle that makes the entry go on, and the edges of class ≤ j inside such
 //     a gap are found among the vertices within 2^(j+1) in its angle (a loose one is an
 //     edge: its leaf is empty);

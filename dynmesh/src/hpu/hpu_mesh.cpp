@@ -118,9 +118,10 @@ class Refiner {
 
   /// Figure 5, line 7, for one vertex: its loose pairs of class j (≤ j at its first entry),
   /// in (x, y) order of their ends. v enters Q_{j+1} unless it has no loose edge of a class
-  /// above j and no triangle whose circumradius exceeds 2^{j+1}: a rule that reads only the
-  /// vertices within 2^{j+2} of v (without the large triangle, the longer edges' neighbours
-  /// are in the star), so that the self-adjusting version decides it from nearby cells.
+  /// above j and no triangle whose circumradius exceeds 2^{j+1+kGoOnReach}: a rule that
+  /// reads only the vertices near v (without the large triangle, the longer edges'
+  /// neighbours are in the star), so that the self-adjusting version decides it from nearby
+  /// cells.
   void collect(Vid v, int j, bool birth) {
     ++stats_.entries;
     dt_.star(v, star_);
@@ -131,7 +132,7 @@ class Refiner {
     for (std::size_t i = 0; i < d; ++i) {
       const Vid q = star_[i];
       const int c = edge_class(v, q);
-      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(v, q, star_[(i + 1) % d], j);
+      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(v, q, star_[(i + 1) % d], j + detail::kGoOnReach);
       const Vid left = i + 1 < d ? star_[i + 1] : cycle ? star_[0] : kNone;
       const Vid right = i > 0 ? star_[i - 1] : cycle ? star_[d - 1] : kNone;
       // A longer edge matters only while loose: looseness never returns, and a later edge
