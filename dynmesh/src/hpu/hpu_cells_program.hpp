@@ -12,7 +12,8 @@
 //   2. each initial vertex's class (its shortest Delaunay edge's): a step;
 //   3. per class j, smallest first: Q_j = (initial entries of class j, in initial order) ++
 //      (continuations made during class j − 1); rounds: collect every entry of the round (a
-//      step: its loose pairs into the entry's own list, and its continuation into Q_{j+1}),
+//      step, memoized apart from the list: its loose pairs into the entry's own list, and its
+//      continuation into the entry's `cont`, which the list step links into Q_{j+1}),
 //      then process the pairs in collection order (each try a step: not loose, split box
 //      edges, or insert the off-center; an insertion is a step that writes the store's leaf);
 //      births (off-centers and side midpoints) form the next round;
@@ -78,6 +79,7 @@ struct HcEntry {
   bool birth;
   sac::Mod<HcEntry*> next;
   sac::Mod<HcPair*> pairs;  // the loose pairs its collect found, in order
+  sac::Mod<HcEntry*> cont;  // its collect's continuation into Q_{j+1} (null: none)
 };
 
 /// A collected pair p→q, keyed by (its collector's entry, p, q).
@@ -313,8 +315,6 @@ struct HpuCellsProgram {
     HcClass* cs;
     HcRound* rs;
     HcEntry* ent;
-    HcEntry* before;  // the entry before ent (null: ent is first)
-    sac::Mod<HcEntry*>* cdest;
     CellView* view(sac::Engine&) const { return &pg->view; }
     const Box<2>& box() const noexcept { return pg->box(); }
     bool run(sac::Engine& e, CellView& v) const {
@@ -331,16 +331,15 @@ struct HpuCellsProgram {
         pd = &pc->next;
       }
       e.write(*pd, nullptr);
-      sac::Mod<HcEntry*>* cd = cdest;
-      if (pg->go_on) {
-        HcEntry* c = e.alloc<HcEntry>(std::tuple{ent->v, j + 1, false}, ent->v, false);
-        e.write(*cd, c);
-        cd = &c->next;
-      }
-      e.memo_read(ent->next, sac::fn<&collect_step>(pg, cs, rs, cd, ent, before));
+      e.write(ent->cont, pg->go_on ? e.alloc<HcEntry>(std::tuple{ent->v, j + 1, false}, ent->v, false) : nullptr);
       return true;
     }
   };
+
+  /// The collect of ent, memoized apart from the list step: its key holds no destination.
+  static void collect_entry(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcRound* rs, HcEntry* ent) {
+    run_step(e, CollectStep{pg, cs, rs, ent});
+  }
 
   /// ent was read from owner's `next` (owner null: the round's head). owner's predecessor
   /// is in the key: when an update moves an entry earlier in the list, its own `next` and the
@@ -350,7 +349,19 @@ struct HpuCellsProgram {
                            sac::Mod<HcEntry*>* cdest, HcEntry* owner, HcEntry* owner_pred) {
     (void)owner_pred;
     if (!ent) return e.write(rs->cont_tail, cdest);
-    run_step(e, CollectStep{pg, cs, rs, ent, owner, cdest});
+    // The continuations' tail threads through the list, and a continuation that appears or
+    // goes changes it for every entry up to the next one that continues. So the collect
+    // itself is a memo of its own, which such a change re-runs as a hit, and only this
+    // link step runs again.
+    e.memo(sac::fn<&collect_entry>(pg, cs, rs, ent));
+    e.read(ent->cont, [pg, cs, rs, cdest, ent, owner](sac::Engine& e2, HcEntry* c) {
+      sac::Mod<HcEntry*>* cd = cdest;
+      if (c) {
+        e2.write(*cd, c);
+        cd = &c->next;
+      }
+      e2.memo_read(ent->next, sac::fn<&collect_step>(pg, cs, rs, cd, ent, owner));
+    });
   }
 
   // ---------------------------------------------------------------- process
