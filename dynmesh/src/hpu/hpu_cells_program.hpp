@@ -336,8 +336,14 @@ struct HpuCellsProgram {
     }
   };
 
-  /// The collect of ent, memoized apart from the list step: its key holds no destination.
-  static void collect_entry(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcRound* rs, HcEntry* ent) {
+  /// The collect of ent, memoized apart from the list step: its key holds no destination,
+  /// but it holds ent's place (the entry before it). Without it, an entry that an update
+  /// moved matched its old collect far ahead, and the memo hit discarded all the trace in
+  /// between (a deletion at uniform 32,000 re-ran 10,020 collects). With the entry before
+  /// that one too, collects re-ran a fifth more often.
+  static void collect_entry(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcRound* rs, HcEntry* ent,
+                            HcEntry* owner) {
+    (void)owner;
     run_step(e, CollectStep{pg, cs, rs, ent});
   }
 
@@ -353,7 +359,7 @@ struct HpuCellsProgram {
     // goes changes it for every entry up to the next one that continues. So the collect
     // itself is a memo of its own, which such a change re-runs as a hit, and only this
     // link step runs again.
-    e.memo(sac::fn<&collect_entry>(pg, cs, rs, ent));
+    e.memo(sac::fn<&collect_entry>(pg, cs, rs, ent, owner));
     e.read(ent->cont, [pg, cs, rs, cdest, ent, owner](sac::Engine& e2, HcEntry* c) {
       sac::Mod<HcEntry*>* cd = cdest;
       if (c) {
