@@ -35,7 +35,7 @@
 //      its newer end was born, whose entries reach its class: nothing loose remains. The
 //      rule reads the vertices within 2^{j+3} of v only: without a larger triangle, both
 //      triangles of every longer edge are in the star, and they decide its looseness.
-//      (Going on for every longer edge and every triangle above 2^{j+1} made 1.7× the
+//      (Going on for every longer edge and every triangle above 2^{j+1} made 1.8× the
 //      entries on unif1e5, most of them collecting nothing; the vertex counts moved by
 //      under 0.01%.)
 //   4. A while-iteration of class j (a "round") takes all of Q_j, collects, and processes the
