@@ -7,10 +7,14 @@
 // steps per input point by kind (first class, collect, try, insert, final), rounds of reads
 // per step and cells per round; per update: the mean and median trace distance, the mean
 // update time, and the mean steps re-run by kind and rounds. With --verify the final mesh is
-// compared with HpuMesh's. Flat in n is the goal for every per-update column.
+// compared with HpuMesh's. Flat in n is the goal for every per-update column. With --tail K,
+// the K costliest propagations of each row follow it: the operation, the trace distance, the
+// events created, the reads re-executed, and the steps re-run by kind. An update that creates
+// far more events than its steps explain has re-run a list pass (bench/RESULTS.md, "Fewer
+// collects"). --breakdown prints where the trace's bytes go after each build.
 //
 //   dynmesh_hpu_steps [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
-//                     [--seed 1] [--angle 20.7] [--verify]
+//                     [--seed 1] [--angle 20.7] [--verify] [--tail K] [--breakdown]
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -75,12 +79,14 @@ int main(int argc, char** argv) {
   double angle = kHpuDefaultMinAngle;
   bool verify = false;
   bool breakdown = false;
+  std::size_t tail = 0;
   app.add_option("--dist", dists, "distributions, comma-separated")->delimiter(',');
   app.add_option("--n", sizes, "sizes, comma-separated")->delimiter(',');
   app.add_option("--updates", updates, "delete-insert pairs measured");
   app.add_option("--seed", seed, "random seed");
   app.add_option("--angle", angle, "angle bound");
   app.add_flag("--verify", verify, "compare the final mesh with HpuMesh's");
+  app.add_option("--tail", tail, "after each row, print its K costliest propagations (by trace distance)");
   app.add_flag("--breakdown", breakdown, "after each build, print where the trace's bytes go (sac::MemoryBreakdown)");
   CLI11_PARSE(app, argc, argv);
 
@@ -109,12 +115,20 @@ int main(int argc, char** argv) {
       std::vector<double> dist_v, us_v;
       std::array<double, HcStepCounts::kKinds> rerun{};
       double rounds = 0;
+      struct Costly {
+        std::uint64_t distance, created, reexecuted;
+        int update;
+        bool insert;
+        std::array<std::uint64_t, HcStepCounts::kKinds> steps;
+      };
+      std::vector<Costly> costly;
       for (int u = 0; u < updates; ++u) {
         const std::size_t i = rng() % pts.size();
         const Point<2> x = pts[i];
         for (int op = 0; op < 2; ++op) {
           const HcStepCounts before = run.program.steps;
           const auto rb = run.program.view.counts().rounds;
+          const std::uint64_t created0 = st.events_created;
           const double sec = bench::seconds([&] {
             if (op == 0) run.update({}, {x});
             else run.update({x}, {});
@@ -124,6 +138,11 @@ int main(int argc, char** argv) {
           for (int k = 0; k < HcStepCounts::kKinds; ++k)
             rerun[k] += static_cast<double>(run.program.steps.done[k] - before.done[k]);
           rounds += static_cast<double>(run.program.view.counts().rounds - rb);
+          if (tail > 0) {
+            Costly c{st.last_trace_distance, st.events_created - created0, st.last_reexecuted, u, op == 1, {}};
+            for (int k = 0; k < HcStepCounts::kKinds; ++k) c.steps[k] = run.program.steps.done[k] - before.done[k];
+            costly.push_back(c);
+          }
         }
       }
       const double m = std::max<double>(1, static_cast<double>(dist_v.size()));
@@ -136,6 +155,17 @@ int main(int argc, char** argv) {
                   scratch_events, bytes, steps_pt, static_cast<double>(c0.rounds) / steps0,
                   static_cast<double>(c0.cells) / static_cast<double>(c0.rounds), bench::mean(dist_v),
                   bench::median(dist_v), bench::mean(us_v), rr, rounds / m);
+      std::stable_sort(costly.begin(), costly.end(),
+                       [](const Costly& a, const Costly& b) { return a.distance > b.distance; });
+      if (costly.size() > tail) costly.resize(tail);
+      for (const Costly& c : costly)
+        std::printf("  costly: update %d %s: distance %llu, %llu events created, %llu reads re-executed, steps "
+                    "re-run (fc co try ins fin) %llu %llu %llu %llu %llu\n",
+                    c.update, c.insert ? "insert" : "delete", static_cast<unsigned long long>(c.distance),
+                    static_cast<unsigned long long>(c.created), static_cast<unsigned long long>(c.reexecuted),
+                    static_cast<unsigned long long>(c.steps[0]), static_cast<unsigned long long>(c.steps[1]),
+                    static_cast<unsigned long long>(c.steps[2]), static_cast<unsigned long long>(c.steps[3]),
+                    static_cast<unsigned long long>(c.steps[4]));
       std::fflush(stdout);
       if (verify) {
         const bool same = run.state.feed.triangles() == HpuMesh(box, pts, angle).triangles();
