@@ -446,8 +446,8 @@ class CellQuestions {
       return detail::loose(P_(p), P_(q), leaf_height_, *t == none_ ? nullptr : &P_(*t),
                            *u == none_ ? nullptr : &P_(*u));
     };
-    const auto take = [&](V q, const V* left, const V* right) {
-      const int c = edge_class(P_(v), P_(q));
+    // c: the class of vq.
+    const auto take = [&](V q, int c, const V* left, const V* right) {
       if (birth ? c > j : c != j) return;
       if (loose_pair(v, q, left, right)) pairs.push_back({v, q});
       if (loose_pair(q, v, right, left)) pairs.push_back({q, v});
@@ -464,9 +464,9 @@ class CellQuestions {
       const V* right = i > 0 ? &star_[i - 1] : cycle ? &star_[d - 1] : whole ? &none_ : nullptr;
       // A longer edge continues v only while loose (the twin's rule). Without a gap both its
       // triangles were walked, so the walk decides; with one, go_on is already set.
-      if (!go_on && edge_class(P_(v), P_(q)) > j)
-        go_on = loose_pair(v, q, left, right) || loose_pair(q, v, right, left);
-      take(q, left, right);
+      const int c = edge_class(P_(v), P_(q));
+      if (!go_on && c > j) go_on = loose_pair(v, q, left, right) || loose_pair(q, v, right, left);
+      take(q, c, left, right);
     }
     if (!whole && d > 0) {
       // Edges inside the gap have both triangles beyond the cap; those of class ≤ j end
@@ -510,7 +510,7 @@ class CellQuestions {
             near_.push_back(w);
             return false;
           });
-      for (const V q : near_) take(q, nullptr, nullptr);
+      for (const V q : near_) take(q, edge_class(P_(v), P_(q)), nullptr, nullptr);
     }
     std::sort(pairs.begin(), pairs.end(), [&](const auto& x, const auto& y) {
       if (P_(x[0]) != P_(y[0])) return xy_less(P_(x[0]), P_(y[0]));
