@@ -93,8 +93,7 @@ struct HcPair {
   sac::Mod<HcPair*> next;
 };
 
-/// An initial vertex, keyed by it: its class, and the rest of the list (each class's filter
-/// writes a new version: the vertices left for later classes).
+/// An initial vertex, keyed by it: its class, and the rest of the list.
 struct HcCell {
   explicit HcCell(HV x) : v(x) {}
   HcCell(const HcCell&) = delete;
@@ -112,18 +111,36 @@ struct HcClass {
   int j;
   sac::Mod<HcEntry*> init;  // Q_j: the initial entries of class j, then `cont`
   sac::Mod<HcEntry*> cont;  // the continuations made during class j − 1
-  sac::Mod<HcCell*> rest;   // the initial vertices of classes above j
+  sac::Mod<bool> more;      // some initial vertex is of a class above j
 };
 
-/// A block of class j's filter, keyed by (j, the vertex whose cell opened it; null for the
-/// first): where the filter's two lists append next while it is in the block. Each append
-/// reads a tail and writes the new one.
+/// The classes of a block's initial vertices: bit c mod 64 for each class c, and the largest.
+struct HcClassSet {
+  std::uint64_t mask = 0;
+  int max = INT_MIN;
+  bool has(int c) const noexcept { return (mask >> (static_cast<unsigned>(c) & 63)) & 1; }
+  friend bool operator==(const HcClassSet&, const HcClassSet&) = default;
+};
+
+/// A block of the initial vertices: from the one that opens it (HpuCellsProgram::opens_block;
+/// the list's head for the first) to the next block's. Keyed by that vertex (null: the first).
+struct HcCellBlock {
+  explicit HcCellBlock(HcCell* f) : first(f) {}
+  HcCellBlock(const HcCellBlock&) = delete;
+  HcCellBlock& operator=(const HcCellBlock&) = delete;
+  HcCell* first;
+  sac::Mod<HcClassSet> classes;
+  sac::Mod<HcCellBlock*> next;
+};
+
+/// Class j's place in a block of the initial vertices, keyed by (j, the block's first
+/// vertex): the tail Q_j's initial entries append at. Each append reads it and writes the new
+/// one, and the block's last step copies it into the next block's.
 struct HcBlock {
   HcBlock() = default;
   HcBlock(const HcBlock&) = delete;
   HcBlock& operator=(const HcBlock&) = delete;
   sac::Mod<sac::Mod<HcEntry*>*> init_tail;
-  sac::Mod<sac::Mod<HcCell*>*> rest_tail;
 };
 
 /// A round, keyed by the modifiable holding its first entry.
@@ -142,6 +159,7 @@ struct HcStart {
   HcStart& operator=(const HcStart&) = delete;
   sac::Mod<HcCell*> cells;  // the initial vertices, in order
   sac::Mod<int> min_class;  // the smallest initial class
+  HcCellBlock* blocks = nullptr;  // the first block of the initial vertices
 };
 
 /// Steps completed (first run included, re-runs of change propagation too), by kind.
@@ -203,9 +221,18 @@ struct HpuCellsProgram {
     std::array<HV, 4> order = pg->corners;
     std::sort(order.begin(), order.end(), [pg](HV a, HV b) { return morton_less(pg->box(), a->p, b->p); });
     sac::Mod<HcCell*>* dest = &pg->start->cells;
-    for (HV v : order) dest = append_cell(e, v, dest);
+    HcCell* head = nullptr;  // the list's first cell: a corner's, fixed
+    for (HV v : order) {
+      HcCell* c = e.alloc<HcCell>(v, v);
+      e.write(*dest, c);
+      dest = &c->next;
+      if (!head) head = c;
+    }
     e.memo_read(*pg->input, sac::fn<&place>(pg, dest));
     e.memo_read(pg->start->cells, sac::fn<&class_step>(pg, INT_MAX, INT_MAX));
+    // The corners come first, so the list's head is a fixed cell.
+    pg->start->blocks = e.alloc<HcCellBlock>(HV{nullptr}, head);
+    e.memo(sac::fn<&block_classes>(pg->start->blocks->first, pg, pg->start->blocks, std::uint64_t{0}, INT_MIN));
     e.memo(sac::fn<&refine_start>(pg));
     e.memo(sac::fn<&final_start>(pg));
   }
@@ -255,22 +282,12 @@ struct HpuCellsProgram {
     e.read(pg->start->min_class, [pg](sac::Engine& e2, int j) {
       HcClass* cs = e2.alloc<HcClass>(j, j);
       e2.write(cs->cont, nullptr);  // nothing continues into the first class
-      e2.memo(sac::fn<&class_start>(pg, cs, &pg->start->cells));
+      e2.memo(sac::fn<&class_start>(pg, cs));
     });
   }
 
-  /// Class j: filter its initial entries out of `src`, then its rounds.
-  static void class_start(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, sac::Mod<HcCell*>* src) {
-    HcClass* csn = e.alloc<HcClass>(cs->j + 1, cs->j + 1);
-    HcBlock* b = e.alloc<HcBlock>(std::tuple{cs->j, HV{nullptr}});
-    e.write(b->init_tail, &cs->init);
-    e.write(b->rest_tail, &cs->rest);
-    e.memo_read(*src, sac::fn<&filter_step>(pg, cs, b));
-    e.memo(sac::fn<&round>(pg, cs, csn, &cs->init, &csn->cont));
-  }
-
-  /// One in about kFilterBlock cells opens a block of the filter, chosen by its vertex's
-  /// coordinates (never by an address).
+  /// One in about kFilterBlock initial vertices opens a block, chosen by its coordinates
+  /// (never by an address).
   static constexpr std::uint64_t kFilterBlock = 32;
   static bool opens_block(HV v) noexcept {
     std::uint64_t h = std::bit_cast<std::uint64_t>(v->p[0]) * 0x9e3779b97f4a7c15ull ^ std::bit_cast<std::uint64_t>(v->p[1]);
@@ -280,45 +297,80 @@ struct HpuCellsProgram {
     return h % kFilterBlock == 0;
   }
 
-  /// One cell of class j's filter: into Q_j's initial entries or into the rest.
-  /// The tails the lists append at are modifiables of the block, not arguments: with them in
-  /// the key, a cell that moved from one list to the other gave every step after it a new
-  /// key up to the next member of that list, which at the class holding most vertices re-ran
-  /// thousands of steps (9,292 in one update on 32,000 curve points). Through the tails'
-  /// versions it re-runs the next member's append only, and at most the next block's copy of
-  /// the tails. A block bounds a tail's versions (the runtime reads and writes a modifiable
-  /// at time t in time linear in its versions after t): one tail for the whole class was as
-  /// exact, and 2-15x slower.
-  static void filter_step(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
-    if (!cell) {
-      e.read(b->rest_tail, [](sac::Engine& e2, sac::Mod<HcCell*>* rd) { e2.write(*rd, nullptr); });
-      // Q_j = its initial entries ++ the continuations of class j − 1 (terminated by now).
-      e.read(b->init_tail, [cs](sac::Engine& e2, sac::Mod<HcEntry*>* qd) {
-        e2.read(cs->cont, [qd](sac::Engine& e3, HcEntry* h) { e3.write(*qd, h); });
-      });
-      return;
-    }
-    e.read(cell->cls, [cell, cs, b](sac::Engine& e2, int c) {
-      if (c == cs->j) {
-        HcEntry* ent = e2.alloc<HcEntry>(std::tuple{cell->v, cs->j, true}, cell->v, true);
-        e2.read(b->init_tail, [b, ent](sac::Engine& e3, sac::Mod<HcEntry*>* qd) {
-          e3.write(*qd, ent);
-          e3.write(b->init_tail, &ent->next);
-        });
-      } else {
-        e2.read(b->rest_tail, [b, cell](sac::Engine& e3, sac::Mod<HcCell*>* rd) {
-          e3.write(*rd, cell);
-          e3.write(b->rest_tail, &cell->next);
-        });
-      }
+  /// The classes of block b's initial vertices from `cell` on, given those before it (mask,
+  /// max). A class that changes re-runs the steps after it in its block only.
+  static void block_classes(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, HcCellBlock* b, std::uint64_t mask,
+                            int max) {
+    e.read(cell->cls, [cell, pg, b, mask, max](sac::Engine& e2, int c) {
+      e2.memo_read(cell->next, sac::fn<&block_classes_next>(pg, b, mask | std::uint64_t{1} << (static_cast<unsigned>(c) & 63),
+                                                            std::max(max, c)));
     });
-    HcBlock* nb = b;
-    if (opens_block(cell->v)) {
-      nb = e.alloc<HcBlock>(std::tuple{cs->j, cell->v});
-      e.read(b->init_tail, [nb](sac::Engine& e2, sac::Mod<HcEntry*>* qd) { e2.write(nb->init_tail, qd); });
-      e.read(b->rest_tail, [nb](sac::Engine& e2, sac::Mod<HcCell*>* rd) { e2.write(nb->rest_tail, rd); });
-    }
-    e.memo_read(cell->next, sac::fn<&filter_step>(pg, cs, nb));
+  }
+
+  static void block_classes_next(sac::Engine& e, HcCell* nx, HpuCellsProgram* pg, HcCellBlock* b, std::uint64_t mask,
+                                 int max) {
+    if (nx && !opens_block(nx->v)) return block_classes(e, nx, pg, b, mask, max);
+    e.write(b->classes, HcClassSet{mask, max});
+    if (!nx) return e.write(b->next, nullptr);
+    HcCellBlock* nb = e.alloc<HcCellBlock>(nx->v, nx);
+    e.write(b->next, nb);
+    block_classes(e, nx, pg, nb, 0, INT_MIN);
+  }
+
+  /// Class j: its initial entries from the blocks that hold some, then its rounds.
+  static void class_start(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs) {
+    HcClass* csn = e.alloc<HcClass>(cs->j + 1, cs->j + 1);
+    HcBlock* b = e.alloc<HcBlock>(std::tuple{cs->j, HV{nullptr}});
+    e.write(b->init_tail, &cs->init);
+    e.memo(sac::fn<&class_block>(pg->start->blocks, pg, cs, b, false));
+    e.memo(sac::fn<&round>(pg, cs, csn, &cs->init, &csn->cont));
+  }
+
+  /// Class j in block cb: its members appended at b's tail, which the next block's copy
+  /// continues. `more`: a block before held a class above j.
+  /// The tail is a modifiable, not an argument: with it in the key, a vertex that joined or
+  /// left the class gave every step after it a new key up to the next member, which at the
+  /// class holding most vertices re-ran thousands of steps (9,292 in one update on 32,000
+  /// curve points). Through the tail's versions it re-runs the next member's append, or the
+  /// copies up to the next block with a member. A block bounds a tail's versions (the
+  /// runtime reads and writes a modifiable at time t in time linear in its versions after
+  /// t): one tail for the whole class was as exact, and 2-15x slower. And a class visits
+  /// only the blocks that hold it, not every vertex of a class at or above it.
+  static void class_block(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b, bool more) {
+    e.read(cb->classes, [cb, pg, cs, b, more](sac::Engine& e2, const HcClassSet& set) {
+      if (set.has(cs->j)) class_cell(e2, cb->first, pg, cs, b);
+      HcBlock* nb = e2.alloc<HcBlock>(std::tuple{cs->j, cb->first->v});
+      e2.read(b->init_tail, [nb](sac::Engine& e3, sac::Mod<HcEntry*>* qd) { e3.write(nb->init_tail, qd); });
+      e2.memo_read(cb->next, sac::fn<&class_block_next>(pg, cs, nb, more || set.max > cs->j));
+    });
+  }
+
+  static void class_block_next(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b,
+                               bool more) {
+    if (cb) return class_block(e, cb, pg, cs, b, more);
+    e.write(cs->more, more);
+    // Q_j = its initial entries ++ the continuations of class j − 1 (terminated by now).
+    e.read(b->init_tail, [cs](sac::Engine& e2, sac::Mod<HcEntry*>* qd) {
+      e2.read(cs->cont, [qd](sac::Engine& e3, HcEntry* h) { e3.write(*qd, h); });
+    });
+  }
+
+  /// One initial vertex of a block that holds class j: appended to Q_j's initial entries if
+  /// of class j.
+  static void class_cell(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
+    e.read(cell->cls, [cell, cs, b](sac::Engine& e2, int c) {
+      if (c != cs->j) return;
+      HcEntry* ent = e2.alloc<HcEntry>(std::tuple{cell->v, cs->j, true}, cell->v, true);
+      e2.read(b->init_tail, [b, ent](sac::Engine& e3, sac::Mod<HcEntry*>* qd) {
+        e3.write(*qd, ent);
+        e3.write(b->init_tail, &ent->next);
+      });
+    });
+    e.memo_read(cell->next, sac::fn<&class_cell_next>(pg, cs, b));
+  }
+
+  static void class_cell_next(sac::Engine& e, HcCell* nx, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
+    if (nx && !opens_block(nx->v)) class_cell(e, nx, pg, cs, b);
   }
 
   /// A round of class j on the entries from `head`: collect all, then process the pairs,
@@ -344,8 +396,8 @@ struct HpuCellsProgram {
   /// The next class when anything is left: continuations, or initial vertices above j.
   static void class_end(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcClass* csn) {
     e.read(csn->cont, [pg, cs, csn](sac::Engine& e2, HcEntry* c) {
-      e2.read(cs->rest, [pg, cs, csn, c](sac::Engine& e3, HcCell* r) {
-        if (c || r) e3.memo(sac::fn<&class_start>(pg, csn, &cs->rest));
+      e2.read(cs->more, [pg, csn, c](sac::Engine& e3, bool more) {
+        if (c || more) e3.memo(sac::fn<&class_start>(pg, csn));
       });
     });
   }
