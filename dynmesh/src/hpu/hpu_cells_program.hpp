@@ -9,8 +9,11 @@
 //   1. the initial vertices: the box's corners in (Morton, xy) order, then the input list
 //      (the inputs and their side midpoints in insertion_less order, kept by the mutator,
 //      hpu_inputs.hpp), whose vertices are also the store's base values (cell_store.hpp);
-//   2. each initial vertex's class (its shortest Delaunay edge's): a step;
-//   3. per class j, smallest first: Q_j = (initial entries of class j, in initial order) ++
+//   2. each initial vertex's class (its shortest Delaunay edge's): a step; and, per block of
+//      the initial list (cut where a vertex's coordinates hash to it, about 32 long), the set
+//      of its classes;
+//   3. per class j, smallest first: Q_j = (initial entries of class j, in initial order, from
+//      the blocks whose set holds j) ++
 //      (continuations made during class j − 1); rounds: collect every entry of the round (a
 //      step, memoized apart from the list: its loose pairs into the entry's own list, and its
 //      continuation into the entry's `cont`, which the list step links into Q_{j+1}),
@@ -25,7 +28,9 @@
 // allocation (an entry by (vertex, class, birth), a pair by (its collector's entry, p, q), a
 // class by j, a round by the modifiable holding its first entry), a list step's key holds its
 // predecessor's predecessor, and phases that follow a list pass are issued after it as
-// siblings. Each step reads its cells as a few multi-reads (cell_view.hpp), so its cost is a
+// siblings. Q_j's initial entries are the exception: they append at a tail held in a
+// modifiable per (class, block), so a vertex that joins or leaves class j re-runs the next
+// member's append, not every step up to it. Each step reads its cells as a few multi-reads (cell_view.hpp), so its cost is a
 // few events however many vertices it looks at, and it re-runs only when a cell it read
 // changes.
 // Invariants: those of the twin's rules; every list is terminated by its pass before a later
@@ -33,7 +38,8 @@
 // run; a step writes, allocates and issues only in the round whose view did not fail.
 // Complexity: the twin's steps (O(n lg n + m) expected), each O(1) cells in a graded mesh. An
 // update re-runs the steps whose cells it changes, plus list steps up to the next cell
-// appended as before (bench/RESULTS.md, docs/EXPERIMENTS.md).
+// appended as before, and a class's tail copies up to the next block that holds it
+// (bench/RESULTS.md, docs/EXPERIMENTS.md).
 // Paper: Acar & Hudson, Figure 5 and Appendix A (DynHPU), Section 4; Har-Peled & Üngör (2005);
 // Üngör, "Off-centers" (2004); Acar, Ahmed & Blume (2008) for keyed allocation and
 // destination passing.
