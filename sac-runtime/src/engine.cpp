@@ -211,6 +211,7 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
   // the whole trace (every from-scratch write) none can.
   if (older && older->readers && v->stamp.next() != nullptr) {
     const bool same = v->ops->equal(v, older);
+    if (newer && older->readers->rnext && move_readers_between(m, older, v, newer, same)) return;
     for (ReaderLink* r = older->readers; r;) {
       ReaderLink* nx = r->rnext;
       if (order_.less(&v->stamp, &owner_of(r)->start)) {  // a slot's time is its multi-read's
@@ -221,6 +222,41 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
       r = nx;
     }
   }
+}
+
+bool Engine::move_readers_between(ModBase& m, VersionBase* older, VersionBase* v, VersionBase* newer, bool same) {
+  // The readers to move are the reads of m timed between v and newer (each sees older,
+  // the version visible at its time). A write that re-executes one already in the trace
+  // (newer) is mostly close to it, while older may have a hundred readers, nearly all before
+  // v: walking the stretch of trace between finds them without touching those. Only
+  // multi-read slots name their modifiable; a plain read of the same value type in the
+  // stretch, or a long stretch, leaves the work to the scan of older's readers.
+  constexpr int kMaxStretch = 64, kMaxFound = 16;
+  ReaderLink* found[kMaxFound];
+  int n = 0, k = 0;
+  for (Stamp* s = v->stamp.next(); s != &newer->stamp; s = s->next()) {
+    if (!s || ++k > kMaxStretch) return false;
+    if (s->kind() != StampKind::ReadStart) continue;
+    ReadNode* r = detail::read_of_start(s);
+    if (!r->many()) {
+      if (r->ops()->value == v->ops) return false;
+      continue;
+    }
+    detail::ReadManyHeader* h = detail::many_of(r);
+    if (r->ops()->value != v->ops) continue;
+    for (std::uint32_t i = 0; i < h->k; ++i)
+      if (h->slots()[i].mod == &m) {
+        if (n == kMaxFound) return false;
+        found[n++] = &h->slots()[i].link;
+      }
+  }
+  for (int i = 0; i < n; ++i) {
+    ReaderLink* r = found[i];
+    detach(r);
+    attach(r, v);
+    if (!same && affects(r, older, v)) enqueue(r, m);
+  }
+  return true;
 }
 
 void Engine::set_base(ModBase& m, VersionBase* fresh, void (*assign)(VersionBase*, VersionBase*)) {

@@ -40,7 +40,10 @@
 // propagate() the queue is empty. Built with the CMake option SAC_DEBUG_CHECKS, propagate()
 // runs the check at its end and throws InvariantError on a violation.
 // Complexity: read/write/alloc O(1) amortized plus the version walk of the touched
-// modifiable; propagate() O(trace distance x log(queue size)) for monotone programs.
+// modifiable; a write inside propagate() also finds the older version's readers timed after
+// it: by walking the trace up to the next version when that is at most 64 events away (a
+// re-executed write), else by scanning the older version's readers;
+// propagate() O(trace distance x log(queue size)) for monotone programs.
 // The machinery (records, ops tables, order list, queue, pool, trampoline) is in sac/detail/.
 #pragma once
 
@@ -319,6 +322,10 @@ class Engine {
   void close_chain(TaskKind kind, void* node);
   void discard_pending() noexcept;
   void link_write(ModBase& m, detail::VersionBase* v);
+  /// link_write's move of older's readers timed after v onto v, when a version newer than v
+  /// follows it closely; false (nothing done) when the stretch between is too long to walk.
+  bool move_readers_between(ModBase& m, detail::VersionBase* older, detail::VersionBase* v,
+                            detail::VersionBase* newer, bool same);
   void unlink_version(ModBase* m, detail::VersionBase* v);  // v a version of m
   void link_alloc(detail::AllocNode* n, std::size_t h);
   void link_memo(detail::MemoNode* n, std::size_t h);
