@@ -214,11 +214,8 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
     if (newer && older->readers->rnext && move_readers_between(m, older, v, newer, same)) return;
     for (ReaderLink* r = older->readers; r;) {
       ReaderLink* nx = r->rnext;
-      if (order_.less(&v->stamp, &owner_of(r)->start)) {  // a slot's time is its multi-read's
-        detach(r);
-        attach(r, v);
-        if (!same && affects(r, older, v)) enqueue(r, m);
-      }
+      // A slot's time is its multi-read's.
+      if (order_.less(&v->stamp, &owner_of(r)->start)) move_reader(r, m, older, v, same);
       r = nx;
     }
   }
@@ -238,25 +235,24 @@ bool Engine::move_readers_between(ModBase& m, VersionBase* older, VersionBase* v
     if (!s || ++k > kMaxStretch) return false;
     if (s->kind() != StampKind::ReadStart) continue;
     ReadNode* r = detail::read_of_start(s);
-    if (!r->many()) {
-      if (r->ops()->value == v->ops) return false;
-      continue;
-    }
+    const detail::ReadOps* ops = r->ops();
+    if (ops->value != v->ops) continue;
+    if (!ops->invoke_many) return false;  // a plain read: of m or not, it does not say
     detail::ReadManyHeader* h = detail::many_of(r);
-    if (r->ops()->value != v->ops) continue;
     for (std::uint32_t i = 0; i < h->k; ++i)
       if (h->slots()[i].mod == &m) {
         if (n == kMaxFound) return false;
         found[n++] = &h->slots()[i].link;
       }
   }
-  for (int i = 0; i < n; ++i) {
-    ReaderLink* r = found[i];
-    detach(r);
-    attach(r, v);
-    if (!same && affects(r, older, v)) enqueue(r, m);
-  }
+  for (int i = 0; i < n; ++i) move_reader(found[i], m, older, v, same);
   return true;
+}
+
+void Engine::move_reader(ReaderLink* r, ModBase& m, VersionBase* older, VersionBase* v, bool same) {
+  detach(r);
+  attach(r, v);
+  if (!same && affects(r, older, v)) enqueue(r, m);
 }
 
 void Engine::set_base(ModBase& m, VersionBase* fresh, void (*assign)(VersionBase*, VersionBase*)) {

@@ -293,8 +293,7 @@ struct HpuCellsProgram {
   }
 
   /// One in about kBlockSpan initial vertices opens a block, chosen by its coordinates
-  /// (never by an address). 16 and 64 gave the same events and distances within 2-5%
-  /// (uniform and curves, 32,000 points).
+  /// (never by an address). Other spans measured: bench/RESULTS.md.
   static constexpr std::uint64_t kBlockSpan = 32;
   static bool opens_block(HV v) noexcept {
     std::uint64_t h = std::bit_cast<std::uint64_t>(v->p[0]) * 0x9e3779b97f4a7c15ull ^ std::bit_cast<std::uint64_t>(v->p[1]);
@@ -336,13 +335,12 @@ struct HpuCellsProgram {
   /// Class j in block cb: its members appended at b's tail, which the next block's copy
   /// continues. `more`: a block before held a class above j.
   /// The tail is a modifiable, not an argument: with it in the key, a vertex that joined or
-  /// left the class gave every step after it a new key up to the next member, which at the
-  /// class holding most vertices re-ran thousands of steps (9,292 in one update on 32,000
-  /// curve points). Through the tail's versions it re-runs the next member's append, or the
-  /// copies up to the next block with a member. A block bounds a tail's versions (the
-  /// runtime reads and writes a modifiable at time t in time linear in its versions after
-  /// t): one tail for the whole class was as exact, and 2-15x slower. And a class visits
-  /// only the blocks that hold it, not every vertex of a class at or above it.
+  /// left the class gave every step after it a new key up to the next member, thousands of
+  /// steps at the class holding most vertices. Through the tail's versions it re-runs the
+  /// next member's append, or the copies up to the next block with a member. A block bounds
+  /// a tail's versions, which the runtime walks from the newest to read or write at a time:
+  /// one tail for the whole class was as exact, and several times slower (bench/RESULTS.md,
+  /// "Class lists by block").
   static void class_block(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b, bool more) {
     e.read(cb->classes, [cb, pg, cs, b, more](sac::Engine& e2, const HcClassSet& set) {
       if (set.has(cs->j)) class_cell(e2, cb->first, pg, cs, b);

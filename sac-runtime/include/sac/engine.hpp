@@ -326,6 +326,9 @@ class Engine {
   /// follows it closely; false (nothing done) when the stretch between is too long to walk.
   bool move_readers_between(ModBase& m, detail::VersionBase* older, detail::VersionBase* v,
                             detail::VersionBase* newer, bool same);
+  /// Hangs r, a reader of older timed after v, on v; queues it when the new value (`same`:
+  /// equal to older's) affects it.
+  void move_reader(detail::ReaderLink* r, ModBase& m, detail::VersionBase* older, detail::VersionBase* v, bool same);
   void unlink_version(ModBase* m, detail::VersionBase* v);  // v a version of m
   void link_alloc(detail::AllocNode* n, std::size_t h);
   void link_memo(detail::MemoNode* n, std::size_t h);
