@@ -161,7 +161,11 @@ void Engine::poison() noexcept {
 
 VersionBase* Engine::visible(const ModBase& m, const Stamp* t) const {
   VersionBase* v = m.newest();
-  while (v && !(v->is_base() || order_.less(&v->stamp, t))) v = v->older();
+  // At the trace's end (every from-scratch step) the newest version is the one, and its
+  // stamp need not be loaded. A version written at t itself is visible at t: a read's
+  // start is never a write's stamp, but now_ is one right after a write.
+  if (t->next() == nullptr) return v;
+  while (v && !(v->is_base() || &v->stamp == t || order_.less(&v->stamp, t))) v = v->older();
   return v;
 }
 

@@ -483,6 +483,28 @@ TEST(ReadMany, PeekSeesTheValueVisibleNowAndRecordsNothing) {
   e.check_invariants();
 }
 
+TEST(ReadMany, PeekSeesAWriteJustMadeByTheSameBody) {
+  // The write's time is now itself: a peek right after it must see it, on the first run
+  // (at the trace's end) and on a re-run inside the trace alike.
+  Mod<int> a, m, seen;
+  Engine e;
+  e.set(a, 1);
+  e.run([&](Engine& en) {
+    en.read(a, [&](Engine& x, int v) {
+      x.write(m, v * 10);
+      const int* p = x.peek(m);
+      x.write(seen, p ? *p : -1);
+    });
+  });
+  EXPECT_EQ(seen.get(), 10);
+  for (int v : {2, 3, 5}) {
+    e.set(a, v);
+    e.propagate();
+    EXPECT_EQ(seen.get(), v * 10);
+    e.check_invariants();
+  }
+}
+
 namespace {
 
 // The prefetch pattern: a chain walk through cells[] (each value the next index, -1 ends)
