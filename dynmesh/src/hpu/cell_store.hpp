@@ -15,11 +15,13 @@
 // A leaf's vertices are sorted by (x, y), so a value is a function of the cell's vertex set
 // and an equal set is a cut-off write.
 //
-// Invariants (InputCells::check_invariants): the base values form the bucket tree of the
-// first vertices (every vertex in the leaf whose cell holds its exact grid position, a leaf
-// over capacity only at the finest level, a split cell over capacity in its subtree); the
-// newest values after a run form the bucket tree of all vertices (the tests compare them
-// with BucketTree). A directory entry is never removed while the engine lives.
+// Invariants (InputCells::check_invariants, which runs CellDirectory's): a node's parent
+// and child links are the directory's lookups of those keys; the base values form the
+// bucket tree of the first vertices (every vertex in the leaf whose cell holds its exact
+// grid position, a leaf over capacity only at the finest level, a split cell over capacity
+// in its subtree); the newest values after a run form the bucket tree of all vertices (the
+// tests compare them with BucketTree). A directory entry is never removed while the engine
+// lives.
 // Complexity: InputCells::insert/erase O(depth + kCapacity) plus O(kCapacity) base values
 // set; a directory lookup O(1) expected.
 // Paper: Acar & Hudson, Section 4 (modifiables, and the mutator's changes); Har-Peled &
@@ -31,6 +33,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -107,13 +110,31 @@ struct CellKeyHash {
   std::size_t operator()(const CellKey& k) const noexcept { return static_cast<std::size_t>(k.hash()); }
 };
 
-/// One cell's modifiable.
+/// What the running step's CellView knows of a cell (cell_view.hpp), kept on the cell's node
+/// so that a search finds it without a lookup. Valid while gen is the view's generation.
+enum class CellTag : std::uint8_t { Unknown, Leaf, Split, Absent };
+struct CellMark {
+  std::uint32_t gen = 0;
+  CellTag tag = CellTag::Unknown;  // Unknown: not looked at; else its state now, read or peeked
+  bool read = false;               // a round of the step read it (or read a cell below it)
+  bool pending = false;            // a search used it unread
+  bool all = false;                // the step used every vertex of it
+  // The box whose vertices the step's searches used, when not all (x0 > x1: none).
+  double bx0 = std::numeric_limits<double>::infinity(), by0 = std::numeric_limits<double>::infinity();
+  double bx1 = -std::numeric_limits<double>::infinity(), by1 = -std::numeric_limits<double>::infinity();
+  const CellState* state = nullptr;
+};
+
+/// One cell's modifiable, linked to its parent's and children's nodes when they exist.
 struct CellNode {
   explicit CellNode(const CellKey& k) : key(k) {}
   CellNode(const CellNode&) = delete;
   CellNode& operator=(const CellNode&) = delete;
   CellKey key;
   sac::Mod<CellState> state;
+  CellNode* parent = nullptr;          // find(key.parent())
+  std::array<CellNode*, 4> child{};    // find(key.child(c)), null when never made
+  CellMark mark;                       // the one CellView's scratch
 };
 
 /// The cells by key, outside the trace: each is made on first use, with the default value
@@ -133,7 +154,39 @@ class CellDirectory {
     e.init_default(n->state);
     *x = Entry{h, n};
     if (2 * nodes_.size() > table_.size()) grow();
+    if (k.level > 0)
+      if (CellNode* p = find(k.parent())) {
+        n->parent = p;
+        p->child[child_index(k)] = n;
+      }
+    if (k.level < BucketTree::kMaxLevel)
+      for (unsigned c = 0; c < 4; ++c)
+        if (CellNode* ch = find(k.child(c))) {
+          n->child[c] = ch;
+          ch->parent = n;
+        }
     return n;
+  }
+  /// Which child of its parent k is (CellKey::child's numbering).
+  static unsigned child_index(const CellKey& k) noexcept {
+    return static_cast<unsigned>((k.ix & 1) | ((k.iy & 1) << 1));
+  }
+  /// Forgets every view mark (a view's generation counter wrapped).
+  void clear_marks() {
+    for (CellNode& n : nodes_) n.mark = CellMark{};
+  }
+  /// Throws InvariantError unless every node's links are the lookups they stand for, and
+  /// every node below the root has its parent.
+  void check_invariants() const {
+    for (const CellNode& n : nodes_) {
+      const CellKey& k = n.key;
+      if (find(k) != &n) throw InvariantError("dynmesh: CellDirectory: a node its key does not find");
+      if (k.level > 0 && (!n.parent || n.parent != find(k.parent())))
+        throw InvariantError("dynmesh: CellDirectory: a node without its parent's link");
+      for (unsigned c = 0; c < 4; ++c)
+        if (n.child[c] != (k.level < BucketTree::kMaxLevel ? find(k.child(c)) : nullptr))
+          throw InvariantError("dynmesh: CellDirectory: a child link that is not the child's node");
+    }
   }
   /// The cell's node if it was ever made, else null. O(1) expected: the questions ask it for
   /// every cell they look at, so it is an open-addressing table whose entries carry the
@@ -293,6 +346,7 @@ class InputCells {
 
   /// The base values against the tree's definition (see the header); throws InvariantError.
   void check_invariants() const {
+    dir_->check_invariants();
     std::size_t total = 0;
     check(CellKey{}, total);
     if (total != size()) throw InvariantError("dynmesh: InputCells: the root counts another number of vertices");

@@ -108,8 +108,6 @@ class CellView {
   using V = const CellVertex*;
 
   CellView(sac::Engine& e, CellDirectory& dir) : e_(&e), dir_(&dir), box_(dir.box()) {
-    table_.resize(1024);
-    mask_ = table_.size() - 1;
     for (int l = 0; l <= BucketTree::kMaxLevel; ++l) width_[l] = std::ldexp(box_.side, -l);
   }
   CellView(const CellView&) = delete;
@@ -129,10 +127,9 @@ class CellView {
     if (kept_) return true;
     pending_.clear();
     if (++gen_ == 0) {
-      for (Slot& s : table_) s.gen = 0;
+      dir_->clear_marks();
       gen_ = 1;
     }
-    used_ = 0;
     read_.clear();
     settled_ = 0;
     visited_.clear();
@@ -150,25 +147,23 @@ class CellView {
     const std::span<const ReadCell> fresh(read_.data() + settled_, read_.size() - settled_);
     settled_ = read_.size();
     for (const auto& [n, s, used] : fresh) {
-      Slot& x = slot(n->key);
+      CellMark& x = mark(n);
       x.tag = tag_of(s);
       x.state = s;
-      x.node = n;
       x.read = true;
     }
     for (const auto& [n, s, used] : fresh) {
-      if (s->kind == CellState::Absent || n->key.level == 0) continue;
-      for (CellKey k = n->key.parent();; k = k.parent()) {
-        Slot& x = slot(k);
+      if (s->kind == CellState::Absent) continue;
+      for (CellNode* a = n->parent; a; a = a->parent) {
+        CellMark& x = mark(a);
         if (x.read && x.tag == Tag::Split) break;
         if (x.read && x.tag != Tag::Unknown)
           throw InvariantError("dynmesh: CellView: a cell read below a leaf or an absent cell");
         x.tag = Tag::Split;
         x.read = true;
-        if (k.level == 0) break;
       }
     }
-    std::erase_if(pending_, [&](CellNode* n) { return find_slot(n->key)->read; });
+    std::erase_if(pending_, [&](CellNode* n) { return mark(n).read; });
   }
 
   // ---------------------------------------------------------------- the store interface
@@ -185,12 +180,12 @@ class CellView {
     if (!visited_.empty()) throw InvariantError("dynmesh: CellView: a search's use was not stated");
     for (const ReadCell& r : read_) {
       if (!r.used) continue;
-      const Slot& x = *find_slot(r.node->key);
+      const CellMark& x = mark(r.node);
       CellInterest in = CellInterest::none();
       if (x.all) {
         in = CellInterest{};
       } else if (x.bx0 <= x.bx1) {
-        in = CellFrame(box_, x.key).interest(x.bx0, x.by0, x.bx1, x.by1);
+        in = CellFrame(box_, r.node->key).interest(x.bx0, x.by0, x.bx1, x.by1);
       }
       *r.used = in;
     }
@@ -236,13 +231,13 @@ class CellView {
   void used_within(const Point<2>& c, double r) const {
     auto* self = const_cast<CellView*>(this);
     const double R = r * (1 + 0x1p-20) + cellq::ulp_room(c);
-    for (const CellKey& k : visited_) self->widen(self->slot(k), c, R);
+    for (CellNode* n : visited_) self->widen(self->mark(n), c, R);
     self->visited_.clear();
   }
   /// The last search()'s answer may depend on any vertex of the leaves it met.
   void used_all() const {
     auto* self = const_cast<CellView*>(this);
-    for (const CellKey& k : visited_) self->slot(k).all = true;
+    for (CellNode* n : visited_) self->mark(n).all = true;
     self->visited_.clear();
   }
 
@@ -265,12 +260,12 @@ class CellView {
 
   /// The leaf that holds grid position q, and its value (pending when unread).
   std::pair<CellNode*, const CellState*> locate(const std::array<std::uint64_t, 2>& q, double /*scale*/) {
-    const CellKey k = deepest_present(CellDirectory::cell_at(q, BucketTree::kMaxLevel));
-    Slot& x = resolve(k);
+    CellNode* n = deepest_present(CellDirectory::cell_at(q, BucketTree::kMaxLevel));
+    CellMark& x = resolve(n);
     if (x.tag != Tag::Leaf) throw InvariantError("dynmesh: CellView: a position with no leaf");
-    touch(x);
+    touch(n, x);
     x.all = true;  // the insertion writes the leaf's next value: all its vertices
-    return {x.node, x.state};
+    return {n, x.state};
   }
 
   /// A cell's box, widened by margin.
@@ -281,85 +276,51 @@ class CellView {
   }
 
  private:
-  // Unknown: not looked at in this view; otherwise the cell's state now, read or peeked.
-  enum class Tag : std::uint8_t { Unknown, Leaf, Split, Absent };
-  struct Slot {
-    std::uint32_t gen = 0;
-    Tag tag = Tag::Unknown;
-    bool read = false;     // a round of the step read it (or read a cell below it)
-    bool pending = false;  // a search used it unread: in pending_
-    bool all = false;      // the step used every vertex of it
-    // The box whose vertices the step's searches used, when not all (x0 > x1: none).
-    double bx0, by0, bx1, by1;
-    CellKey key;
-    const CellState* state = nullptr;
-    CellNode* node = nullptr;
-  };
+  using Tag = CellTag;
 
   static Tag tag_of(const CellState* s) noexcept {
     if (!s || s->kind == CellState::Absent) return Tag::Absent;
     return s->kind == CellState::Leaf ? Tag::Leaf : Tag::Split;
   }
 
-  Slot& slot(const CellKey& k) {
-    if (2 * (used_ + 1) > table_.size()) grow();
-    for (std::size_t i = k.hash() & mask_;; i = (i + 1) & mask_) {
-      Slot& s = table_[i];
-      if (s.gen != gen_) {
-        s.gen = gen_;
-        s.tag = Tag::Unknown;
-        s.read = false;
-        s.pending = false;
-        s.all = false;
-        s.bx0 = s.by0 = std::numeric_limits<double>::infinity();
-        s.bx1 = s.by1 = -std::numeric_limits<double>::infinity();
-        s.key = k;
-        s.state = nullptr;
-        s.node = nullptr;
-        ++used_;
-        return s;
-      }
-      if (s.key == k) return s;
-    }
-  }
-
-  const Slot* find_slot(const CellKey& k) const {
-    for (std::size_t i = k.hash() & mask_;; i = (i + 1) & mask_) {
-      const Slot& s = table_[i];
-      if (s.gen != gen_) return nullptr;
-      if (s.key == k) return &s;
-    }
-  }
-
-  /// k's slot, its state looked up now if the view does not know it: a peek, which records
-  /// nothing (the runtime's guess for a prefetch); a search that uses the cell makes it
-  /// pending, and the step reads it before it acts.
-  Slot& resolve(const CellKey& k) {
-    Slot& x = slot(k);
-    if (x.tag == Tag::Unknown) {
-      CellNode* n = dir_->find(k);
-      const CellState* s = n ? e_->peek(n->state) : nullptr;
-      x.tag = tag_of(s);
-      x.state = s;
-      x.node = n;
+  /// n's mark in this view: what the step knows of the cell (its node holds it, so a search
+  /// reaches it by the directory's child links, with no lookup).
+  CellMark& mark(CellNode* n) const noexcept {
+    CellMark& x = n->mark;
+    if (x.gen != gen_) {
+      x = CellMark{};
+      x.gen = gen_;
     }
     return x;
   }
 
-  void touch(Slot& x) {
+  /// n's mark, its state looked up now if the view does not know it: a peek, which records
+  /// nothing (the runtime's guess for a prefetch); a search that uses the cell makes it
+  /// pending, and the step reads it before it acts.
+  CellMark& resolve(CellNode* n) {
+    CellMark& x = mark(n);
+    if (x.tag == Tag::Unknown) {
+      x.state = e_->peek(n->state);
+      x.tag = tag_of(x.state);
+    }
+    return x;
+  }
+
+  void touch(CellNode* n, CellMark& x) {
     if (x.read || x.pending) return;
     x.pending = true;
-    pending_.push_back(x.node);
+    pending_.push_back(n);
   }
 
   /// The deepest cell on k's path to the root that is not absent (a leaf or a split): a
   /// binary search over the levels, since the path is split cells, then the leaf, then
-  /// absent ones.
-  CellKey deepest_present(const CellKey& k) {
+  /// absent ones (a cell never made is absent).
+  CellNode* deepest_present(const CellKey& k) {
     int lo = 0, hi = k.level;  // the root is present
     const auto present = [&](int level) {
       const int s = k.level - level;
-      return resolve(CellKey{level, k.ix >> s, k.iy >> s}).tag != Tag::Absent;
+      CellNode* n = dir_->find(CellKey{level, k.ix >> s, k.iy >> s});
+      return n && resolve(n).tag != Tag::Absent;
     };
     // The last answer's level first: a step's searches are mostly in one region, so its
     // leaves' level and the one below usually settle it in two lookups.
@@ -384,7 +345,7 @@ class CellView {
     }
     guess_level_ = lo;
     const int s = k.level - lo;
-    return CellKey{lo, k.ix >> s, k.iy >> s};
+    return dir_->find(CellKey{lo, k.ix >> s, k.iy >> s});
   }
 
   template <class Keep, class F>
@@ -396,7 +357,7 @@ class CellView {
     bool stop = false;
     if (!bounded && R == 0) {
       region_ = false;
-      return search_node(CellKey{}, focus, margin, keep, f, stop);
+      return search_node(root(), focus, margin, keep, f, stop);
     }
     // search_from() records the leaves it meets until the question states its use. A
     // bounded search's answer uses the vertices within R of the focus only
@@ -407,13 +368,13 @@ class CellView {
       region_c_ = focus;
       region_r_ = R * (1 + 0x1p-20) + cellq::ulp_room(focus);
     }
-    std::array<CellKey, 4> starts;
+    std::array<CellNode*, 4> starts;
     const std::size_t n = starts_for(focus, R, starts);
     for (std::size_t i = 0; i < n && !stop; ++i) search_node(starts[i], focus, margin, keep, f, stop);
   }
 
   /// x's box of used vertices grows by the box around the disc (c, R).
-  static void widen(Slot& x, const Point<2>& c, double R) noexcept {
+  static void widen(CellMark& x, const Point<2>& c, double R) noexcept {
     x.bx0 = std::min(x.bx0, c[0] - R), x.by0 = std::min(x.by0, c[1] - R);
     x.bx1 = std::max(x.bx1, c[0] + R), x.by1 = std::max(x.by1, c[1] + R);
   }
@@ -423,7 +384,7 @@ class CellView {
   /// (itself when present), without repeats, nearest to the focus first. Starting at the
   /// smallest cell holding the whole box instead walked down from the root whenever the box
   /// straddled a coarse cell's boundary.
-  std::size_t starts_for(const Point<2>& focus, double R, std::array<CellKey, 4>& out) {
+  std::size_t starts_for(const Point<2>& focus, double R, std::array<CellNode*, 4>& out) {
     const auto a = dir_->position(Point<2>{focus[0] - R, focus[1] - R});
     const auto b = dir_->position(Point<2>{focus[0] + R, focus[1] + R});
     const int g = BucketTree::kMaxLevel - std::bit_width(std::max(b[0] - a[0], b[1] - a[1]));
@@ -432,11 +393,11 @@ class CellView {
     std::size_t n = 0;
     for (std::uint64_t iy = a[1] >> s; iy <= b[1] >> s; ++iy)
       for (std::uint64_t ix = a[0] >> s; ix <= b[0] >> s; ++ix) {
-        const CellKey k = deepest_present(CellKey{g, ix, iy});
+        CellNode* k = deepest_present(CellKey{g, ix, iy});
         const auto end = out.begin() + static_cast<std::ptrdiff_t>(n);
         if (std::find(out.begin(), end, k) != end) continue;
         double x0, y0, x1, y1;
-        cell_box(k, 0.0, x0, y0, x1, y1);
+        cell_box(k->key, 0.0, x0, y0, x1, y1);
         const double d = BucketTree::box_distance2(focus, x0, y0, x1, y1);
         std::size_t i = n++;
         for (; i > 0 && dist[i - 1] > d; --i) {  // insertion: stable, so ties keep the scan order
@@ -449,33 +410,27 @@ class CellView {
     return n;
   }
 
-  void grow() {
-    std::vector<Slot> old(table_.size() * 2);
-    old.swap(table_);
-    mask_ = table_.size() - 1;
-    used_ = 0;
-    for (const Slot& s : old) {
-      if (s.gen != gen_) continue;
-      Slot& n = slot(s.key);
-      n = s;
-    }
+  CellNode* root() {
+    if (!root_) root_ = dir_->find(CellKey{});
+    return root_;
   }
 
   /// A search's visit of k. Its answers depend on the leaves it hands vertices from, and on
   /// a split cell whose children it all prunes; those cells are used (touched). Every other
   /// cell it passes is an ancestor of a used one, known split through it.
   template <class Keep, class F>
-  void search_node(const CellKey& k, const Point<2>& focus, double margin, Keep& keep, F& f, bool& stop) {
+  void search_node(CellNode* n, const Point<2>& focus, double margin, Keep& keep, F& f, bool& stop) {
+    const CellKey& k = n->key;
     double x0, y0, x1, y1;
     cell_box(k, margin, x0, y0, x1, y1);
     if (!keep(x0, y0, x1, y1)) return;
-    Slot& x = resolve(k);
+    CellMark& x = resolve(n);
     switch (x.tag) {
       case Tag::Leaf: {
         ++leaves_read_;
-        touch(x);
+        touch(n, x);
         if (region_) widen(x, region_c_, region_r_);
-        else visited_.push_back(k);
+        else visited_.push_back(n);
         const CellState& s = *x.state;
         for (std::size_t i = 0; i < s.count; ++i)
           if (f(s.items[i])) {
@@ -498,9 +453,11 @@ class CellView {
         const unsigned order[4] = {near, near ^ (x_first ? 2u : 1u), near ^ (x_first ? 1u : 2u), near ^ 3u};
         for (const unsigned c : order) {
           if (stop) return;
-          search_node(k.child(c), focus, margin, keep, f, stop);
+          CellNode* ch = n->child[c];
+          if (!ch) throw InvariantError("dynmesh: CellView: a split cell without its children's nodes");
+          search_node(ch, focus, margin, keep, f, stop);
         }
-        if (leaves_read_ == before) touch(slot(k));  // x may have moved (the table grew)
+        if (leaves_read_ == before) touch(n, x);
         return;
       }
       case Tag::Absent:
@@ -514,9 +471,8 @@ class CellView {
   CellDirectory* dir_;
   Box<2> box_;
   std::array<double, BucketTree::kMaxLevel + 1> width_{};
-  std::vector<Slot> table_;
-  std::size_t mask_ = 0, used_ = 0;
-  std::uint32_t gen_ = 0;
+  CellNode* root_ = nullptr;  // the directory's, made before any step runs
+  std::uint32_t gen_ = 0;     // the marks of this generation are this step's
   struct ReadCell {
     CellNode* node;
     const CellState* state;
@@ -530,7 +486,7 @@ class CellView {
   bool region_ = false;
   Point<2> region_c_{};
   double region_r_ = 0;
-  std::vector<CellKey> visited_;
+  std::vector<CellNode*> visited_;
   bool searched_from_ = false;  // the last search was a search_from()
   int guess_level_ = 0;  // deepest_present's last answer (a hint only)
   std::size_t leaves_read_ = 0;
