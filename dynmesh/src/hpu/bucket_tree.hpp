@@ -42,9 +42,7 @@ struct BucketLeaf {
 class BucketTree {
  public:
   using Vid = std::uint32_t;
-  // 16: a search then passes fewer cells than with 8, and scans few more vertices; 8, 12 and
-  // 32 were slower (bench/RESULTS.md, "Leaves of 16").
-  static constexpr std::size_t kCapacity = 16;
+  static constexpr std::size_t kCapacity = 8;
   static constexpr int kMaxLevel = 52;
 
   explicit BucketTree(const Box<2>& box) : box_(box), scale_(box.scale()) { nodes_.emplace_back(); }
