@@ -2,7 +2,8 @@
 // of a box hold every vertex inside the box, whatever the cell and the rounding, and a change
 // of a leaf counts exactly when it changes the vertices inside the used box (or the kind).
 // The program's reads that rely on it are checked end to end by hpu_cells_program_test.cpp
-// (every update against the twin).
+// (every update against the twin). Also the directory's node links and the one view that
+// may keep its marks on the nodes.
 #include "hpu/cell_view.hpp"
 
 #include <gtest/gtest.h>
@@ -13,7 +14,10 @@
 #include <random>
 #include <vector>
 
+#include <sac/engine.hpp>
+
 #include "dynmesh/box.hpp"
+#include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
 #include "hpu/cell_store.hpp"
 
@@ -36,6 +40,7 @@ TEST(CellInterest, EveryVertexInsideABoxIsInsideItsParts) {
     const CellKey k{level, rng() % n, rng() % n};
     const CellFrame f(box, k);
     const double w = std::ldexp(box.side, -level);
+    ASSERT_EQ(f.inv, 256.0 / w) << "the frame's width is ldexp's, try " << t;
     const double x0 = f.ox + w * (1.4 * u(rng) - 0.2), x1 = x0 + w * u(rng);
     const double y0 = f.oy + w * (1.4 * u(rng) - 0.2), y1 = y0 + w * u(rng);
     const CellInterest in = f.interest(x0, y0, x1, y1);
@@ -67,6 +72,41 @@ TEST(CellInterest, ALeafChangesForAReadOnlyInsideWhatItUsed) {
   EXPECT_TRUE(interest_changed(box, k, CellInterest{}, before, leaf({a, b, c, d})));
   EXPECT_FALSE(interest_changed(box, k, CellInterest::none(), before, leaf({d})));
   EXPECT_TRUE(interest_changed(box, k, CellInterest::none(), before, CellState{}));  // absent
+}
+
+TEST(CellDirectory, NodesLinkTheirParentAndChildrenWhateverTheOrderMade) {
+  sac::Engine e;
+  CellDirectory dir(Box<2>{{0, 0}, 1});
+  CellNode* c = dir.node(e, CellKey{2, 1, 2});  // below a cell not made yet
+  CellNode* root = dir.node(e, CellKey{});
+  CellNode* mid = dir.node(e, CellKey{1, 0, 1});
+  EXPECT_EQ(c->parent, mid);
+  EXPECT_EQ(mid->parent, root);
+  EXPECT_EQ(root->parent, nullptr);
+  EXPECT_EQ(mid->child[CellDirectory::child_index(c->key)], c);
+  EXPECT_EQ(root->child[CellDirectory::child_index(mid->key)], mid);
+  EXPECT_EQ(root->child[0], nullptr);
+  EXPECT_NO_THROW(dir.check_invariants());
+  mid->child[0] = c;  // a link that is not the lookup
+  EXPECT_THROW(dir.check_invariants(), dynmesh::InvariantError);
+  mid->child[0] = nullptr;
+  c->parent = nullptr;
+  EXPECT_THROW(dir.check_invariants(), dynmesh::InvariantError);
+}
+
+TEST(CellDirectory, OneViewAtATimeKeepsItsMarksOnTheNodes) {
+  sac::Engine e;
+  CellDirectory dir(Box<2>{{0, 0}, 1});
+  CellNode* root = dir.node(e, CellKey{});
+  {
+    CellView v(e, dir);
+    EXPECT_THROW(CellView(e, dir), dynmesh::InvariantError);
+    root->mark.gen = 1;  // as a step of the first view leaves it
+    root->mark.read = true;
+  }
+  CellView w(e, dir);  // the first is gone: the marks start clean
+  EXPECT_EQ(root->mark.gen, 0u);
+  EXPECT_FALSE(root->mark.read);
 }
 
 }  // namespace

@@ -16,12 +16,12 @@
 // and an equal set is a cut-off write.
 //
 // Invariants (InputCells::check_invariants, which runs CellDirectory's): a node's parent
-// and child links are the directory's lookups of those keys; the base values form the
-// bucket tree of the first vertices (every vertex in the leaf whose cell holds its exact
-// grid position, a leaf over capacity only at the finest level, a split cell over capacity
-// in its subtree); the newest values after a run form the bucket tree of all vertices (the
-// tests compare them with BucketTree). A directory entry is never removed while the engine
-// lives.
+// and child links are the directory's lookups of those keys; one CellView at a time keeps
+// its marks on the nodes (claim_marks); the base values form the bucket tree of the first
+// vertices (every vertex in the leaf whose cell holds its exact grid position, a leaf over
+// capacity only at the finest level, a split cell over capacity in its subtree); the newest
+// values after a run form the bucket tree of all vertices (the tests compare them with
+// BucketTree). A directory entry is never removed while the engine lives.
 // Complexity: InputCells::insert/erase O(depth + kCapacity) plus O(kCapacity) base values
 // set; a directory lookup O(1) expected.
 // Paper: Acar & Hudson, Section 4 (modifiables, and the mutator's changes); Har-Peled &
@@ -171,6 +171,18 @@ class CellDirectory {
   static unsigned child_index(const CellKey& k) noexcept {
     return static_cast<unsigned>((k.ix & 1) | ((k.iy & 1) << 1));
   }
+  /// The nodes' marks belong to one CellView at a time, from its construction to its
+  /// destruction: InvariantError for a second, whose marks would mix with the first's. A
+  /// later view starts from clean marks (its generations count from the start again).
+  void claim_marks(const void* view) {
+    if (mark_owner_) throw InvariantError("dynmesh: CellDirectory: a second CellView on the same cells");
+    if (marks_used_) clear_marks();
+    mark_owner_ = view;
+    marks_used_ = true;
+  }
+  void release_marks(const void* view) noexcept {
+    if (mark_owner_ == view) mark_owner_ = nullptr;
+  }
   /// Forgets every view mark (a view's generation counter wrapped).
   void clear_marks() {
     for (CellNode& n : nodes_) n.mark = CellMark{};
@@ -268,6 +280,8 @@ class CellDirectory {
   Box<2> box_;
   std::vector<Entry> table_;  // a power of two, at most half full
   std::deque<CellNode> nodes_;
+  const void* mark_owner_ = nullptr;  // the CellView whose marks the nodes hold
+  bool marks_used_ = false;           // some view has held them
 };
 
 /// The mutator's part: the bucket tree of the first vertices, kept as the cells' base

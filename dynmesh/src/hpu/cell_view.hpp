@@ -112,8 +112,10 @@ class CellView {
   using V = const CellVertex*;
 
   CellView(sac::Engine& e, CellDirectory& dir) : e_(&e), dir_(&dir), box_(dir.box()) {
+    dir.claim_marks(this);
     for (int l = 0; l <= BucketTree::kMaxLevel; ++l) width_[l] = std::ldexp(box_.side, -l);
   }
+  ~CellView() { dir_->release_marks(this); }
   CellView(const CellView&) = delete;
   CellView& operator=(const CellView&) = delete;
 
