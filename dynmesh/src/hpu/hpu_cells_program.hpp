@@ -610,7 +610,7 @@ struct HpuCellsProgram {
     std::array<std::size_t, 4> count{};
     for (HV w : items) {
       const CellKey c = CellDirectory::cell_at(pg->dir->position(w->p), n->key.level + 1);
-      const unsigned k = static_cast<unsigned>((c.ix & 1) | ((c.iy & 1) << 1));
+      const unsigned k = CellDirectory::child_index(c);
       part[k][count[k]++] = w;
     }
     for (unsigned k = 0; k < 4; ++k)

@@ -172,12 +172,12 @@ class Engine {
   template <class T>
   const T& current(const Mod<T>& m);
 
-  /// The value of m visible now, or null when m has no version visible now (a modifiable
-  /// made with init_default then has the value T{}). Records nothing and makes nothing, so
-  /// it is a guess, never a dependency: a body may use it only to choose which modifiables
-  /// to read, and its effects must depend on the values it reads. The use is a prefetch: a
-  /// search runs on the values visible now to learn which cells it needs, then reads them
-  /// all as one read_many. O(versions of m newer than now).
+  /// The value of m visible now (a write this body just made included), or null when m has
+  /// no version visible now (a modifiable made with init_default then has the value T{}).
+  /// Records nothing and makes nothing, so it is a guess, never a dependency: a body may use
+  /// it only to choose which modifiables to read, and its effects must depend on the values
+  /// it reads. The use is a prefetch: a search runs on the values visible now to learn which
+  /// cells it needs, then reads them all as one read_many. O(versions of m newer than now).
   template <class T>
   const T* peek(const Mod<T>& m);
 
