@@ -7,8 +7,14 @@
 // mesh is built `--reps` times (median time), checked against the contract (Delaunay, every
 // angle >= the bound, tiling, inputs present: checked = 1), and reported with its size, its
 // ratio to the peers' sizes, and its angle histogram (10-degree bins, every angle of every
-// triangle). Output: a table, or CSV with --csv:
-//   input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,entries_per_vertex,checked
+// triangle).
+// When the build has Triangle (DYNMESH_TRIANGLE_SOURCE, triangle_peer.hpp), each rep also
+// builds Triangle's mesh of the same points and box right after the twin's, so that both
+// medians come from the same run: tri_s is its median time, twin/Tri the ratio of the
+// medians, and vs_Tri uses the vertices Triangle made here instead of the figure.
+// Without it those columns are empty ("-"; CSV: empty). Output: a table, or CSV with --csv:
+//   input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,entries_per_vertex,checked,
+//   triangle_seconds,twin_over_triangle,triangle_vertices
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
@@ -18,6 +24,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bench_stats.hpp"
+#include "triangle_peer.hpp"
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/distributions.hpp"
@@ -56,42 +63,60 @@ int main(int argc, char** argv) {
   app.add_flag("--histogram", histogram, "print each mesh's angle histogram");
   CLI11_PARSE(app, argc, argv);
 
+  if (!bench::kHaveTriangle && !csv)
+    std::printf("# no Triangle in this build: vs_Tri uses Triangle 1.6's sizes on these inputs, measured before "
+                "(configure with -DDYNMESH_TRIANGLE_SOURCE=.../triangle.c to run it here)\n");
   if (csv)
-    std::printf("input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,entries_per_vertex,checked\n");
+    std::printf(
+        "input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,entries_per_vertex,checked,"
+        "triangle_seconds,twin_over_triangle,triangle_vertices\n");
   else
-    std::printf("%-9s %6s %9s %9s %9s %8s %8s %9s %6s %8s %7s\n", "input", "angle", "seconds", "vertices", "triangles",
-                "vs_Tri", "vs_CGAL", "min_angle", "rounds", "entries", "checked");
+    std::printf("%-9s %6s %9s %9s %9s %8s %8s %9s %6s %8s %7s %9s %8s %9s\n", "input", "angle", "seconds", "vertices",
+                "triangles", "vs_Tri", "vs_CGAL", "min_angle", "rounds", "entries", "checked", "tri_s", "twin/Tri",
+                "tri_V");
   bool all_ok = true;
   for (const std::size_t n : ns) {
     const auto pts = python_uniform(n, 1);
     const Box<2> box = derive_box<2>(pts);
     for (const Peer& peer : kPeers) {
       if (peer.n != n) continue;
-      std::vector<double> times;
+      std::vector<double> times, tri_times;
       std::vector<Triangle> tris;
       HpuStats stats;
-      for (int r = 0; r < reps; ++r)
+      bench::TriangleMeshSize tri_size;
+      for (int r = 0; r < reps; ++r) {
         times.push_back(bench::seconds([&] {
           const HpuMesh m(box, pts, peer.angle);
           tris = m.triangles();
           stats = m.stats();
         }));
+        if (bench::kHaveTriangle)
+          tri_times.push_back(bench::seconds([&] { tri_size = bench::triangle_quality_mesh(box, pts, peer.angle); }));
+      }
       const Mesh mesh = make_mesh(tris);
       const MeshReport report =
           check_mesh(mesh, box, pts, MeshCheckOptions{.min_angle_deg = peer.angle, .delaunay = true});
       all_ok = all_ok && report.ok();
       const std::string input = "unif1e" + std::to_string(n == 10000 ? 4 : n == 100000 ? 5 : 0);
-      const double vt = double(mesh.num_vertices()) / peer.triangle_vertices;
+      const double tri_vertices = bench::kHaveTriangle ? double(tri_size.vertices) : peer.triangle_vertices;
+      const double vt = double(mesh.num_vertices()) / tri_vertices;
+      const double tri_s = bench::median(tri_times);
+      char tri_cols[96] = "";
+      if (bench::kHaveTriangle)
+        std::snprintf(tri_cols, sizeof tri_cols, csv ? ",%.4f,%.3f,%zu" : " %9.4f %8.3f %9zu", tri_s,
+                      bench::median(times) / tri_s, tri_size.vertices);
+      else
+        std::snprintf(tri_cols, sizeof tri_cols, csv ? ",,," : " %9s %8s %9s", "-", "-", "-");
       const double vc = double(mesh.num_vertices()) / peer.cgal_vertices;
       const double per_vertex = double(stats.entries) / double(mesh.num_vertices());  // queue entries
       if (csv)
-        std::printf("%s,%.1f,%.4f,%zu,%zu,%.4f,%.4f,%.3f,%zu,%.3f,%d\n", input.c_str(), peer.angle,
+        std::printf("%s,%.1f,%.4f,%zu,%zu,%.4f,%.4f,%.3f,%zu,%.3f,%d%s\n", input.c_str(), peer.angle,
                     bench::median(times), mesh.num_vertices(), mesh.num_triangles(), vt, vc, report.min_angle_deg,
-                    stats.rounds, per_vertex, report.ok() ? 1 : 0);
+                    stats.rounds, per_vertex, report.ok() ? 1 : 0, tri_cols);
       else
-        std::printf("%-9s %6.1f %9.4f %9zu %9zu %8.3f %8.3f %9.3f %6zu %8.3f %7d\n", input.c_str(), peer.angle,
+        std::printf("%-9s %6.1f %9.4f %9zu %9zu %8.3f %8.3f %9.3f %6zu %8.3f %7d%s\n", input.c_str(), peer.angle,
                     bench::median(times), mesh.num_vertices(), mesh.num_triangles(), vt, vc, report.min_angle_deg,
-                    stats.rounds, per_vertex, report.ok() ? 1 : 0);
+                    stats.rounds, per_vertex, report.ok() ? 1 : 0, tri_cols);
       if (histogram) {
         const MeshStats ms = mesh_stats(mesh);
         std::printf("  angle histogram (%s, %.1f deg):", input.c_str(), peer.angle);
