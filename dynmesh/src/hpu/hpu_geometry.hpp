@@ -21,6 +21,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
@@ -77,16 +78,44 @@ inline double leaf_height(double min_angle_deg) noexcept {
   return kLeafMargin * 0.5 / std::tan(min_angle_deg * (std::numbers::pi / 180.0));
 }
 
+/// std::ilogb(x) without the libm call, for finite non-zero x (subnormals included); std::ilogb
+/// itself otherwise. The twin and the program call it for every edge they classify.
+inline int exponent_of(double x) noexcept {
+  const std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
+  const int field = static_cast<int>((bits >> 52) & 0x7ff);
+  const std::uint64_t mantissa = bits & ((std::uint64_t{1} << 52) - 1);
+  if (field == 0x7ff || (field == 0 && mantissa == 0)) return std::ilogb(x);  // inf, NaN, ±0
+  if (field == 0) return -1011 - std::countl_zero(mantissa);                  // subnormal
+  return field - 1023;
+}
+
+/// 2^e, exactly, for e in [-1074, 1023] (subnormal below -1022); 0 below and +inf above, as
+/// std::ldexp(1.0, e) saturates.
+inline double pow2(int e) noexcept {
+  if (e > 1023) return std::numeric_limits<double>::infinity();
+  if (e < -1074) return 0.0;
+  if (e >= -1022) return std::bit_cast<double>(static_cast<std::uint64_t>(e + 1023) << 52);
+  return std::bit_cast<double>(std::uint64_t{1} << (e + 1074));
+}
+
+/// std::ldexp(x, -exponent_of(m)) for |x| ≤ m, m finite and non-zero: x in the frame where m
+/// lies in [1, 2). Scaling up is exact, and scaling down rounds once, as ldexp does; only a
+/// subnormal m needs two factors (both scale up, so both are exact).
+inline double scale_down_by(double x, int e) noexcept {
+  if (e >= -1023) return x * pow2(-e);
+  return (x * pow2(1023)) * pow2(-e - 1023);
+}
+
 /// The size class of an edge of squared length `squared`: ⌊log2 |pq|⌋.
-inline int size_class(double squared) noexcept { return std::ilogb(squared) >> 1; }
+inline int size_class(double squared) noexcept { return exponent_of(squared) >> 1; }
 /// ⌊log2 |ab|⌋ as size_class(|ab|²) gives it, computed in a frame scaled by a power of two
 /// (exact), so that |ab|² neither overflows in a huge box nor underflows to 0 in a tiny one
 /// (fuzz_hpu_mesh found the int overflow that followed). a ≠ b.
 inline int edge_class(const Point<2>& a, const Point<2>& b) noexcept {
   const double dx = b[0] - a[0], dy = b[1] - a[1];
-  const int e = std::ilogb(std::max(std::abs(dx), std::abs(dy)));
-  const double sx = std::ldexp(dx, -e), sy = std::ldexp(dy, -e);
-  return e + (std::ilogb(sx * sx + sy * sy) >> 1);
+  const int e = exponent_of(std::max(std::abs(dx), std::abs(dy)));
+  const double sx = scale_down_by(dx, e), sy = scale_down_by(dy, e);
+  return e + (exponent_of(sx * sx + sy * sy) >> 1);
 }
 
 /// The Morton code of p on the box's 2^32 grid (clamped): the initial queue order.
@@ -219,14 +248,14 @@ inline bool circumradius_above(const Point<2>& a, const Point<2>& b, const Point
   double bx = (*Q)[0] - (*P)[0], by = (*Q)[1] - (*P)[1], cx = (*R)[0] - (*P)[0], cy = (*R)[1] - (*P)[1];
   const double m = std::max({std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)});
   if (!(m > 0)) return true;
-  const int e = std::ilogb(m);
-  bx = std::ldexp(bx, -e), by = std::ldexp(by, -e), cx = std::ldexp(cx, -e), cy = std::ldexp(cy, -e);
+  const int e = exponent_of(m);
+  bx = scale_down_by(bx, e), by = scale_down_by(by, e), cx = scale_down_by(cx, e), cy = scale_down_by(cy, e);
   const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
   const double d = 2.0 * (bx * cy - by * cx);
   const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
-  // R² > 4^(j+1)  ⇔  (R·2^-e)² > 2^(2(j+1) − 2e); the exponent is clamped (ldexp saturates).
+  // R² > 4^(j+1)  ⇔  (R·2^-e)² > 2^(2(j+1) − 2e); the exponent is clamped (pow2 saturates).
   const long k = std::clamp(2L * (static_cast<long>(j) + 1 - e), -4000L, 4000L);
-  return ux * ux + uy * uy > std::ldexp(1.0, static_cast<int>(k));
+  return ux * ux + uy * uy > pow2(static_cast<int>(k));
 }
 
 /// p→q is ccw-loose: its ccw-leaf (height `leaf`) holds no vertex. t is the third corner of
@@ -251,8 +280,8 @@ struct OffCenter {
 /// products neither overflow nor underflow in any accepted box.
 inline OffCenter off_center(const Point<2>& p, const Point<2>& q, const Point<2>& t, double apex) noexcept {
   double bx = q[0] - p[0], by = q[1] - p[1], cx = t[0] - p[0], cy = t[1] - p[1];
-  const int e = std::ilogb(std::max({std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)}));
-  bx = std::ldexp(bx, -e), by = std::ldexp(by, -e), cx = std::ldexp(cx, -e), cy = std::ldexp(cy, -e);
+  const int e = exponent_of(std::max({std::abs(bx), std::abs(by), std::abs(cx), std::abs(cy)}));
+  bx = scale_down_by(bx, e), by = scale_down_by(by, e), cx = scale_down_by(cx, e), cy = scale_down_by(cy, e);
   const double mx = 0.5 * bx, my = 0.5 * by;
   const double ax = mx - apex * by, ay = my + apex * bx;
   const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
@@ -262,7 +291,8 @@ inline OffCenter off_center(const Point<2>& p, const Point<2>& q, const Point<2>
   const double da = apex * apex * b2;
   const bool circumcentre = du <= da;
   const double rx = circumcentre ? ux : ax, ry = circumcentre ? uy : ay;
-  return OffCenter{Point<2>{p[0] + std::ldexp(rx, e), p[1] + std::ldexp(ry, e)}, circumcentre};
+  // rx · 2^e: one multiply by an exact power of two (e ≥ -1074), rounded once as ldexp is.
+  return OffCenter{Point<2>{p[0] + rx * pow2(e), p[1] + ry * pow2(e)}, circumcentre};
 }
 
 /// The box side the segment from pq's midpoint m to r (outside the box) crosses first
