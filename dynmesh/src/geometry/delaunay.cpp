@@ -214,7 +214,6 @@ Delaunay::Vid Delaunay::insert(const Point<2>& x, std::span<const Tid> cav, std:
   }
   for (Tid t : cav) {
     tris_[t].alive = false;
-    ++tris_[t].gen;
     free_.push_back(t);
     --live_;
   }

@@ -45,13 +45,14 @@ class Delaunay {
   using Tid = std::uint32_t;
   static constexpr std::uint32_t kNone = 0xffff'ffffu;
 
-  struct Tri {
+  // 32 bytes, aligned: a star or a walk loads one cache line per triangle, never two.
+  struct alignas(32) Tri {
     std::array<Vid, 3> v;  // counter-clockwise
     std::array<Tid, 3> n;  // n[i]: the triangle across the edge opposite v[i] (kNone: a box side)
-    std::uint32_t gen = 0; // bumped when the slot dies, so stale references can be told apart
-    bool alive = false;
     mutable std::uint32_t mark = 0;  // == the epoch of the cavity that holds it
+    bool alive = false;
   };
+  static_assert(sizeof(Tri) == 32);
 
   /// Where a walk towards x ended.
   struct Walk {

@@ -71,12 +71,21 @@ class Refiner {
     // in (Morton, xy) order, then the rest in insertion_less order (hpu_geometry.hpp).
     std::vector<Point<2>> pts(dt_.num_vertices());
     for (Vid v = 0; v < pts.size(); ++v) pts[v] = dt_.point(v);
-    for (const Vid v : detail::first_entry_order(box_, pts)) {
-      dt_.star(v, star_);
-      int c = std::numeric_limits<int>::max();
-      for (const Vid q : star_) c = std::min(c, edge_class(v, q));
-      queues_[c].push_back({v, true});
+    // Each vertex's shortest edge class, from one pass over the triangles in slot order:
+    // every edge once, from the triangle of lower slot (a star walk per vertex loaded the
+    // same triangles in random order).
+    std::vector<int> first(pts.size(), std::numeric_limits<int>::max());
+    for (Tid t = 0; t < dt_.num_slots(); ++t) {
+      const auto& T = dt_.tri(t);
+      if (!T.alive) continue;
+      for (int k = 0; k < 3; ++k) {
+        if (T.n[k] != kNone && T.n[k] < t) continue;
+        const Vid a = T.v[k == 2 ? 0 : k + 1], b = T.v[k == 0 ? 2 : k - 1];
+        const int c = edge_class(a, b);
+        first[a] = std::min(first[a], c), first[b] = std::min(first[b], c);
+      }
     }
+    for (const Vid v : detail::first_entry_order(box_, pts)) queues_[first[v]].push_back({v, true});
     detail::run_rounds(queues_, batch_, pairs_, stats_.rounds,
                        [&](const Entry& e, int j) { collect(e.v, j, e.birth); },
                        [&](Vid p, Vid q, int j) { process(p, q, j); });
