@@ -134,6 +134,9 @@ class Refiner {
   void collect(Vid v, int j, bool birth) {
     ++stats_.entries;
     dt_.star(v, star_);
+    // The neighbours' coordinates are the collect's cache misses: ask for all of them at
+    // once, so that they overlap instead of one per edge.
+    for (const Vid q : star_) __builtin_prefetch(&dt_.point(q));
     const bool cycle = !on_boundary(v);
     const std::size_t d = star_.size();
     bool go_on = false;
@@ -141,7 +144,7 @@ class Refiner {
     for (std::size_t i = 0; i < d; ++i) {
       const Vid q = star_[i];
       const int c = edge_class(v, q);
-      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(v, q, star_[(i + 1) % d], j + detail::kGoOnReach);
+      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(v, q, star_[i + 1 < d ? i + 1 : 0], j + detail::kGoOnReach);
       const Vid left = i + 1 < d ? star_[i + 1] : cycle ? star_[0] : kNone;
       const Vid right = i > 0 ? star_[i - 1] : cycle ? star_[d - 1] : kNone;
       // A longer edge matters only while loose: looseness never returns, and a later edge
