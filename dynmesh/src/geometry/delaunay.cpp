@@ -69,8 +69,9 @@ Delaunay::Tid Delaunay::new_tri(Vid a, Vid b, Vid c) {
   return t;
 }
 
-void Delaunay::star(Vid v, std::vector<Vid>& out) const {
+void Delaunay::star(Vid v, std::vector<Vid>& out, std::vector<Tid>* left) const {
   out.clear();
+  if (left) left->clear();
   const Tid t0 = vtri_[v];
   const auto at = [&](Tid t) {
     const Tri& T = tris_[t];
@@ -89,9 +90,13 @@ void Delaunay::star(Vid v, std::vector<Vid>& out) const {
   out.push_back(tris_[t].v[next(at(t))]);
   for (;;) {  // counter-clockwise: across the edge v→b of (v, a, b)
     const int i = at(t);
+    if (left) left->push_back(t);  // (v, a, b) is on the left of v→a, a = out.back()
     out.push_back(tris_[t].v[prev(i)]);
     t = tris_[t].n[next(i)];
-    if (t == kNone) return;
+    if (t == kNone) {
+      if (left) left->push_back(kNone);  // v→b runs along a box side
+      return;
+    }
     if (t == first) {
       out.pop_back();  // an interior vertex: the last neighbour is the first
       return;

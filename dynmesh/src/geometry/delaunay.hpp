@@ -79,11 +79,24 @@ class Delaunay {
 
   /// The neighbours of v in counter-clockwise order (a cycle for an interior vertex; from
   /// one box side to the other for a vertex on the boundary).
-  void star(Vid v, std::vector<Vid>& out) const;
+  void star(Vid v, std::vector<Vid>& out) const { star(v, out, nullptr); }
+  /// star(), and in `left` the triangle on the left of v→out[i] for each i (kNone: the
+  /// outside of the box, for a boundary vertex's last neighbour).
+  void star(Vid v, std::vector<Vid>& out, std::vector<Tid>& left) const { star(v, out, &left); }
   /// The live triangle with the directed edge p→q (q follows p counter-clockwise in it),
   /// and the index of its third corner; nullopt when p→q is not an edge or the outside of
   /// the box lies on its left.
   std::optional<std::pair<Tid, int>> left_of(Vid p, Vid q) const noexcept;
+  /// left_of(p, q), answered by `hint` when that is a live triangle holding p→q (the one
+  /// triangle that can: so any hint, stale or not, gives left_of's answer).
+  std::optional<std::pair<Tid, int>> left_of(Vid p, Vid q, Tid hint) const noexcept {
+    if (hint < tris_.size() && tris_[hint].alive) {
+      const Tri& T = tris_[hint];
+      for (int i = 0; i < 3; ++i)
+        if (T.v[i] == p && T.v[i == 2 ? 0 : i + 1] == q) return std::pair{hint, i == 0 ? 2 : i - 1};
+    }
+    return left_of(p, q);
+  }
 
   /// Walks from `start` (live) towards x: the triangle holding x in its closure, or the box
   /// side crossed when x is outside the box. Deterministic for a given triangulation: at each
@@ -123,6 +136,7 @@ class Delaunay {
 
  private:
   Tid new_tri(Vid a, Vid b, Vid c);
+  void star(Vid v, std::vector<Vid>& out, std::vector<Tid>* left) const;
 
   Box<2> box_;
   double hi_[2];  // fl(o + L) per axis: the box's far sides

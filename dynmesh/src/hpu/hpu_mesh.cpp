@@ -133,7 +133,10 @@ class Refiner {
   /// cells.
   void collect(Vid v, int j, bool birth) {
     ++stats_.entries;
-    dt_.star(v, star_);
+    // The first collect of a round (run_rounds has just cleared the pairs) starts the
+    // round's hints.
+    if (pairs_.empty()) hints_.clear(), hint_at_ = 0;
+    dt_.star(v, star_, star_left_);
     // The neighbours' coordinates are the collect's cache misses: ask for all of them at
     // once, so that they overlap instead of one per edge.
     for (const Vid q : star_) __builtin_prefetch(&dt_.point(q));
@@ -151,24 +154,35 @@ class Refiner {
       // of v has a newer end whose own entries collect it.
       if (c > j && !go_on) go_on = loose(v, q, left, right) || loose(q, v, right, left);
       if (birth ? c > j : c != j) continue;
-      if (loose(v, q, left, right)) local_.push_back({v, q});
-      if (loose(q, v, right, left)) local_.push_back({q, v});
+      // With each pair, the triangle on its left as the walk saw it: process() tries it
+      // before walking around p (left_of's hint, checked there).
+      if (loose(v, q, left, right)) local_.push_back({{v, q}, star_left_[i]});
+      if (loose(q, v, right, left)) local_.push_back({{q, v}, i > 0 ? star_left_[i - 1] : cycle ? star_left_[d - 1] : kNone});
     }
-    std::sort(local_.begin(), local_.end(), [&](const auto& a, const auto& b) {
+    std::sort(local_.begin(), local_.end(), [&](const LocalPair& x, const LocalPair& y) {
+      const auto &a = x.pq, &b = y.pq;
       if (dt_.point(a[0]) != dt_.point(b[0])) return xy_less(dt_.point(a[0]), dt_.point(b[0]));
       return xy_less(dt_.point(a[1]), dt_.point(b[1]));
     });
     // A pair collected twice (from both ends) is processed twice; the second time it is no
     // longer loose, since looseness and edges, once lost, never come back as vertices are
     // added. So no de-duplication is needed, and the result is that of the first.
-    pairs_.insert(pairs_.end(), local_.begin(), local_.end());
+    for (const LocalPair& l : local_) {
+      pairs_.push_back(l.pq);
+      hints_.push_back(l.left);
+    }
     if (go_on) queues_[j + 1].push_back({v, false});
   }
 
   /// Figure 5, lines 10-14, for the ccw side of p→q.
   void process(Vid p, Vid q, int j) {
+    // The pairs are processed in the order collected, so this one's hint is the next.
+    Tid hint = kNone;
+    if (hint_at_ < hints_.size() && pairs_[hint_at_] == std::array<Vid, 2>{p, q}) hint = hints_[hint_at_];
+    ++hint_at_;
     for (;;) {
-      const auto e = dt_.left_of(p, q);
+      const auto e = dt_.left_of(p, q, hint);
+      hint = kNone;  // after a split, the triangles have changed
       if (!e) return;
       const auto [t, k] = *e;
       const auto& T = dt_.tri(t);
@@ -249,7 +263,15 @@ class Refiner {
   detail::BoxSides<Vid> sides_;
   std::vector<Entry> batch_;
   std::vector<Vid> star_;
-  std::vector<std::array<Vid, 2>> pairs_, local_;
+  std::vector<Tid> star_left_;  // star_left_[i]: the triangle on the left of v→star_[i]
+  struct LocalPair {
+    std::array<Vid, 2> pq;
+    Tid left;  // the triangle on the left of p→q when collected (a hint)
+  };
+  std::vector<LocalPair> local_;
+  std::vector<std::array<Vid, 2>> pairs_;
+  std::vector<Tid> hints_;   // hints_[i]: pairs_[i]'s LocalPair::left
+  std::size_t hint_at_ = 0;  // the next pair process() sees
   std::vector<Tid> created_, cavity_;
   std::vector<std::array<Vid, 2>> sides_found_, encroached_;
 };
