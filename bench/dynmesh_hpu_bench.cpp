@@ -121,12 +121,12 @@ int main(int argc, char** argv) {
       const double tri_vertices = bench::kHaveTriangle ? double(tri_size.vertices) : peer.triangle_vertices;
       const double vt = double(mesh.num_vertices()) / tri_vertices;
       const double tri_s = bench::median(tri_times);
-      char tri_cols[96] = "";
+      char tri_cols[96] = ",,,";  // CSV's empty fields without Triangle
       if (bench::kHaveTriangle)
         std::snprintf(tri_cols, sizeof tri_cols, csv ? ",%.4f,%.3f,%zu" : " %9.4f %8.3f %9zu", tri_s,
                       bench::median(times) / tri_s, tri_size.vertices);
-      else
-        std::snprintf(tri_cols, sizeof tri_cols, csv ? ",,," : " %9s %8s %9s", "-", "-", "-");
+      else if (!csv)
+        std::snprintf(tri_cols, sizeof tri_cols, " %9s %8s %9s", "-", "-", "-");
       const double vc = double(mesh.num_vertices()) / peer.cgal_vertices;
       const double per_vertex = double(stats.entries) / double(mesh.num_vertices());  // queue entries
       if (csv)

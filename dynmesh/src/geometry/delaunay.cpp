@@ -122,6 +122,15 @@ std::optional<std::pair<Delaunay::Tid, int>> Delaunay::left_of(Vid p, Vid q) con
   return std::nullopt;
 }
 
+std::optional<std::pair<Delaunay::Tid, int>> Delaunay::left_of(Vid p, Vid q, Tid hint) const noexcept {
+  if (hint < tris_.size() && tris_[hint].alive) {
+    const Tri& T = tris_[hint];
+    for (int i = 0; i < 3; ++i)
+      if (T.v[i] == p && T.v[next(i)] == q) return std::pair{hint, prev(i)};
+  }
+  return left_of(p, q);
+}
+
 Delaunay::Tid Delaunay::any_live() const noexcept {
   for (Tid t = 0; t < tris_.size(); ++t)
     if (tris_[t].alive) return t;

@@ -89,14 +89,7 @@ class Delaunay {
   std::optional<std::pair<Tid, int>> left_of(Vid p, Vid q) const noexcept;
   /// left_of(p, q), answered by `hint` when that is a live triangle holding p→q (the one
   /// triangle that can: so any hint, stale or not, gives left_of's answer).
-  std::optional<std::pair<Tid, int>> left_of(Vid p, Vid q, Tid hint) const noexcept {
-    if (hint < tris_.size() && tris_[hint].alive) {
-      const Tri& T = tris_[hint];
-      for (int i = 0; i < 3; ++i)
-        if (T.v[i] == p && T.v[i == 2 ? 0 : i + 1] == q) return std::pair{hint, i == 0 ? 2 : i - 1};
-    }
-    return left_of(p, q);
-  }
+  std::optional<std::pair<Tid, int>> left_of(Vid p, Vid q, Tid hint) const noexcept;
 
   /// Walks from `start` (live) towards x: the triangle holding x in its closure, or the box
   /// side crossed when x is outside the box. Deterministic for a given triangulation: at each

@@ -135,7 +135,10 @@ class Refiner {
     ++stats_.entries;
     // The first collect of a round (run_rounds has just cleared the pairs) starts the
     // round's hints.
-    if (pairs_.empty()) hints_.clear(), hint_at_ = 0;
+    if (pairs_.empty()) {
+      hints_.clear();
+      hint_at_ = 0;
+    }
     dt_.star(v, star_, star_left_);
     // The neighbours' coordinates are the collect's cache misses: ask for all of them at
     // once, so that they overlap instead of one per edge.
