@@ -7,11 +7,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <optional>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -143,6 +145,44 @@ TEST(HpuDelaunay, StarsAndLeftTrianglesMatchTheTriangles) {
     }
     EXPECT_FALSE(dt.left_of(v, v));
   }
+}
+
+/// stars() walks several stars in turn; each must be star()'s, neighbours and left
+/// triangles, for interior, side and corner vertices, in groups of every size.
+TEST(HpuDelaunay, StarsTogetherEqualStarsOneByOne) {
+  const Box<2> box{{0, 0}, 6};
+  std::vector<Point<2>> pts;
+  for (int i = 0; i <= 6; ++i)
+    for (int j = 0; j <= 6; ++j) pts.push_back({double(i), double(j)});
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(0.0, 6.0);
+  for (int i = 0; i < 300; ++i) pts.push_back({u(rng), u(rng)});
+  Delaunay dt(box);
+  std::vector<Delaunay::Tid> created;
+  for (const auto& p : pts) dt.insert(p, dt.any_live(), created);
+  constexpr std::size_t K = Delaunay::kStarsAtOnce;
+  std::vector<Delaunay::Vid> order(dt.num_vertices());
+  for (Delaunay::Vid v = 0; v < order.size(); ++v) order[v] = v;
+  std::shuffle(order.begin(), order.end(), rng);  // boundary and interior vertices mixed in each group
+  std::array<std::vector<Delaunay::Vid>, K> out;
+  std::array<std::vector<Delaunay::Tid>, K> left;
+  std::vector<Delaunay::Vid> star;
+  std::vector<Delaunay::Tid> star_left;
+  std::size_t checked = 0;
+  for (std::size_t size = 1; size <= K; ++size)
+    for (std::size_t at = 0; at < order.size(); at += size) {
+      const std::span<const Delaunay::Vid> group(order.data() + at, std::min(size, order.size() - at));
+      dt.stars(group, out, left);
+      for (std::size_t k = 0; k < group.size(); ++k) {
+        dt.star(group[k], star, star_left);
+        ASSERT_EQ(out[k], star) << "vertex " << group[k] << " in a group of " << size;
+        ASSERT_EQ(left[k], star_left) << "vertex " << group[k] << " in a group of " << size;
+        ++checked;
+      }
+    }
+  EXPECT_EQ(checked, K * order.size());
+  std::vector<Delaunay::Vid> too_many(K + 1, 0);
+  EXPECT_THROW(dt.stars(too_many, out, left), InvariantError);
 }
 
 TEST(HpuDelaunay, CheckerCatchesABrokenTriangulation) {

@@ -104,6 +104,48 @@ void Delaunay::star(Vid v, std::vector<Vid>& out, std::vector<Tid>* left) const 
   }
 }
 
+void Delaunay::stars(std::span<const Vid> vs, std::span<std::vector<Vid>> out, std::span<std::vector<Tid>> left) const {
+  if (vs.size() > kStarsAtOnce || out.size() < vs.size() || left.size() < vs.size())
+    throw InvariantError("dynmesh: Delaunay::stars: too many vertices or too few outputs");
+  // Counter-clockwise from each vertex's triangle, as star() does for an interior vertex. A
+  // walk that meets a box side belongs to a boundary vertex, which star() redoes from its
+  // clockwise end: knowing that needs no load of the vertex's point.
+  struct Cursor {
+    Tid t, first;
+    std::uint32_t k;
+  };
+  std::array<Cursor, kStarsAtOnce> w;
+  std::size_t n = 0;
+  for (std::uint32_t k = 0; k < vs.size(); ++k) {
+    out[k].clear();
+    left[k].clear();
+    const Tid t = vtri_[vs[k]];
+    __builtin_prefetch(&tris_[t]);
+    w[n++] = Cursor{t, t, k};
+  }
+  while (n > 0) {
+    for (std::size_t i = 0; i < n;) {
+      Cursor& x = w[i];
+      const Vid v = vs[x.k];
+      const Tri& T = tris_[x.t];
+      const int a = T.v[0] == v ? 0 : T.v[1] == v ? 1 : 2;
+      std::vector<Vid>& o = out[x.k];
+      if (o.empty()) o.push_back(T.v[next(a)]);
+      left[x.k].push_back(x.t);
+      o.push_back(T.v[prev(a)]);
+      x.t = T.n[next(a)];
+      if (x.t == kNone || x.t == x.first) {
+        if (x.t == kNone) star(v, o, &left[x.k]);  // a boundary vertex
+        else o.pop_back();                         // the last neighbour is the first
+        x = w[--n];
+        continue;
+      }
+      __builtin_prefetch(&tris_[x.t]);
+      ++i;
+    }
+  }
+}
+
 std::optional<std::pair<Delaunay::Tid, int>> Delaunay::left_of(Vid p, Vid q) const noexcept {
   const Tid t0 = vtri_[p];
   // Counter-clockwise around p, then clockwise from t0 when a box side stopped the first turn.

@@ -83,6 +83,11 @@ class Delaunay {
   /// star(), and in `left` the triangle on the left of v→out[i] for each i (kNone: the
   /// outside of the box, for a boundary vertex's last neighbour).
   void star(Vid v, std::vector<Vid>& out, std::vector<Tid>& left) const { star(v, out, &left); }
+  /// The stars of several vertices at once (at most kStarsAtOnce): star(vs[i], out[i],
+  /// left[i]) for each i. A star walk is a chain of dependent loads, one cache miss per
+  /// triangle; these walks advance in turn, so that their misses overlap.
+  static constexpr std::size_t kStarsAtOnce = 16;
+  void stars(std::span<const Vid> vs, std::span<std::vector<Vid>> out, std::span<std::vector<Tid>> left) const;
   /// The live triangle with the directed edge p→q (q follows p counter-clockwise in it),
   /// and the index of its third corner; nullopt when p→q is not an edge or the outside of
   /// the box lies on its left.

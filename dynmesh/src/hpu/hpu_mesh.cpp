@@ -87,7 +87,7 @@ class Refiner {
     }
     for (const Vid v : detail::first_entry_order(box_, pts)) queues_[first[v]].push_back({v, true});
     detail::run_rounds(queues_, batch_, pairs_, stats_.rounds,
-                       [&](const Entry& e, int j) { collect(e.v, j, e.birth); },
+                       [&](const Entry& e, int j) { collect(e, j); },
                        [&](Vid p, Vid q, int j) { process(p, q, j); });
   }
 
@@ -131,7 +131,9 @@ class Refiner {
   /// reads only the vertices near v (without the large triangle, the longer edges'
   /// neighbours are in the star), so that the self-adjusting version decides it from nearby
   /// cells.
-  void collect(Vid v, int j, bool birth) {
+  void collect(const Entry& e, int j) {
+    const Vid v = e.v;
+    const bool birth = e.birth;
     ++stats_.entries;
     // The first collect of a round (run_rounds has just cleared the pairs) starts the
     // round's hints.
@@ -139,28 +141,40 @@ class Refiner {
       hints_.clear();
       hint_at_ = 0;
     }
-    dt_.star(v, star_, star_left_);
-    // The neighbours' coordinates are the collect's cache misses: ask for all of them at
-    // once, so that they overlap instead of one per edge.
-    for (const Vid q : star_) __builtin_prefetch(&dt_.point(q));
+    // A round's collects only read the triangulation (its pairs are processed after them),
+    // so the stars of the next kStarsAtOnce entries are walked together, their cache misses
+    // overlapping, when the round reaches the first of them.
+    const std::size_t at = static_cast<std::size_t>(&e - batch_.data());  // e is batch_[at]
+    if (at % kGroup == 0) {
+      group_.clear();
+      for (std::size_t i = at; i < std::min(at + kGroup, batch_.size()); ++i) group_.push_back(batch_[i].v);
+      dt_.stars(group_, stars_, lefts_);
+      // The neighbours' coordinates are the collects' next misses: ask for them all at once.
+      for (std::size_t k = 0; k < group_.size(); ++k) {
+        __builtin_prefetch(&dt_.point(group_[k]));
+        for (const Vid q : stars_[k]) __builtin_prefetch(&dt_.point(q));
+      }
+    }
+    const std::vector<Vid>& star = stars_[at % kGroup];
+    const std::vector<Tid>& starleft = lefts_[at % kGroup];
     const bool cycle = !on_boundary(v);
-    const std::size_t d = star_.size();
+    const std::size_t d = star.size();
     bool go_on = false;
     local_.clear();
     for (std::size_t i = 0; i < d; ++i) {
-      const Vid q = star_[i];
+      const Vid q = star[i];
       const int c = edge_class(v, q);
-      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(v, q, star_[i + 1 < d ? i + 1 : 0], j + detail::kGoOnReach);
-      const Vid left = i + 1 < d ? star_[i + 1] : cycle ? star_[0] : kNone;
-      const Vid right = i > 0 ? star_[i - 1] : cycle ? star_[d - 1] : kNone;
+      if (i + 1 < d || cycle) go_on = go_on || circumradius_above(v, q, star[i + 1 < d ? i + 1 : 0], j + detail::kGoOnReach);
+      const Vid left = i + 1 < d ? star[i + 1] : cycle ? star[0] : kNone;
+      const Vid right = i > 0 ? star[i - 1] : cycle ? star[d - 1] : kNone;
       // A longer edge matters only while loose: looseness never returns, and a later edge
       // of v has a newer end whose own entries collect it.
       if (c > j && !go_on) go_on = loose(v, q, left, right) || loose(q, v, right, left);
       if (birth ? c > j : c != j) continue;
       // With each pair, the triangle on its left as the walk saw it: process() tries it
       // before walking around p (left_of's hint, checked there).
-      if (loose(v, q, left, right)) local_.push_back({{v, q}, star_left_[i]});
-      if (loose(q, v, right, left)) local_.push_back({{q, v}, i > 0 ? star_left_[i - 1] : cycle ? star_left_[d - 1] : kNone});
+      if (loose(v, q, left, right)) local_.push_back({{v, q}, starleft[i]});
+      if (loose(q, v, right, left)) local_.push_back({{q, v}, i > 0 ? starleft[i - 1] : cycle ? starleft[d - 1] : kNone});
     }
     std::sort(local_.begin(), local_.end(), [&](const LocalPair& x, const LocalPair& y) {
       const auto &a = x.pq, &b = y.pq;
@@ -265,8 +279,12 @@ class Refiner {
   std::map<int, std::vector<Entry>> queues_;
   detail::BoxSides<Vid> sides_;
   std::vector<Entry> batch_;
-  std::vector<Vid> star_;
-  std::vector<Tid> star_left_;  // star_left_[i]: the triangle on the left of v→star_[i]
+  // The stars of a group of a round's entries (collect()): stars_[k] of group_[k], and
+  // lefts_[k][i] the triangle on the left of group_[k]→stars_[k][i].
+  static constexpr std::size_t kGroup = Delaunay::kStarsAtOnce;
+  std::vector<Vid> group_;
+  std::array<std::vector<Vid>, kGroup> stars_;
+  std::array<std::vector<Tid>, kGroup> lefts_;
   struct LocalPair {
     std::array<Vid, 2> pq;
     Tid left;  // the triangle on the left of p→q when collected (a hint)
