@@ -318,10 +318,47 @@ class CellView {
     pending_.push_back(n);
   }
 
-  /// The deepest cell on k's path to the root that is not absent (a leaf or a split): a
-  /// binary search over the levels, since the path is split cells, then the leaf, then
-  /// absent ones (a cell never made is absent).
+  /// The deepest cell on k's path to the root that is not absent (a leaf or a split; the
+  /// path is split cells, then the leaf, then absent ones, and a cell never made is absent).
   CellNode* deepest_present(const CellKey& k) {
+    // From the last answer by the tree's links, when it is near k: a step's searches are
+    // mostly in one region, where the nodes are in the cache, but a lookup of a key not
+    // looked up before misses on the table however hot its node is (6-7% of an update at
+    // 10^5: bench/RESULTS.md). Else by the lookups.
+    if (finger_) {
+      const CellKey& f = finger_->key;
+      const int m = std::min(f.level, k.level);
+      const std::uint64_t dx = (f.ix >> (f.level - m)) ^ (k.ix >> (k.level - m));
+      const std::uint64_t dy = (f.iy >> (f.level - m)) ^ (k.iy >> (k.level - m));
+      const int c = m - static_cast<int>(std::bit_width(dx | dy));  // their common ancestor's level
+      if ((f.level - c) + (k.level - c) <= kNearSteps) {
+        finger_ = walk_from(finger_, c, k);
+#ifdef SAC_DEBUG_CHECKS
+        if (finger_ != probe_deepest_present(k))
+          throw InvariantError("dynmesh: CellView: the walk from the last answer and the lookups disagree");
+#endif
+        return finger_;
+      }
+    }
+    return finger_ = probe_deepest_present(k);
+  }
+  static constexpr int kNearSteps = 12;
+
+  /// deepest_present(k) from n, whose ancestor at level c (≤ k.level) is k's: up to that
+  /// ancestor, up past absent cells, then down k's path while the cells are split.
+  CellNode* walk_from(CellNode* n, int c, const CellKey& k) {
+    while (n->key.level > c) n = n->parent;
+    while (resolve(n).tag == Tag::Absent) n = n->parent;  // the root is present
+    while (n->key.level < k.level && resolve(n).tag == Tag::Split) {
+      const int s = k.level - n->key.level - 1;
+      n = n->child[((k.ix >> s) & 1) | (((k.iy >> s) & 1) << 1)];
+      if (!n) throw InvariantError("dynmesh: CellView: a split cell without its children's nodes");
+    }
+    return n;
+  }
+
+  /// deepest_present(k) by directory lookups: a binary search over the levels.
+  CellNode* probe_deepest_present(const CellKey& k) {
     int lo = 0, hi = k.level;  // the root is present
     const auto present = [&](int level) {
       const int s = k.level - level;
@@ -494,7 +531,8 @@ class CellView {
   double region_r_ = 0;
   std::vector<CellNode*> visited_;
   bool searched_from_ = false;  // the last search was a search_from()
-  int guess_level_ = 0;  // deepest_present's last answer (a hint only)
+  int guess_level_ = 0;  // deepest_present's last answer's level (a hint only)
+  CellNode* finger_ = nullptr;  // and the answer (a start only: its state is looked up again)
   std::size_t leaves_read_ = 0;
   Counts counts_;
   // The run the view was last filled for, when it failed (see reset()).
