@@ -323,8 +323,8 @@ class CellView {
   CellNode* deepest_present(const CellKey& k) {
     // From the last answer by the tree's links, when it is near k: a step's searches are
     // mostly in one region, where the nodes are in the cache, but a lookup of a key not
-    // looked up before misses on the table however hot its node is (6-7% of an update at
-    // 10^5: bench/RESULTS.md). Else by the lookups.
+    // looked up before misses on the table however hot its node is (bench/RESULTS.md, "The
+    // program's searches start from their last answer"). Else by the lookups.
     if (finger_) {
       const CellKey& f = finger_->key;
       const int m = std::min(f.level, k.level);

@@ -144,7 +144,10 @@ class Refiner {
     // A round's collects only read the triangulation (its pairs are processed after them),
     // so the stars of the next kStarsAtOnce entries are walked together, their cache misses
     // overlapping, when the round reaches the first of them.
-    const std::size_t at = static_cast<std::size_t>(&e - batch_.data());  // e is batch_[at]
+    // run_rounds hands the round's entries by reference into batch_, in order.
+    const std::size_t at = static_cast<std::size_t>(&e - batch_.data());
+    if (at >= batch_.size() || &batch_[at] != &e)
+      throw InvariantError("dynmesh: a collect of an entry not in the round");
     if (at % kGroup == 0) {
       group_.clear();
       for (std::size_t i = at; i < std::min(at + kGroup, batch_.size()); ++i) group_.push_back(batch_[i].v);
@@ -156,7 +159,7 @@ class Refiner {
       }
     }
     const std::vector<Vid>& star = stars_[at % kGroup];
-    const std::vector<Tid>& starleft = lefts_[at % kGroup];
+    const std::vector<Tid>& star_left = lefts_[at % kGroup];
     const bool cycle = !on_boundary(v);
     const std::size_t d = star.size();
     bool go_on = false;
@@ -173,8 +176,8 @@ class Refiner {
       if (birth ? c > j : c != j) continue;
       // With each pair, the triangle on its left as the walk saw it: process() tries it
       // before walking around p (left_of's hint, checked there).
-      if (loose(v, q, left, right)) local_.push_back({{v, q}, starleft[i]});
-      if (loose(q, v, right, left)) local_.push_back({{q, v}, i > 0 ? starleft[i - 1] : cycle ? starleft[d - 1] : kNone});
+      if (loose(v, q, left, right)) local_.push_back({{v, q}, star_left[i]});
+      if (loose(q, v, right, left)) local_.push_back({{q, v}, i > 0 ? star_left[i - 1] : cycle ? star_left[d - 1] : kNone});
     }
     std::sort(local_.begin(), local_.end(), [&](const LocalPair& x, const LocalPair& y) {
       const auto &a = x.pq, &b = y.pq;
