@@ -37,6 +37,21 @@ void expect_contract(const HpuMesh& m, std::span<const Point<2>> points, double 
 
 // ------------------------------------------------------------------ the triangulation
 
+/// The triangulation of the box [0, 6]² with a cocircular 7 × 7 grid (points on its sides
+/// and corners) and `random` uniform points drawn by `rng`, checked.
+Delaunay grid_and_random(std::mt19937_64& rng, int random) {
+  std::vector<Point<2>> pts;
+  for (int i = 0; i <= 6; ++i)
+    for (int j = 0; j <= 6; ++j) pts.push_back({double(i), double(j)});
+  std::uniform_real_distribution<double> u(0.0, 6.0);
+  for (int i = 0; i < random; ++i) pts.push_back({u(rng), u(rng)});
+  Delaunay dt(Box<2>{{0, 0}, 6});
+  std::vector<Delaunay::Tid> created;
+  for (const auto& p : pts) dt.insert(p, dt.any_live(), created);
+  dt.check_invariants();
+  return dt;
+}
+
 TEST(HpuDelaunay, PerturbedInCircleDecidesCocircularPointsConsistently) {
   // The four corners of a square: exactly cocircular. Of the two diagonals' triangles, the
   // perturbation must reject exactly one pair, so one diagonal is Delaunay.
@@ -108,17 +123,8 @@ TEST(HpuDelaunay, CocircularGridAndPointsOnTheSides) {
 /// star() and left_of() against the triangle list: the neighbours of each vertex, in
 /// counter-clockwise order, and the triangle on the left of each directed edge.
 TEST(HpuDelaunay, StarsAndLeftTrianglesMatchTheTriangles) {
-  const Box<2> box{{0, 0}, 6};
-  std::vector<Point<2>> pts;
-  for (int i = 0; i <= 6; ++i)  // a cocircular grid with points on the sides, and random ones
-    for (int j = 0; j <= 6; ++j) pts.push_back({double(i), double(j)});
   std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(0.0, 6.0);
-  for (int i = 0; i < 200; ++i) pts.push_back({u(rng), u(rng)});
-  Delaunay dt(box);
-  std::vector<Delaunay::Tid> created;
-  for (const auto& p : pts) dt.insert(p, dt.any_live(), created);
-  dt.check_invariants();
+  const Delaunay dt = grid_and_random(rng, 200);
   std::vector<std::vector<std::pair<Delaunay::Vid, Delaunay::Vid>>> left(dt.num_vertices());  // (q, third)
   for (Delaunay::Tid t = 0; t < dt.num_slots(); ++t) {
     const auto& T = dt.tri(t);
@@ -150,16 +156,8 @@ TEST(HpuDelaunay, StarsAndLeftTrianglesMatchTheTriangles) {
 /// stars() walks several stars in turn; each must be star()'s, neighbours and left
 /// triangles, for interior, side and corner vertices, in groups of every size.
 TEST(HpuDelaunay, StarsTogetherEqualStarsOneByOne) {
-  const Box<2> box{{0, 0}, 6};
-  std::vector<Point<2>> pts;
-  for (int i = 0; i <= 6; ++i)
-    for (int j = 0; j <= 6; ++j) pts.push_back({double(i), double(j)});
   std::mt19937_64 rng(12);
-  std::uniform_real_distribution<double> u(0.0, 6.0);
-  for (int i = 0; i < 300; ++i) pts.push_back({u(rng), u(rng)});
-  Delaunay dt(box);
-  std::vector<Delaunay::Tid> created;
-  for (const auto& p : pts) dt.insert(p, dt.any_live(), created);
+  const Delaunay dt = grid_and_random(rng, 300);
   constexpr std::size_t K = Delaunay::kStarsAtOnce;
   std::vector<Delaunay::Vid> order(dt.num_vertices());
   for (Delaunay::Vid v = 0; v < order.size(); ++v) order[v] = v;

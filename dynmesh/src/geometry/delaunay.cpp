@@ -13,6 +13,8 @@ namespace {
 
 constexpr int next(int i) noexcept { return i == 2 ? 0 : i + 1; }
 constexpr int prev(int i) noexcept { return i == 0 ? 2 : i - 1; }
+/// The index of v among T's corners (T has corner v).
+int corner(const Delaunay::Tri& T, Delaunay::Vid v) noexcept { return T.v[0] == v ? 0 : T.v[1] == v ? 1 : 2; }
 
 }  // namespace
 
@@ -73,10 +75,7 @@ void Delaunay::star(Vid v, std::vector<Vid>& out, std::vector<Tid>* left) const 
   out.clear();
   if (left) left->clear();
   const Tid t0 = vtri_[v];
-  const auto at = [&](Tid t) {
-    const Tri& T = tris_[t];
-    return T.v[0] == v ? 0 : T.v[1] == v ? 1 : 2;
-  };
+  const auto at = [&](Tid t) { return corner(tris_[t], v); };
   // Back up clockwise to a box side, if v is on one: across the edge v→a of (v, a, b).
   Tid t = t0;
   const Point<2>& p = pts_[v];
@@ -128,7 +127,7 @@ void Delaunay::stars(std::span<const Vid> vs, std::span<std::vector<Vid>> out, s
       Cursor& x = w[i];
       const Vid v = vs[x.k];
       const Tri& T = tris_[x.t];
-      const int a = T.v[0] == v ? 0 : T.v[1] == v ? 1 : 2;
+      const int a = corner(T, v);
       std::vector<Vid>& o = out[x.k];
       if (o.empty()) o.push_back(T.v[next(a)]);
       left[x.k].push_back(x.t);
@@ -153,7 +152,7 @@ std::optional<std::pair<Delaunay::Tid, int>> Delaunay::left_of(Vid p, Vid q) con
     Tid t = t0;
     for (;;) {
       const Tri& T = tris_[t];
-      const int i = T.v[0] == p ? 0 : T.v[1] == p ? 1 : 2;
+      const int i = corner(T, p);
       if (T.v[next(i)] == q) return std::pair{t, prev(i)};
       const Tid u = dir == 0 ? T.n[next(i)] : T.n[prev(i)];
       if (u == t0) return std::nullopt;  // all the way round: not a neighbour

@@ -69,7 +69,7 @@ class CellRefiner {
       step_end(CellStep::FirstClass, mix(0, pts_[v]), static_cast<std::uint64_t>(c));
       queues_[c].push_back({v, true});
     }
-    run_rounds(queues_, batch_, pairs_, out_.stats.rounds, [&](const Entry& e, int j) { collect(e.v, j, e.birth); },
+    run_rounds(queues_, batch_, pairs_, out_.stats.rounds, [&](const Entry& e, std::size_t, int j) { collect(e.v, j, e.birth); },
                [&](Vid p, Vid q, int j) { process(p, q, j); });
   }
 

@@ -367,7 +367,7 @@ class CellView {
     };
     // The last answer's level first: a step's searches are mostly in one region, so its
     // leaves' level and the one below usually settle it in two lookups.
-    if (const int g = std::min(guess_level_, k.level); g > 0) {
+    if (const int g = std::min(finger_ ? finger_->key.level : 0, k.level); g > 0) {
       if (present(g)) {
         lo = g;
         if (g < hi) {
@@ -386,7 +386,6 @@ class CellView {
       else
         hi = mid - 1;
     }
-    guess_level_ = lo;
     const int s = k.level - lo;
     return dir_->find(CellKey{lo, k.ix >> s, k.iy >> s});
   }
@@ -531,8 +530,9 @@ class CellView {
   double region_r_ = 0;
   std::vector<CellNode*> visited_;
   bool searched_from_ = false;  // the last search was a search_from()
-  int guess_level_ = 0;  // deepest_present's last answer's level (a hint only)
-  CellNode* finger_ = nullptr;  // and the answer (a start only: its state is looked up again)
+  // deepest_present's last answer: where the next starts (its walk, or its lookups at the
+  // answer's level first), a hint only, whose state is looked up again.
+  CellNode* finger_ = nullptr;
   std::size_t leaves_read_ = 0;
   Counts counts_;
   // The run the view was last filled for, when it failed (see reset()).

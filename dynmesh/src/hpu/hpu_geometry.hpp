@@ -362,8 +362,8 @@ class BoxSides {
 };
 
 /// Figure 5's loop, one for every refiner: while a queue is left, a round takes the whole
-/// queue of the smallest class, collects every entry's loose pairs (collect(entry, j)
-/// appends to `pairs`), then processes the pairs in that order (process(p, q, j)); entries
+/// queue of the smallest class, collects every entry's loose pairs (collect(entry, i, j),
+/// i its index in `batch`, appends to `pairs`), then processes the pairs in that order (process(p, q, j)); entries
 /// made meanwhile wait in their queues for later rounds.
 template <class Entry, class Vid, class Collect, class Process>
 void run_rounds(std::map<int, std::vector<Entry>>& queues, std::vector<Entry>& batch,
@@ -375,7 +375,7 @@ void run_rounds(std::map<int, std::vector<Entry>>& queues, std::vector<Entry>& b
     queues.erase(it);
     ++rounds;
     pairs.clear();
-    for (const Entry& e : batch) collect(e, j);
+    for (std::size_t i = 0; i < batch.size(); ++i) collect(batch[i], i, j);
     for (const auto& [p, q] : pairs) process(p, q, j);
     batch.clear();
   }

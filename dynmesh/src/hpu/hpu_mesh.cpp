@@ -87,7 +87,7 @@ class Refiner {
     }
     for (const Vid v : detail::first_entry_order(box_, pts)) queues_[first[v]].push_back({v, true});
     detail::run_rounds(queues_, batch_, pairs_, stats_.rounds,
-                       [&](const Entry& e, int j) { collect(e, j); },
+                       [&](const Entry& e, std::size_t at, int j) { collect(e, at, j); },
                        [&](Vid p, Vid q, int j) { process(p, q, j); });
   }
 
@@ -131,23 +131,19 @@ class Refiner {
   /// reads only the vertices near v (without the large triangle, the longer edges'
   /// neighbours are in the star), so that the self-adjusting version decides it from nearby
   /// cells.
-  void collect(const Entry& e, int j) {
+  void collect(const Entry& e, std::size_t at, int j) {
     const Vid v = e.v;
     const bool birth = e.birth;
     ++stats_.entries;
-    // The first collect of a round (run_rounds has just cleared the pairs) starts the
-    // round's hints.
-    if (pairs_.empty()) {
+    // The first collect of a round (e is batch_[at]; run_rounds has just cleared the pairs)
+    // starts the round's hints.
+    if (at == 0) {
       hints_.clear();
       hint_at_ = 0;
     }
     // A round's collects only read the triangulation (its pairs are processed after them),
     // so the stars of the next kStarsAtOnce entries are walked together, their cache misses
     // overlapping, when the round reaches the first of them.
-    // run_rounds hands the round's entries by reference into batch_, in order.
-    const std::size_t at = static_cast<std::size_t>(&e - batch_.data());
-    if (at >= batch_.size() || &batch_[at] != &e)
-      throw InvariantError("dynmesh: a collect of an entry not in the round");
     if (at % kGroup == 0) {
       group_.clear();
       for (std::size_t i = at; i < std::min(at + kGroup, batch_.size()); ++i) group_.push_back(batch_[i].v);
