@@ -3,7 +3,8 @@
 // of a leaf counts exactly when it changes the vertices inside the used box (or the kind).
 // The program's reads that rely on it are checked end to end by hpu_cells_program_test.cpp
 // (every update against the twin). Also the directory's node links and the one view that
-// may keep its marks on the nodes.
+// may keep its marks on the nodes, and the nearest search from a focus's leaf upwards
+// (search_near), which must visit what the search from the root visits, in its order.
 #include "hpu/cell_view.hpp"
 
 #include <gtest/gtest.h>
@@ -11,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -107,6 +109,64 @@ TEST(CellDirectory, OneViewAtATimeKeepsItsMarksOnTheNodes) {
   CellView w(e, dir);  // the first is gone: the marks start clean
   EXPECT_EQ(root->mark.gen, 0u);
   EXPECT_FALSE(root->mark.read);
+}
+
+// The nearest search's keep() and a record of the vertices handed over, in order.
+struct NearestRecord {
+  Point<2> p;
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<const CellVertex*> seen;
+  double reach() const { return best * (1 + 0x1p-19); }
+  bool keep(double x0, double y0, double x1, double y1) const {
+    const double dx = p[0] < x0 ? x0 - p[0] : p[0] > x1 ? p[0] - x1 : 0.0;
+    const double dy = p[1] < y0 ? y0 - p[1] : p[1] > y1 ? p[1] - y1 : 0.0;
+    return std::hypot(dx, dy) <= reach();
+  }
+  bool see(const CellVertex* w) {
+    seen.push_back(w);
+    if (w->p == p) return false;  // the focus's own vertex
+    best = std::min(best, std::hypot(w->p[0] - p[0], w->p[1] - p[1]));
+    return false;
+  }
+};
+
+TEST(CellView, TheNearestSearchFromTheLeafUpVisitsWhatTheSearchFromTheRootVisits) {
+  std::mt19937_64 rng(20261128);
+  std::printf("seed 20261128\n");
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  sac::Engine e;
+  const Box<2> box{{-2, 3}, 8};
+  CellDirectory dir(box);
+  InputCells in(dir);
+  std::deque<CellVertex> vs;
+  // Clustered and spread points, so that leaves lie at many levels, and points on the
+  // midlines of cells, where a focus's grid position and the search's side tests can part.
+  for (int i = 0; i < 3000; ++i) {
+    const double s = i % 3 == 0 ? 1.0 : i % 3 == 1 ? 1.0 / 64 : 1.0 / 4096;
+    const Point<2> x{box.origin[0] + box.side * (s * u(rng) + (1 - s) * 0.3),
+                     box.origin[1] + box.side * (s * u(rng) + (1 - s) * 0.6)};
+    in.insert(e, &vs.emplace_back(x));
+  }
+  for (int i = 1; i < 16; ++i) in.insert(e, &vs.emplace_back(Point<2>{box.origin[0] + box.side * i / 16, box.origin[1] + box.side / 2}));
+  CellView view(e, dir);
+  std::size_t focused = 0;
+  e.run([&](sac::Engine&) {  // a view peeks, which only the computation may
+  for (const CellVertex& v : vs) {
+    NearestRecord down{v.p, std::numeric_limits<double>::infinity(), {}};
+    NearestRecord up = down;
+    view.reset();
+    view.search(v.p, 0.0, dir.margin_for(v.p, 0.0), [&](double a, double b, double c, double d) { return down.keep(a, b, c, d); },
+                [&](const CellVertex* w) { return down.see(w); });
+    view.used_all();
+    view.reset();
+    view.search_near(v.p, 0.0, dir.margin_for(v.p, 0.0), [&](double a, double b, double c, double d) { return up.keep(a, b, c, d); },
+                     [&](const CellVertex* w) { return up.see(w); }, [&] { return up.reach(); });
+    view.used_all();
+    ASSERT_EQ(up.seen, down.seen) << "at (" << v.p[0] << ", " << v.p[1] << ")";
+    focused += up.seen.size() < 200;
+  }
+  });
+  EXPECT_GT(focused, vs.size() * 9 / 10) << "most searches see a few cells only";
 }
 
 }  // namespace

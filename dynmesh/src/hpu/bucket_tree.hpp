@@ -140,6 +140,13 @@ class BucketTree {
   void search_from(const Point<2>& focus, double /*R*/, double margin, Keep&& keep, F&& f) const {
     search(focus, margin, keep, f);
   }
+  /// search() for a keep() that accepts no cell farther than radius() from focus (the
+  /// cell-store interface): the same on a static tree.
+  template <class Keep, class F, class Radius>
+  void search_near(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f,
+                   Radius&& /*radius*/) const {
+    search(focus, margin, keep, f);
+  }
   /// search() for a keep() bounded by the disc (focus, radius): the same on a static tree.
   template <class Keep, class F>
   void search_within(const Point<2>& focus, double /*radius*/, double /*scale*/, double margin, Keep&& keep,

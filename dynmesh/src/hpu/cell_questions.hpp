@@ -27,6 +27,8 @@
 // search_within(focus, radius, scale, margin, keep, f) (the same, keep() bounded by that disc),
 // search_from(focus, R, margin, keep, f) (the same over the cells that cover [focus ± R], its
 // use stated afterwards as a search()'s; more search_from()s may come first),
+// search_near(focus, scale, margin, keep, f, radius) (search() for a keep() that accepts no
+// cell beyond radius(), which only shrinks: it may start at focus's leaf),
 // margin_for(c, r) and leaves_read(). After every search() the question says what its answer
 // used of the leaves it read: used_within(c, r) (the vertices within r of c) or used_all().
 // A search_within's answer uses only the vertices within its radius (plus the margins): f
@@ -206,7 +208,7 @@ class CellQuestions {
     const auto reach = [&](double d) { return d * (1 + 0x1p-19) + room; };
     double best = std::numeric_limits<double>::infinity();
     near_all_.clear();
-    store_->search(
+    store_->search_near(
         p, scale, store_->margin_for(p, 0.0),
         [&](double x0, double y0, double x1, double y1) {
           // By length(), which does not overflow: near the largest doubles every squared
@@ -221,7 +223,8 @@ class CellQuestions {
           if (l <= reach(best)) near_all_.push_back(w);
           best = std::min(best, l);
           return false;
-        });
+        },
+        [&] { return reach(best); });
     // The minimum is that of the vertices within best, and the kept ones lie within
     // reach(best): one farther changes neither.
     if (std::isfinite(best)) store_->used_within(p, reach(best));

@@ -225,6 +225,19 @@ class CellView {
     auto* self = const_cast<CellView*>(this);
     self->run_search(focus, margin, keep, f, false, 0.0);
   }
+  /// search() for a keep() that accepts no cell whose box (widened by margin) lies farther
+  /// than radius() from focus, where radius() only shrinks as the search goes (a nearest
+  /// search). It visits the same cells in the same order as search(), but from focus's leaf
+  /// upwards: the descent from the root goes to that leaf first, then visits the other
+  /// children of each cell on the way back up, so walking up from the leaf and visiting
+  /// them level by level is the same search. It stops climbing once a cell holds the disc
+  /// (focus, radius()) with room: every cell outside it is one keep() would refuse. The
+  /// cells on the path to the root are what search() would have walked for nothing.
+  template <class Keep, class F, class Radius>
+  void search_near(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f,
+                   Radius&& radius) const {
+    const_cast<CellView*>(this)->run_search_near(focus, margin, keep, f, radius);
+  }
   /// search() over the cells that cover the box [focus ± R] only (starts_for), for a
   /// keep() that accepts no cell beyond it. Unlike search_within(), the question states
   /// afterwards what its answer used, as after search(); more search_from()s may come first.
@@ -415,6 +428,53 @@ class CellView {
     for (std::size_t i = 0; i < n && !stop; ++i) search_node(starts[i], focus, margin, keep, f, stop);
   }
 
+  template <class Keep, class F, class Radius>
+  void run_search_near(const Point<2>& focus, double margin, Keep& keep, F& f, Radius& radius) {
+    const auto from_root = [&] { run_search(focus, margin, keep, f, false, 0.0); };
+    const double x1 = box_.origin[0] + box_.side, y1 = box_.origin[1] + box_.side;
+    if (!(focus[0] >= box_.origin[0] && focus[0] <= x1 && focus[1] >= box_.origin[1] && focus[1] <= y1))
+      return from_root();
+    CellNode* leaf = deepest_present(CellDirectory::cell_at(dir_->position(focus), BucketTree::kMaxLevel));
+    // search() descends by the side tests of search_node on doubles, and prunes by keep():
+    // the walk up is the same search only if those lead to this leaf (a focus on a cell's
+    // boundary may have its grid position on the other side).
+    for (CellNode* n = leaf;; n = n->parent) {
+      double bx0, by0, bx1, by1;
+      cell_box(n->key, margin, bx0, by0, bx1, by1);
+      if (!keep(bx0, by0, bx1, by1)) return from_root();
+      if (!n->parent) break;
+      if (n->parent->child[near_child(n->parent->key, focus)] != n) return from_root();
+    }
+    if (!visited_.empty()) throw InvariantError("dynmesh: CellView: a search's use was not stated");
+    searched_from_ = false;
+    region_ = false;
+    bool stop = false;
+    search_node(leaf, focus, margin, keep, f, stop);
+    for (CellNode* n = leaf; n->parent && !stop; n = n->parent) {
+      double bx0, by0, bx1, by1;
+      cell_box(n->key, 0.0, bx0, by0, bx1, by1);
+      const double inside = std::min({focus[0] - bx0, bx1 - focus[0], focus[1] - by0, by1 - focus[1]});
+      if (inside > (radius() + 2 * margin) * (1 + 0x1p-30)) break;
+      CellNode* p = n->parent;
+      const auto order = child_order(p->key, focus);
+      for (int i = 1; i < 4 && !stop; ++i) search_node(p->child[order[i]], focus, margin, keep, f, stop);
+    }
+  }
+
+  /// The children of a split cell k in the order search_node visits them: the one holding
+  /// focus's side in x and y first, then its x neighbour, its y neighbour, and the opposite
+  /// one (nearest first for four equal squares, by their centres' distance, as BucketTree).
+  std::array<unsigned, 4> child_order(const CellKey& k, const Point<2>& focus) const noexcept {
+    const double w = width_[k.level];
+    const double mx = box_.origin[0] + (static_cast<double>(k.ix) + 0.5) * w;
+    const double my = box_.origin[1] + (static_cast<double>(k.iy) + 0.5) * w;
+    const unsigned hx = focus[0] >= mx ? 1 : 0, hy = focus[1] >= my ? 1 : 0;
+    const unsigned near = hx | (hy << 1);
+    const bool x_first = std::abs(focus[0] - mx) >= std::abs(focus[1] - my);
+    return {near, near ^ (x_first ? 2u : 1u), near ^ (x_first ? 1u : 2u), near ^ 3u};
+  }
+  unsigned near_child(const CellKey& k, const Point<2>& focus) const noexcept { return child_order(k, focus)[0]; }
+
   /// x's box of used vertices grows by the box around the disc (c, R).
   static void widen(CellMark& x, const Point<2>& c, double R) noexcept {
     x.bx0 = std::min(x.bx0, c[0] - R), x.by0 = std::min(x.by0, c[1] - R);
@@ -482,18 +542,8 @@ class CellView {
         return;
       }
       case Tag::Split: {
-        // Children nearest to the focus first (by their centres' distance), as BucketTree.
-        // The child holding the focus's side in x and y first, then its x neighbour, its y
-        // neighbour, and the opposite one: nearest first for the four equal squares.
         const std::size_t before = leaves_read_;
-        const double w = width_[k.level];
-        const double mx = box_.origin[0] + (static_cast<double>(k.ix) + 0.5) * w;
-        const double my = box_.origin[1] + (static_cast<double>(k.iy) + 0.5) * w;
-        const unsigned hx = focus[0] >= mx ? 1 : 0, hy = focus[1] >= my ? 1 : 0;
-        const unsigned near = hx | (hy << 1);
-        const bool x_first = std::abs(focus[0] - mx) >= std::abs(focus[1] - my);
-        const unsigned order[4] = {near, near ^ (x_first ? 2u : 1u), near ^ (x_first ? 1u : 2u), near ^ 3u};
-        for (const unsigned c : order) {
+        for (const unsigned c : child_order(k, focus)) {
           if (stop) return;
           CellNode* ch = n->child[c];
           if (!ch) throw InvariantError("dynmesh: CellView: a split cell without its children's nodes");
