@@ -55,6 +55,23 @@ TEST(CellInterest, EveryVertexInsideABoxIsInsideItsParts) {
   }
 }
 
+TEST(CellInterest, APartIsTheFloorOfTheScaledOffsetClamped) {
+  // part() truncates instead of calling std::floor: the same 256ths, on the grid lines too.
+  std::mt19937_64 rng(20261128);
+  std::printf("seed 20261128\n");
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int t = 0; t < 20000; ++t) {
+    const double o = -10 + 20 * u(rng), inv = std::ldexp(256.0, static_cast<int>(rng() % 60) - 30);
+    const double on_line = o + static_cast<double>(rng() % 300) / inv - 20 / inv;
+    for (const double x : {o + (1.4 * u(rng) - 0.2) * 256 / inv, on_line, std::nextafter(on_line, 1e300),
+                           std::nextafter(on_line, -1e300), o, std::nextafter(o, -1e300)}) {
+      const double f = std::floor((x - o) * inv);
+      const auto expected = static_cast<std::uint8_t>(f <= 0 ? 0 : f >= 255 ? 255 : f);
+      ASSERT_EQ(CellFrame::part(x, o, inv), expected) << "x = " << x << ", o = " << o << ", try " << t;
+    }
+  }
+}
+
 TEST(CellInterest, ALeafChangesForAReadOnlyInsideWhatItUsed) {
   const Box<2> box{{0, 0}, 16};
   const CellKey k{2, 1, 1};  // [4, 8] × [4, 8]

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <random>
@@ -87,6 +88,36 @@ TEST(BucketTree, CheckerRejectsAVertexOutsideItsLeaf) {
   tree.check_invariants(pts);
   pts[2] = Point<2>{0.9, 0.9};
   EXPECT_THROW(tree.check_invariants(pts), InvariantError);
+}
+
+TEST(BucketTree, PositionIsTheFloorOfTheScaledOffsetClamped) {
+  // position() truncates instead of calling std::floor; the grid positions are part of the
+  // contract (every cell store and the twin's tree place a vertex by them), so they must be
+  // the floor's to the bit, on the box's sides and on every grid line too.
+  std::mt19937_64 rng(20261128);
+  std::printf("seed 20261128\n");
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int t = 0; t < 2000; ++t) {
+    const Box<2> box{{-50 + 100 * u(rng), -50 + 100 * u(rng)}, std::ldexp(0.5 + u(rng), static_cast<int>(rng() % 40) - 20)};
+    const detail::BucketTree tree(box);
+    const double scale = box.scale();
+    const auto expected = [&](double x, int a) {
+      const double f = std::floor((x - box.origin[a]) * scale);
+      return f <= 0 ? std::uint64_t{0} : f >= 0x1p52 ? (std::uint64_t{1} << 52) - 1 : static_cast<std::uint64_t>(f);
+    };
+    const std::uint64_t k = rng() % (std::uint64_t{1} << 52);
+    const double on_line = box.origin[0] + static_cast<double>(k) / scale;
+    for (const double f : {0.0, u(rng), 1.0, 1e-300, 1 - 0x1p-53}) {
+      const double x = box.origin[0] + f * box.side;
+      for (const double xx : {x, std::nextafter(x, -1e300), std::nextafter(x, 1e300), on_line, std::nextafter(on_line, 1e300),
+                              std::nextafter(on_line, -1e300)}) {
+        const Point<2> p{xx, box.origin[1] + u(rng) * box.side};
+        const auto q = tree.position(p);
+        ASSERT_EQ(q[0], expected(p[0], 0)) << "x = " << p[0] << ", try " << t;
+        ASSERT_EQ(q[1], expected(p[1], 1)) << "y = " << p[1] << ", try " << t;
+      }
+    }
+  }
 }
 
 TEST(BucketTree, PrunedSearchesFindWhatAScanFinds) {

@@ -78,8 +78,9 @@ struct CellFrame {
     inv = 256.0 / w;
   }
   static std::uint8_t part(double x, double o, double inv) noexcept {
-    const double t = std::floor((x - o) * inv);
-    return static_cast<std::uint8_t>(t <= 0 ? 0 : t >= 255 ? 255 : t);  // NaN-free: x, o finite
+    // ⌊t⌋ clamped to [0, 255], by truncation, which is the floor for t > 0 (as position()).
+    const double t = (x - o) * inv;
+    return static_cast<std::uint8_t>(!(t > 0) ? 0 : t >= 255 ? 255 : static_cast<int>(t));  // x, o finite
   }
   /// The 256ths of the box [x0, x1] × [y0, y1] (any box: parts outside the cell clamp).
   CellInterest interest(double x0, double y0, double x1, double y1) const noexcept {
