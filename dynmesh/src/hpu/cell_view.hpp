@@ -458,7 +458,11 @@ class CellView {
       if (inside > (radius() + 2 * margin) * (1 + 0x1p-30)) break;
       CellNode* p = n->parent;
       const auto order = child_order(p->key, focus);
-      for (int i = 1; i < 4 && !stop; ++i) search_node(p->child[order[i]], focus, margin, keep, f, stop);
+      for (int i = 1; i < 4 && !stop; ++i) {
+        CellNode* ch = p->child[order[i]];
+        if (!ch) throw InvariantError("dynmesh: CellView: a split cell without its children's nodes");
+        search_node(ch, focus, margin, keep, f, stop);
+      }
     }
   }
 
