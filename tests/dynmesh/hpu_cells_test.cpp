@@ -92,7 +92,7 @@ TEST(BucketTree, CheckerRejectsAVertexOutsideItsLeaf) {
 
 TEST(BucketTree, PositionIsTheFloorOfTheScaledOffsetClamped) {
   // position() truncates instead of calling std::floor; the grid positions are part of the
-  // contract (every cell store and the twin's tree place a vertex by them), so they must be
+  // contract (the cell store and the static cell refiner place a vertex by them), so they must be
   // the floor's to the bit, on the box's sides and on every grid line too.
   std::mt19937_64 rng(20261128);
   std::printf("seed 20261128\n");
