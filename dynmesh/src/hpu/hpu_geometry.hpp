@@ -363,8 +363,8 @@ class BoxSides {
 
 /// Figure 5's loop, one for every refiner: while a queue is left, a round takes the whole
 /// queue of the smallest class, collects every entry's loose pairs (collect(entry, i, j),
-/// i its index in `batch`, appends to `pairs`), then processes the pairs in that order (process(p, q, j)); entries
-/// made meanwhile wait in their queues for later rounds.
+/// i its index in `batch`, appends to `pairs`), then processes the pairs in that order
+/// (process(p, q, j)); entries made meanwhile wait in their queues for later rounds.
 template <class Entry, class Vid, class Collect, class Process>
 void run_rounds(std::map<int, std::vector<Entry>>& queues, std::vector<Entry>& batch,
                 std::vector<std::array<Vid, 2>>& pairs, std::size_t& rounds, Collect&& collect, Process&& process) {
