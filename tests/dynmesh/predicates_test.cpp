@@ -611,4 +611,35 @@ TEST(Predicates, PencilAgreesWithTheCircleDefinition) {
   EXPECT_EQ(dynmesh::pencil(p, q, 0.5, Point<2>{1, -1}), 1);
 }
 
+/// The pencil's filter has no range test: products that underflow or overflow, and heights
+/// from 0 to beyond 2^60, must still give the definition's sign.
+TEST(Predicates, PencilMixedMagnitudesAgreeWithTheCircleDefinition) {
+  constexpr std::array<double, 13> kPool{0.0, 5e-324, 3e-320, 2.2250738585072014e-308, 1e-300, 1e-150, 0.1,
+                                         1.0, 3.0, 1e15, 1e150, 1e300, std::numeric_limits<double>::max()};
+  constexpr std::array<double, 8> kHeights{0.0, 5e-324, 1e-200, 0.5, 1.3, 0x1p60, 0x1p61, 1e200};
+  constexpr std::uint64_t kSeed = 20261128;
+  SCOPED_TRACE(seed_trace(kSeed));
+  std::mt19937_64 rng(kSeed);
+  auto coord = [&] { return ((rng() & 1) ? -1.0 : 1.0) * kPool[rng() % kPool.size()]; };
+  auto point = [&] { return Point<2>{coord(), coord()}; };
+  std::size_t zeros = 0, decided = 0;
+  for (int i = 0; i < 20000; ++i) {
+    // Points near one another at a random scale as well, so that the filter decides some
+    // (offsets below the pool's last, DBL_MAX, so that every coordinate stays finite).
+    const double s = kPool[rng() % (kPool.size() - 1)];
+    const Point<2> p = point(), q = i % 2 ? point() : Point<2>{p[0] + s, p[1] - 0.5 * s};
+    const Point<2> x = i % 3 ? point() : Point<2>{p[0] + 0.25 * s, p[1] + s};
+    const double h = ((rng() & 1) ? -1.0 : 1.0) * kHeights[rng() % kHeights.size()];
+    if (!(std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(x[0]) && std::isfinite(x[1])))
+      continue;  // an offset from a coordinate near DBL_MAX overflowed
+    const int want = pencil_reference(p, q, h, x);
+    zeros += want == 0;
+    decided += want != 0;
+    ASSERT_EQ(dynmesh::pencil(p, q, h, x), want) << dynmesh::to_string<2>(p) << dynmesh::to_string<2>(q) << " h=" << h
+                                                  << " x=" << dynmesh::to_string<2>(x);
+  }
+  EXPECT_GT(zeros, 0u);
+  EXPECT_GT(decided, 0u);
+}
+
 }  // namespace

@@ -38,11 +38,15 @@ inline constexpr double kIncircleBound = (10.0 + 96.0 * kEpsilon) * kEpsilon;
 /// For pencil(): a term carries at most 5ε of relative error (a rounded difference in each
 /// factor, the product, the h product, a sum) and the final difference ε more; 12ε leaves room.
 inline constexpr double kPencilBound = 12.0 * kEpsilon;
-/// The bounds assume that no product underflows or overflows. Differences of the
-/// coordinates that are 0 or within [2^−lo, 2^hi] guarantee it: for orient2d (degree 2)
-/// products of at least 2^−1000; for incircle (degree 4) lifts and products of at least
-/// 2^−480, whose differences are multiples of 2^−532, so every term is at least 2^−1012.
-/// Anything else (a mix of magnitudes, huge or tiny boxes) goes to the exact stage.
+/// Added to the orient2d and pencil bounds: far above the error of the products that
+/// underflow, far below any determinant the filters decide in a mesh.
+inline constexpr double kUnderflowRoom = 0x1p-1000;
+/// The incircle bound assumes that no product underflows or overflows (a degree-4 term can
+/// multiply an underflow's error by a large lift, so an absolute term would not do).
+/// Differences of the coordinates that are 0 or within [2^−240, 2^240] guarantee it: lifts
+/// and products of at least 2^−480, whose differences are multiples of 2^−532, so every term
+/// is at least 2^−1012. Anything else (a mix of magnitudes, huge or tiny boxes) goes to the
+/// exact stage.
 constexpr bool in_range(double x, double lo, double hi) noexcept {
   const double a = x < 0 ? -x : x;
   return a == 0 || (a >= lo && a <= hi);
@@ -57,13 +61,13 @@ inline int orient2d(const Point<2>& a, const Point<2>& b, const Point<2>& c) noe
   const double right = acy * bcx;
   const double det = left - right;
   const double permanent = std::fabs(left) + std::fabs(right);
-  constexpr double lo = 0x1p-500, hi = 0x1p500;
-  if (detail::in_range(acx, lo, hi) && detail::in_range(bcy, lo, hi) && detail::in_range(acy, lo, hi) &&
-      detail::in_range(bcx, lo, hi)) {
-    const double bound = detail::kOrientBound * permanent;
-    if (det > bound) return 1;
-    if (-det > bound) return -1;
-  }
+  // No range test (a tenth of the searches' instructions went to them): the absolute term
+  // covers products that underflow (each off by at most 2^-1075), and a difference or a
+  // product that overflows makes the permanent infinite or the determinant NaN, so that
+  // neither comparison holds.
+  const double bound = detail::kOrientBound * permanent + detail::kUnderflowRoom;
+  if (det > bound) return 1;
+  if (-det > bound) return -1;
   return detail::orient2d_exact(a, b, c);
 }
 
@@ -108,11 +112,10 @@ inline int pencil(const Point<2>& p, const Point<2>& q, double h, const Point<2>
   const double h2 = 2.0 * h;
   const double det = (d1 + d2) - h2 * (c1 - c2);
   const double permanent = std::fabs(d1) + std::fabs(d2) + std::fabs(h2) * (std::fabs(c1) + std::fabs(c2));
-  constexpr double lo = 0x1p-400, hi = 0x1p400;
-  if (detail::in_range(apx, lo, hi) && detail::in_range(apy, lo, hi) && detail::in_range(aqx, lo, hi) &&
-      detail::in_range(aqy, lo, hi) && detail::in_range(bx, lo, hi) && detail::in_range(by, lo, hi) &&
-      detail::in_range(h, 0x1p-60, 0x1p60)) {
-    const double bound = detail::kPencilBound * permanent;
+  // As orient2d: the absolute term covers underflow (with |h| ≤ 2^60, at most 2^-1012 in
+  // all), and an overflow leaves both comparisons false.
+  if (std::fabs(h) <= 0x1p60) {
+    const double bound = detail::kPencilBound * permanent + detail::kUnderflowRoom;
     if (det > bound) return 1;
     if (-det > bound) return -1;
   }
