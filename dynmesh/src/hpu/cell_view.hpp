@@ -73,8 +73,8 @@ struct CellFrame {
     // box.side · 2^-level: a product by a power of two is rounded as ldexp's result is, and
     // costs a multiply rather than a libm call (one frame per cell a step read).
     const double w = box.side * std::bit_cast<double>(static_cast<std::uint64_t>(1023 - k.level) << 52);
-    ox = box.origin[0] + static_cast<double>(k.ix) * w;
-    oy = box.origin[1] + static_cast<double>(k.iy) * w;
+    ox = box.origin[0] + grid_double(k.ix) * w;
+    oy = box.origin[1] + grid_double(k.iy) * w;
     inv = 256.0 / w;
   }
   static std::uint8_t part(double x, double o, double inv) noexcept {
@@ -291,8 +291,8 @@ class CellView {
   /// A cell's box, widened by margin.
   void cell_box(const CellKey& k, double margin, double& x0, double& y0, double& x1, double& y1) const noexcept {
     const double w = width_[k.level];
-    x0 = box_.origin[0] + static_cast<double>(k.ix) * w - margin, x1 = x0 + w + 2 * margin;
-    y0 = box_.origin[1] + static_cast<double>(k.iy) * w - margin, y1 = y0 + w + 2 * margin;
+    x0 = box_.origin[0] + grid_double(k.ix) * w - margin, x1 = x0 + w + 2 * margin;
+    y0 = box_.origin[1] + grid_double(k.iy) * w - margin, y1 = y0 + w + 2 * margin;
   }
 
  private:
@@ -471,8 +471,8 @@ class CellView {
   /// one (nearest first for four equal squares, by their centres' distance, as BucketTree).
   std::array<unsigned, 4> child_order(const CellKey& k, const Point<2>& focus) const noexcept {
     const double w = width_[k.level];
-    const double mx = box_.origin[0] + (static_cast<double>(k.ix) + 0.5) * w;
-    const double my = box_.origin[1] + (static_cast<double>(k.iy) + 0.5) * w;
+    const double mx = box_.origin[0] + (grid_double(k.ix) + 0.5) * w;
+    const double my = box_.origin[1] + (grid_double(k.iy) + 0.5) * w;
     const unsigned hx = focus[0] >= mx ? 1 : 0, hy = focus[1] >= my ? 1 : 0;
     const unsigned near = hx | (hy << 1);
     const bool x_first = std::abs(focus[0] - mx) >= std::abs(focus[1] - my);
