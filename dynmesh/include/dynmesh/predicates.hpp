@@ -19,6 +19,7 @@
 // predicates" (1997) for the determinants; CGAL's filtered kernel for the implementation.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "dynmesh/point.hpp"
@@ -41,16 +42,6 @@ inline constexpr double kPencilBound = 12.0 * kEpsilon;
 /// Added to the orient2d and pencil bounds: far above the error of the products that
 /// underflow, far below any determinant the filters decide in a mesh.
 inline constexpr double kUnderflowRoom = 0x1p-1000;
-/// The incircle bound assumes that no product underflows or overflows (a degree-4 term can
-/// multiply an underflow's error by a large lift, so an absolute term would not do).
-/// Differences of the coordinates that are 0 or within [2^−240, 2^240] guarantee it: lifts
-/// and products of at least 2^−480, whose differences are multiples of 2^−532, so every term
-/// is at least 2^−1012. Anything else (a mix of magnitudes, huge or tiny boxes) goes to the
-/// exact stage.
-constexpr bool in_range(double x, double lo, double hi) noexcept {
-  const double a = x < 0 ? -x : x;
-  return a == 0 || (a >= lo && a <= hi);
-}
 }  // namespace detail
 
 /// Sign of det[[bx−ax, by−ay], [cx−ax, cy−ay]]: +1 when a, b, c turn counter-clockwise,
@@ -89,13 +80,15 @@ inline int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, con
   const double permanent = (std::fabs(bdxcdy) + std::fabs(cdxbdy)) * alift +
                            (std::fabs(cdxady) + std::fabs(adxcdy)) * blift +
                            (std::fabs(adxbdy) + std::fabs(bdxady)) * clift;
-  constexpr double lo = 0x1p-240, hi = 0x1p240;
-  if (detail::in_range(adx, lo, hi) && detail::in_range(ady, lo, hi) && detail::in_range(bdx, lo, hi) &&
-      detail::in_range(bdy, lo, hi) && detail::in_range(cdx, lo, hi) && detail::in_range(cdy, lo, hi)) {
-    const double bound = detail::kIncircleBound * permanent;
-    if (det > bound) return 1;
-    if (-det > bound) return -1;
-  }
+  // No range test, as orient2d: an underflow's error (at most 2^-1075 a product) is
+  // multiplied by at most a lift or a degree-2 difference, each below 2M² for M the largest
+  // difference, so they add up to less than 30·2^-1075·(M² + 1); (M² + 1)·2^-1065 is far
+  // above that. An overflow makes the permanent
+  // or the room infinite, or the determinant NaN, and then neither comparison holds.
+  const double m = std::max({std::fabs(adx), std::fabs(ady), std::fabs(bdx), std::fabs(bdy), std::fabs(cdx), std::fabs(cdy)});
+  const double bound = detail::kIncircleBound * permanent + (m * m + 1) * 0x1p-1065;
+  if (det > bound) return 1;
+  if (-det > bound) return -1;
   return detail::incircle_exact(a, b, c, d);
 }
 
