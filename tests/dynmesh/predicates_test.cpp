@@ -622,9 +622,9 @@ TEST(Predicates, PencilMixedMagnitudesAgreeWithTheCircleDefinition) {
   std::mt19937_64 rng(kSeed);
   auto coord = [&] { return ((rng() & 1) ? -1.0 : 1.0) * kPool[rng() % kPool.size()]; };
   auto point = [&] { return Point<2>{coord(), coord()}; };
-  std::size_t zeros = 0, decided = 0;
+  std::size_t zeros = 0, nonzero = 0;
   for (int i = 0; i < 20000; ++i) {
-    // Points near one another at a random scale as well, so that the filter decides some
+    // Points near one another at a random scale as well, where the filter can decide
     // (offsets below the pool's last, DBL_MAX, so that every coordinate stays finite).
     const double s = kPool[rng() % (kPool.size() - 1)];
     const Point<2> p = point(), q = i % 2 ? point() : Point<2>{p[0] + s, p[1] - 0.5 * s};
@@ -634,12 +634,12 @@ TEST(Predicates, PencilMixedMagnitudesAgreeWithTheCircleDefinition) {
       continue;  // an offset from a coordinate near DBL_MAX overflowed
     const int want = pencil_reference(p, q, h, x);
     zeros += want == 0;
-    decided += want != 0;
+    nonzero += want != 0;
     ASSERT_EQ(dynmesh::pencil(p, q, h, x), want) << dynmesh::to_string<2>(p) << dynmesh::to_string<2>(q) << " h=" << h
                                                   << " x=" << dynmesh::to_string<2>(x);
   }
   EXPECT_GT(zeros, 0u);
-  EXPECT_GT(decided, 0u);
+  EXPECT_GT(nonzero, 0u);
 }
 
 }  // namespace

@@ -5,9 +5,8 @@
 // static and the self-adjusting meshers, and the mesh checker, never disagree through
 // rounding. Each test first evaluates its determinant in double, inline, and returns the
 // sign when it exceeds Shewchuk's a-priori error bound for that evaluation (his
-// ccwerrboundA and iccerrboundA); otherwise, and whenever a coordinate difference leaves the
-// range in which that bound holds (no product may underflow or overflow), it asks
-// CGAL's Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
+// ccwerrboundA and iccerrboundA) plus a small absolute term for the products that underflow
+// (an overflow leaves the comparison undecided); otherwise it asks CGAL's Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
 // interval filter with an exact fallback. CGAL's headers are confined to src/geometry/predicates.cpp.
 // The inline stage decides nearly all calls on meshing input and saves the call and CGAL's
 // own filter setup (the predicates were a third of the hpu mesh's build time).
@@ -52,7 +51,7 @@ inline int orient2d(const Point<2>& a, const Point<2>& b, const Point<2>& c) noe
   const double right = acy * bcx;
   const double det = left - right;
   const double permanent = std::fabs(left) + std::fabs(right);
-  // No range test (a tenth of the searches' instructions went to them): the absolute term
+  // No range test (8% of the hpu program's instructions went to them): the absolute term
   // covers products that underflow (each off by at most 2^-1075), and a difference or a
   // product that overflows makes the permanent infinite or the determinant NaN, so that
   // neither comparison holds.
@@ -83,8 +82,8 @@ inline int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, con
   // No range test, as orient2d: an underflow's error (at most 2^-1075 a product) is
   // multiplied by at most a lift or a degree-2 difference, each below 2M² for M the largest
   // difference, so they add up to less than 30·2^-1075·(M² + 1); (M² + 1)·2^-1065 is far
-  // above that. An overflow makes the permanent
-  // or the room infinite, or the determinant NaN, and then neither comparison holds.
+  // above that. An overflow makes the permanent or the room infinite, or the determinant
+  // NaN, and then neither comparison holds.
   const double m = std::max({std::fabs(adx), std::fabs(ady), std::fabs(bdx), std::fabs(bdy), std::fabs(cdx), std::fabs(cdy)});
   const double bound = detail::kIncircleBound * permanent + (m * m + 1) * 0x1p-1065;
   if (det > bound) return 1;
