@@ -1,7 +1,7 @@
 // cell_view.hpp (private) — how a step of the self-adjusting hpu program reads the cells:
 // its view of the cell store, the rounds of reads that fill it, and the insertion step.
 //
-// Purpose: a step (a vertex's first class, an entry's collect, one try of a pair, a leaf's
+// Purpose: a step (a vertex's first class, an entry's collect, one try of a pair, a vertex's
 // final triangles) runs the static questions of cell_questions.hpp on a CellView. The view
 // holds the cells the step has read and answers searches from them. A cell it has not read
 // is looked up with Engine::peek (its value now, recorded nothing), so every answer is

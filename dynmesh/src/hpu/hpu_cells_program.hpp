@@ -20,9 +20,9 @@
 //      then process the pairs in collection order (each try a step: not loose, split box
 //      edges, or insert the off-center; an insertion is a step that writes the store's leaf);
 //      births (off-centers and side midpoints) form the next round;
-//   4. the final mesh: a pass over the store's newest leaves; each leaf's step finds the
-//      triangles whose (x, y)-smallest corner it holds, from those vertices' stars, and makes
-//      them one block of the change feed (hpu_mesh_feed.hpp).
+//   4. the final mesh: a pass over the store's newest leaves; a memoized step per vertex of
+//      a leaf finds the triangles whose (x, y)-smallest corner it is, from its star, and
+//      makes them one block of the change feed (hpu_mesh_feed.hpp).
 // Lists by destination passing, with the memo keys that keep an update local
 // (docs/EXPERIMENTS.md, "What made the trace distance flat"): every list cell is a keyed
 // allocation (an entry by (vertex, class, birth), a pair by (its collector's entry, p, q), a
@@ -628,28 +628,30 @@ struct HpuCellsProgram {
     e.read(n->state, [pg, n](sac::Engine& e2, const CellState& s) {
       if (s.kind == CellState::Split) {
         for (unsigned k = 0; k < 4; ++k) e2.memo(sac::fn<&final_node>(pg, pg->dir->node(e2, n->key.child(k))));
-      } else if (s.kind == CellState::Leaf && s.count > 0) {
-        run_step(e2, FinalStep{pg, n});
+      } else if (s.kind == CellState::Leaf) {
+        // One step a vertex, each memoized: when the leaf gains or loses a vertex, the
+        // others' steps are found again with their reads, and a change near one vertex
+        // re-runs its star walk only, not the leaf's.
+        for (std::size_t i = 0; i < s.count; ++i) e2.memo(sac::fn<&final_vertex>(pg, n, s.items[i]));
       }
     });
   }
 
-  /// The triangles whose (x, y)-smallest corner lies in leaf n, as one block.
+  static void final_vertex(sac::Engine& e, HpuCellsProgram* pg, CellNode* n, HV a) { run_step(e, FinalStep{pg, n, a}); }
+
+  /// The triangles whose (x, y)-smallest corner is a (a vertex of leaf n), as one block.
   struct FinalStep {
     HpuCellsProgram* pg;
     CellNode* n;
+    HV a;
     CellView* view(sac::Engine&) const { return &pg->view; }
     const Box<2>& box() const noexcept { return pg->box(); }
     bool run(sac::Engine& e, CellView& v) const {
-      const CellState& s = e.current(n->state);  // read by final_node, the enclosing read
       const double scale = std::ldexp(pg->box().side, -n->key.level) / 4;
       if (!v.kept()) {
         pg->block.clear();
-        for (std::size_t i = 0; i < s.count; ++i) {
-          HV a = s.items[i];
-          pg->q.triangles_of(a, scale, pg->tris);
-          for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
-        }
+        pg->q.triangles_of(a, scale, pg->tris);
+        for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
       }
       if (!v.done()) return false;
       ++pg->steps.done[HcStepCounts::Final];

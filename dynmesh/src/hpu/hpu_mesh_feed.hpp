@@ -1,9 +1,9 @@
 // hpu_mesh_feed.hpp (private) — the self-adjusting hpu mesh's output: its live triangles in
 // blocks, and the change feed.
 //
-// Purpose: the program (hpu_cells_program.hpp) emits the final mesh leaf by leaf: the
-// triangles whose (x, y)-smallest corner lies in a leaf of the cell store form one block, a
-// keyless allocation of the step that found them. Change propagation destroys the blocks of
+// Purpose: the program (hpu_cells_program.hpp) emits the final mesh vertex by vertex: the
+// triangles whose (x, y)-smallest corner is one vertex form one block, a keyless allocation
+// of the step that found them (none when there are none). Change propagation destroys the blocks of
 // the steps it re-runs or discards and makes new ones, so the feed falls out of the trace:
 // each block's birth logs +1 per triangle and its destruction −1, and the net count of a
 // triangle over an update is its change (a block re-made unchanged nets 0).
