@@ -3,10 +3,10 @@
 //
 // Purpose: the program (hpu_cells_program.hpp) emits the final mesh vertex by vertex: the
 // triangles whose (x, y)-smallest corner is one vertex form one block, a keyless allocation
-// of the step that found them (none when there are none). Change propagation destroys the blocks of
-// the steps it re-runs or discards and makes new ones, so the feed falls out of the trace:
-// each block's birth logs +1 per triangle and its destruction −1, and the net count of a
-// triangle over an update is its change (a block re-made unchanged nets 0).
+// of the step that found them (none when there are none). Change propagation destroys the
+// blocks of the steps it re-runs or discards and makes new ones, so the feed falls out of
+// the trace: each block's birth logs +1 per triangle and its destruction −1, and the net
+// count of a triangle over an update is its change (a block re-made unchanged nets 0).
 // Invariants (check_invariants): every live block is on the live list once; the live count
 // is the sum of the live blocks' sizes; after an update every triangle nets −1, 0 or +1.
 // Complexity: O(t) per block made or destroyed; take_change O(e log e) for e logged. A
