@@ -33,6 +33,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <set>
@@ -62,7 +63,7 @@ struct HpuInputNode : CellVertex {
 
 class HpuInputs {
  public:
-  explicit HpuInputs(const Box<2>& box) : box_(box), list_(InsertionOrder{box}) {
+  explicit HpuInputs(const Box<2>& box) : box_(box) {
     for (int k = 0; k < 4; ++k) {
       const SideFrame f = frame(k);
       side_[k] = {box.origin[f.u], box.origin[f.u] + box.side};
@@ -115,8 +116,8 @@ class HpuInputs {
           side_path(k, pl.sides[k], p, path);
           for (const Point<2>& m : path) ++counts[m[frame(k).u]];
         };
-        for (const auto& [p, entry] : list_)
-          if (entry.input && !after.count(p)) count_all(p);
+        for (const auto& [at, entry] : list_)
+          if (entry.input && !after.count(at.p)) count_all(at.p);
         for (const auto& [p, present] : after)
           if (present) count_all(p);
         continue;
@@ -164,7 +165,7 @@ class HpuInputs {
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     for (const Point<2>& p : touched) {
-      auto it = list_.find(p);
+      auto it = list_.find(key(p));
       const auto in = input_after.find(p);
       const bool input = in != input_after.end() ? in->second : it != list_.end() && it->second.input;
       const bool listed = (input || is_midpoint(p)) && !is_corner(p);
@@ -196,14 +197,14 @@ class HpuInputs {
       if (i >= order.size()) fail("the list has more points than the inputs and their side midpoints");
       if (n->p != order[i]) fail("the list's point " + std::to_string(i) + " is " + to_string(n->p) +
                                      ", its definition says " + to_string(order[i]));
-      const auto it = list_.find(n->p);
+      const auto it = list_.find(key(n->p));
       if (it == list_.end() || it->second.node.get() != n) fail("a listed node is not in the map");
     }
     if (i != order.size()) fail("the list misses points (" + std::to_string(i) + " of " + std::to_string(order.size()) + ")");
     if (list_.size() != order.size()) fail("the map holds nodes that are not listed");
     const std::set<Point<2>> in(inputs.begin(), inputs.end());
-    for (const auto& [p, entry] : list_)
-      if (entry.input != (in.count(p) > 0)) fail("a node's input flag is wrong: " + to_string(p));
+    for (const auto& [at, entry] : list_)
+      if (entry.input != (in.count(at.p) > 0)) fail("a node's input flag is wrong: " + to_string(at.p));
   }
 
   /// Points listed (inputs and midpoints).
@@ -212,7 +213,7 @@ class HpuInputs {
   std::size_t bytes() const noexcept {
     std::size_t mids = 0;
     for (const auto& m : mids_) mids += m.size();
-    return list_.size() * (sizeof(Point<2>) + sizeof(Entry) + 4 * sizeof(void*) + sizeof(HpuInputNode)) +
+    return list_.size() * (sizeof(OrderKey) + sizeof(Entry) + 4 * sizeof(void*) + sizeof(HpuInputNode)) +
            mids * (sizeof(double) + sizeof(int) + 4 * sizeof(void*));
   }
 
@@ -221,6 +222,20 @@ class HpuInputs {
     Box<2> box;
     bool operator()(const Point<2>& a, const Point<2>& b) const noexcept { return insertion_less(box, a, b); }
   };
+  /// A point with the two parts of insertion_less computed once: the list's map compares
+  /// keys at every step of a search, and the BRIO hash and the Morton code were most of the
+  /// mutator's work from scratch (check_invariants() sorts by insertion_less itself).
+  struct OrderKey {
+    int level;
+    std::uint64_t code;
+    Point<2> p;
+    friend bool operator<(const OrderKey& a, const OrderKey& b) noexcept {
+      if (a.level != b.level) return a.level > b.level;
+      if (a.code != b.code) return a.code < b.code;
+      return xy_less(a.p, b.p);
+    }
+  };
+  OrderKey key(const Point<2>& p) const noexcept { return {brio_level(p), morton_of(box_, p), p}; }
   struct Entry {
     std::unique_ptr<HpuInputNode> node;
     bool input = false;
@@ -255,7 +270,7 @@ class HpuInputs {
     return (p[0] == box_.origin[0] || p[0] == x1) && (p[1] == box_.origin[1] || p[1] == y1);
   }
   bool is_input(const Point<2>& p) const {
-    const auto it = list_.find(p);
+    const auto it = list_.find(key(p));
     return it != list_.end() && it->second.input;
   }
   bool is_midpoint(const Point<2>& p) const {
@@ -266,14 +281,14 @@ class HpuInputs {
     return false;
   }
   void link(sac::Engine& e, const Point<2>& p, bool input) {
-    auto [it, fresh] = list_.emplace(p, Entry{std::make_unique<HpuInputNode>(p), input});
+    auto [it, fresh] = list_.emplace(key(p), Entry{std::make_unique<HpuInputNode>(p), input});
     HpuInputNode* n = it->second.node.get();
     if (cells_) cells_->insert(e, n);
     const auto after = std::next(it);
     e.set(n->next, after == list_.end() ? nullptr : after->second.node.get());
     e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next, n);
   }
-  void unlink(sac::Engine& e, std::map<Point<2>, Entry, InsertionOrder>::iterator it) {
+  void unlink(sac::Engine& e, std::map<OrderKey, Entry>::iterator it) {
     const auto after = std::next(it);
     e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next,
           after == list_.end() ? nullptr : after->second.node.get());
@@ -283,7 +298,7 @@ class HpuInputs {
   }
 
   Box<2> box_;
-  std::map<Point<2>, Entry, InsertionOrder> list_;
+  std::map<OrderKey, Entry> list_;
   std::array<std::set<double>, 4> side_;       // per side: the along coordinates of its vertices
   std::array<std::map<double, int>, 4> mids_;  // per side: midpoint (along coordinate) → paths
   std::vector<std::unique_ptr<HpuInputNode>> gone_;
