@@ -6,7 +6,8 @@
 // rounding. Each test first evaluates its determinant in double, inline, and returns the
 // sign when it exceeds Shewchuk's a-priori error bound for that evaluation (his
 // ccwerrboundA and iccerrboundA) plus a small absolute term for the products that underflow
-// (an overflow leaves the comparison undecided); otherwise it asks CGAL's Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
+// (an overflow leaves the comparison undecided); otherwise it asks CGAL's
+// Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
 // interval filter with an exact fallback. CGAL's headers are confined to src/geometry/predicates.cpp.
 // The inline stage decides nearly all calls on meshing input and saves the call and CGAL's
 // own filter setup (the predicates were a third of the hpu mesh's build time).

@@ -28,6 +28,7 @@
 #include <span>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "dynmesh/box.hpp"
@@ -160,6 +161,24 @@ inline bool insertion_less(const Box<2>& box, const Point<2>& a, const Point<2>&
   const int la = brio_level(a), lb = brio_level(b);
   if (la != lb) return la > lb;
   return morton_less(box, a, b);
+}
+
+/// A point with insertion_less's BRIO level and Morton code computed once, for an order
+/// that compares each point many times (the input list's map, the first entries' sort):
+/// keys compare as insertion_less compares their points. insertion_less stays the
+/// definition, which HpuInputs::check_invariants() sorts by.
+struct InsertionKey {
+  int level;
+  std::uint64_t code;
+  Point<2> p;
+  friend bool operator<(const InsertionKey& a, const InsertionKey& b) noexcept {
+    if (a.level != b.level) return a.level > b.level;
+    if (a.code != b.code) return a.code < b.code;
+    return xy_less(a.p, b.p);
+  }
+};
+inline InsertionKey insertion_key(const Box<2>& box, const Point<2>& p) noexcept {
+  return {brio_level(p), morton_of(box, p), p};
 }
 
 /// The midpoint of a box edge, from its (x, y)-smaller end: one formula whoever asks (the
@@ -384,21 +403,14 @@ void run_rounds(std::map<int, std::vector<Entry>>& queues, std::vector<Entry>& b
 /// The order of the first queue entries: the four box corners (vertices 0-3) first in
 /// (Morton, x, y) order, then the other vertices in insertion_less order. Returns indices.
 inline std::vector<std::uint32_t> first_entry_order(const Box<2>& box, std::span<const Point<2>> pts) {
-  struct Key {
-    int level;
-    std::uint64_t code;
-    std::uint32_t v;
-  };
-  std::vector<Key> keys(pts.size());
-  for (std::uint32_t v = 0; v < keys.size(); ++v)
-    keys[v] = {v < 4 ? INT_MAX : brio_level(pts[v]), morton_of(box, pts[v]), v};
-  std::sort(keys.begin(), keys.end(), [&](const Key& a, const Key& b) {
-    if (a.level != b.level) return a.level > b.level;
-    if (a.code != b.code) return a.code < b.code;
-    return xy_less(pts[a.v], pts[b.v]);
-  });
+  std::vector<std::pair<InsertionKey, std::uint32_t>> keys(pts.size());
+  for (std::uint32_t v = 0; v < keys.size(); ++v) {
+    keys[v] = {insertion_key(box, pts[v]), v};
+    if (v < 4) keys[v].first.level = INT_MAX;  // the corners first
+  }
+  std::sort(keys.begin(), keys.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<std::uint32_t> out(keys.size());
-  for (std::size_t i = 0; i < keys.size(); ++i) out[i] = keys[i].v;
+  for (std::size_t i = 0; i < keys.size(); ++i) out[i] = keys[i].second;
   return out;
 }
 

@@ -213,7 +213,7 @@ class HpuInputs {
   std::size_t bytes() const noexcept {
     std::size_t mids = 0;
     for (const auto& m : mids_) mids += m.size();
-    return list_.size() * (sizeof(OrderKey) + sizeof(Entry) + 4 * sizeof(void*) + sizeof(HpuInputNode)) +
+    return list_.size() * (sizeof(InsertionKey) + sizeof(Entry) + 4 * sizeof(void*) + sizeof(HpuInputNode)) +
            mids * (sizeof(double) + sizeof(int) + 4 * sizeof(void*));
   }
 
@@ -222,20 +222,9 @@ class HpuInputs {
     Box<2> box;
     bool operator()(const Point<2>& a, const Point<2>& b) const noexcept { return insertion_less(box, a, b); }
   };
-  /// A point with the two parts of insertion_less computed once: the list's map compares
-  /// keys at every step of a search, and the BRIO hash and the Morton code were most of the
-  /// mutator's work from scratch (check_invariants() sorts by insertion_less itself).
-  struct OrderKey {
-    int level;
-    std::uint64_t code;
-    Point<2> p;
-    friend bool operator<(const OrderKey& a, const OrderKey& b) noexcept {
-      if (a.level != b.level) return a.level > b.level;
-      if (a.code != b.code) return a.code < b.code;
-      return xy_less(a.p, b.p);
-    }
-  };
-  OrderKey key(const Point<2>& p) const noexcept { return {brio_level(p), morton_of(box_, p), p}; }
+  // The map compares keys at every step of a search: computing the BRIO hash and the
+  // Morton code there was most of the mutator's work from scratch.
+  InsertionKey key(const Point<2>& p) const noexcept { return insertion_key(box_, p); }
   struct Entry {
     std::unique_ptr<HpuInputNode> node;
     bool input = false;
@@ -288,7 +277,7 @@ class HpuInputs {
     e.set(n->next, after == list_.end() ? nullptr : after->second.node.get());
     e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next, n);
   }
-  void unlink(sac::Engine& e, std::map<OrderKey, Entry>::iterator it) {
+  void unlink(sac::Engine& e, std::map<InsertionKey, Entry>::iterator it) {
     const auto after = std::next(it);
     e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next,
           after == list_.end() ? nullptr : after->second.node.get());
@@ -298,7 +287,7 @@ class HpuInputs {
   }
 
   Box<2> box_;
-  std::map<OrderKey, Entry> list_;
+  std::map<InsertionKey, Entry> list_;
   std::array<std::set<double>, 4> side_;       // per side: the along coordinates of its vertices
   std::array<std::map<double, int>, 4> mids_;  // per side: midpoint (along coordinate) → paths
   std::vector<std::unique_ptr<HpuInputNode>> gone_;
