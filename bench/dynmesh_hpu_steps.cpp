@@ -11,10 +11,11 @@
 // the K costliest propagations of each row follow it: the operation, the trace distance, the
 // events created, the reads re-executed, and the steps re-run by kind. An update that creates
 // far more events than its steps explain has re-run a list pass (bench/RESULTS.md, "Fewer
-// collects"). --breakdown prints where the trace's bytes go after each build.
+// collects"). --breakdown prints where the trace's bytes go after each build; --engine-stats
+// the engine's counters (sac::Stats) after each series.
 //
 //   dynmesh_hpu_steps [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
-//                     [--seed 1] [--angle 20.7] [--verify] [--tail K] [--breakdown]
+//                     [--seed 1] [--angle 20.7] [--verify] [--tail K] [--breakdown] [--engine-stats]
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -79,6 +80,7 @@ int main(int argc, char** argv) {
   double angle = kHpuDefaultMinAngle;
   bool verify = false;
   bool breakdown = false;
+  bool engine_stats = false;
   std::size_t tail = 0;
   app.add_option("--dist", dists, "distributions, comma-separated")->delimiter(',');
   app.add_option("--n", sizes, "sizes, comma-separated")->delimiter(',');
@@ -87,6 +89,7 @@ int main(int argc, char** argv) {
   app.add_option("--angle", angle, "angle bound");
   app.add_flag("--verify", verify, "compare the final mesh with HpuMesh's");
   app.add_option("--tail", tail, "after each row, print its K costliest propagations (by trace distance)");
+  app.add_flag("--engine-stats", engine_stats, "after each series, print the engine's counters (sac::Stats)");
   app.add_flag("--breakdown", breakdown, "after each build, print where the trace's bytes go (sac::MemoryBreakdown)");
   CLI11_PARSE(app, argc, argv);
 
@@ -167,6 +170,7 @@ int main(int argc, char** argv) {
                     static_cast<unsigned long long>(c.steps[2]), static_cast<unsigned long long>(c.steps[3]),
                     static_cast<unsigned long long>(c.steps[4]));
       std::fflush(stdout);
+      if (engine_stats) std::cout << "  engine: " << st << "\n" << std::flush;
       if (verify) {
         const bool same = run.state.feed.triangles() == HpuMesh(box, pts, angle).triangles();
         std::printf("  verified against HpuMesh: %s\n", same ? "yes" : "NO");

@@ -256,21 +256,25 @@ bool Engine::move_readers_between(ModBase& m, VersionBase* older, VersionBase* v
 void Engine::move_reader(ReaderLink* r, ModBase& m, VersionBase* older, VersionBase* v, bool same) {
   detach(r);
   attach(r, v);
-  if (!same && affects(r, older, v)) enqueue(r, m);
+  if (!same) note_change(r, m, older, v, true);
 }
 
-void Engine::set_base(ModBase& m, VersionBase* fresh, void (*assign)(VersionBase*, VersionBase*)) {
+void Engine::set_base(ModBase& m, VersionBase* fresh, bool (*assign)(VersionBase*, VersionBase*)) {
   // set() on a default that reads saw: make it a base version, then assign to it.
   if (assign && m.default_readers()) default_base(m, true, fresh->ops);
   VersionBase* last = nullptr;
   for (VersionBase* v = m.newest(); v; v = v->older()) last = v;
   if (VersionBase* base = last && last->is_base() ? last : nullptr) {
-    // An equal value changes nothing. Otherwise the readers are asked before the
-    // assignment, while both values exist.
+    // An equal value changes nothing. Otherwise the base takes the new value and, when the
+    // values were swapped, fresh keeps the old one for the readers that saw it.
     if (!base->ops->equal(base, fresh)) {
-      for (ReaderLink* r = base->readers; r; r = r->rnext)
-        if (affects(r, base, fresh)) enqueue(r, m);
-      assign(base, fresh);
+      const bool swapped = assign(base, fresh);
+      bool kept = false;
+      for (ReaderLink* r = base->readers; r; r = r->rnext) kept |= note_change(r, m, fresh, base, swapped);
+      if (kept) {
+        dead_versions_.push_back(fresh);
+        return;
+      }
     }
     destroy(fresh);
     return;
@@ -459,11 +463,11 @@ void Engine::execute(const Task& t) {
       // execution continues after it.
       auto* end = static_cast<Stamp*>(t.node);
       if (!queue_.empty() && order_.less(&queue_.top()->start, end)) {
-        const ModBase* m = nullptr;
-        ReadNode* r = queue_.pop(&m);
+        QueueAux a;
+        ReadNode* r = queue_.pop(&a);
         ++stats_.queue_pops;
         tasks_.push_back(t);  // drain on after this re-execution
-        rerun(r, m);
+        if (still_affected(r, a)) rerun(r, a.mod);
       } else {
         now_ = end;
       }
@@ -494,18 +498,60 @@ void Engine::discard_pending() noexcept {
   pending_.clear();  // the allocations are in the trace; destroy_all frees them there
 }
 
-void Engine::enqueue(ReaderLink* l, const ModBase& m) {
+bool Engine::note_change(ReaderLink* l, const ModBase& m, const VersionBase* before, const VersionBase* after,
+                         bool lazy) {
   ReadNode* r = owner_of(l);
-  if (r->link.qpos != kNotQueued) return;  // a multi-read with several changed slots: once
-  queue_.push(r, detail::is_slot(l) ? nullptr : &m);
+  const std::uint32_t slot = detail::is_slot(l) ? l->qpos : 0;
+  if (r->link.qpos != kNotQueued) {  // queued already (a multi-read with several changed slots)
+    QueueAux& a = queue_.aux(r);
+    if (!lazy) {
+      a.seen = kSeenForced;
+      return false;
+    }
+    if (a.seen == kSeenForced) return false;
+    for (std::uint32_t i = a.seen; i != kSeenNone; i = seen_[i].next)
+      if (seen_[i].slot == slot) return false;  // what it saw last is recorded
+    seen_.push_back(Seen{before, slot, a.seen});
+    a.seen = static_cast<std::uint32_t>(seen_.size() - 1);
+    return true;
+  }
+  const auto f = r->ops()->affected;
+  if (f && !f(r, slot, before, after)) return false;
+  std::uint32_t head = kSeenForced;
+  if (lazy) {
+    seen_.push_back(Seen{before, slot, kSeenNone});
+    head = static_cast<std::uint32_t>(seen_.size() - 1);
+  }
+  queue_.push(r, QueueAux{detail::is_slot(l) ? nullptr : &m, head});
   ++stats_.queue_pushes;
+  return lazy;
 }
 
-bool Engine::affects(ReaderLink* l, const VersionBase* before, const VersionBase* after) {
-  const ReadNode* r = owner_of(l);
-  if (r->link.qpos != kNotQueued) return false;  // it re-runs anyway
+bool Engine::still_affected(ReadNode* r, const QueueAux& a) {
+  if (a.seen == kSeenForced) return true;
   const auto f = r->ops()->affected;
-  return !f || f(r, detail::is_slot(l) ? l->qpos : 0, before, after);
+  for (std::uint32_t i = a.seen; i != kSeenNone; i = seen_[i].next) {
+    const Seen& s = seen_[i];
+    const ModBase& m = a.mod ? *a.mod : *detail::many_of(r)->slots()[s.slot].mod;
+    const VersionBase* now = visible(m, &r->start);
+    if (now == s.v) continue;
+    // A default seen or seen now (no version to compare): re-run, as before.
+    if (!now || !s.v || m.default_only()) return true;
+    if (now->ops->equal(now, s.v)) continue;
+    if (f && !f(r, s.slot, s.v, now)) continue;
+    const ModBase* to = (a.mod || !r->ops()->follow) ? nullptr : r->ops()->follow(*this, r, s.slot, s.v, now);
+    if (!to) return true;
+    // The slot reads `to` from now on, with no re-execution.
+    ReadSlot& sl = detail::many_of(r)->slots()[s.slot];
+    VersionBase* v = visible(*to, &r->start);
+    if (!v) throw UsageError("sac::Engine::read_many: follow() named a modifiable with no value at the read's time");
+    detach(&sl.link);
+    attach(&sl.link, v);
+    sl.mod = to;
+    ++stats_.reads_followed;
+  }
+  ++stats_.reads_unaffected;
+  return false;
 }
 
 void Engine::rerun(ReadNode* r, const ModBase* mp) {
@@ -538,10 +584,11 @@ void Engine::propagate() {
   stats_.last_reexecuted = 0;
   try {
     while (!queue_.empty()) {
-      const ModBase* m = nullptr;
-      ReadNode* r = queue_.pop(&m);
+      QueueAux a;
+      ReadNode* r = queue_.pop(&a);
       ++stats_.queue_pops;
-      rerun(r, m);
+      if (!still_affected(r, a)) continue;
+      rerun(r, a.mod);
       drain(0);
     }
   } catch (...) {
@@ -705,11 +752,13 @@ void Engine::undo(Stamp* s) {
           r->rnext = nullptr;
           if (older) attach(r, older);
           else if (defaulted) attach_default(r, *m);
-          if (!same && (!seen || affects(r, v, seen))) enqueue(r, *m);
+          if (!same) note_change(r, *m, v, seen, seen != nullptr);
           r = nx;
         }
       }
-      destroy(v);
+      // A queued read may have seen v (note_change): freed once propagate() ends.
+      if (in_computation_) dead_versions_.push_back(v);
+      else destroy(v);
     } else if constexpr (K == StampKind::Alloc) {
       AllocNode* n = rec;
       ++stats_.events_undone;
@@ -741,6 +790,9 @@ void Engine::free_deferred() noexcept {
     destroy(n);
   }
   deferred_.clear();
+  for (VersionBase* v : dead_versions_) destroy(v);
+  dead_versions_.clear();
+  seen_.clear();
 }
 
 void Engine::destroy_all() noexcept {
@@ -770,7 +822,8 @@ void Engine::destroy_all() noexcept {
 std::size_t Engine::trace_bytes() const {
   return record_bytes() + order_.memory_bytes() + queue_.memory_bytes() +
          allocs_.memory_bytes() + memos_.memory_bytes() +
-         deferred_.capacity() * sizeof(AllocNode*);
+         deferred_.capacity() * sizeof(AllocNode*) + dead_versions_.capacity() * sizeof(VersionBase*) +
+         seen_.capacity() * sizeof(Seen);
 }
 
 MemoryBreakdown Engine::memory_breakdown() const {
@@ -823,7 +876,8 @@ MemoryBreakdown Engine::memory_breakdown() const {
   b.queue_bytes = queue_.memory_bytes();
   b.alloc_table_bytes = allocs_.memory_bytes();
   b.memo_table_bytes = memos_.memory_bytes();
-  b.deferred_bytes = deferred_.capacity() * sizeof(AllocNode*);
+  b.deferred_bytes = deferred_.capacity() * sizeof(AllocNode*) + dead_versions_.capacity() * sizeof(VersionBase*) +
+                     seen_.capacity() * sizeof(Seen);
   b.engine_vectors = bases_.capacity() * sizeof(VersionBase*) + tasks_.capacity() * sizeof(Task) +
                      reruns_.capacity() * sizeof(RerunContext) + issued_.capacity() * sizeof(Task) +
                      pending_.directory_bytes();
@@ -838,6 +892,7 @@ void Engine::check_invariants() const {
   queue_.check_invariants();
   if (!queue_.empty()) fail("queue not empty outside propagate()");
   if (!deferred_.empty()) fail("deferred frees left after propagate()");
+  if (!dead_versions_.empty() || !seen_.empty()) fail("undone versions or seen lists left after propagate()");
 
   // Walk the trace: nesting, per-record checks, counts.
   struct Open {

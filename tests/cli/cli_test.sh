@@ -178,10 +178,13 @@ case $case_name in
       grep -q "points2d 2D, n = 50, .*, $edits edits, mean trace distance" out.txt || fail "$pp: summary: $(cat out.txt)"
     done
     grep -q '^stability: hpu mesh, points2d 2D' out.txt || fail "the hpu run did not say it measured the hpu mesh"
-    # Through a mesh, the same edits cost more than through the tree alone (same ops and spreads).
+    # The same ops and spreads row by row. The quadtree mesh runs in the tree's trace, so each
+    # of its edits costs more than the tree's alone; the hpu program has its own trace (an
+    # edit may cost it less than the tree), so only its mean is compared.
     for pp in quadtree hpu; do
-      paste -d, <(tail -n +2 none.csv) <(tail -n +2 $pp.csv) | awk -F, '$4 != $11 || $5 != $12 || $13 <= $6 {
-        bad = 1; print } END { exit bad }' || fail "$pp rows do not follow the tree rows"
+      paste -d, <(tail -n +2 none.csv) <(tail -n +2 $pp.csv) | awk -F, -v pp=$pp '$4 != $11 || $5 != $12 ||
+        (pp == "quadtree" && $13 <= $6) { bad = 1; print } { a += $6; b += $13 } END { exit bad || b <= a }' ||
+        fail "$pp rows do not follow the tree rows"
     done
     # The last row's log2_spread is log2(L/s) of the final points (final2d.txt), L the side of the
     # box derived from points2d.node, s their closest pair (brute force here).

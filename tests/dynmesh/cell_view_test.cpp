@@ -4,11 +4,13 @@
 // The program's reads that rely on it are checked end to end by hpu_cells_program_test.cpp
 // (every update against the twin). Also the directory's node links and the one view that
 // may keep its marks on the nodes, and the nearest search from a focus's leaf upwards
-// (search_near), which must visit what the search from the root visits, in its order.
+// (search_near), which must visit what the search from the root visits, in its order; and
+// follow_cell, where a read of a leaf that split or merged away moves.
 #include "hpu/cell_view.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <deque>
@@ -87,10 +89,171 @@ TEST(CellInterest, ALeafChangesForAReadOnlyInsideWhatItUsed) {
   EXPECT_TRUE(interest_changed(box, k, lower_left, before, leaf({b, c})));      // a left
   EXPECT_TRUE(interest_changed(box, k, lower_left, before, leaf({a, b, c, e})));  // e came: inside
   EXPECT_TRUE(interest_changed(box, k, lower_left, before, CellState::split()));  // a kind change
-  // All of it: any other vertex set changes it; none of it: only the kind does.
+  // All of it: any other vertex set changes it; none of it: nothing does, the kind included
+  // (the step's answers held whatever the cell held).
   EXPECT_TRUE(interest_changed(box, k, CellInterest{}, before, leaf({a, b, c, d})));
   EXPECT_FALSE(interest_changed(box, k, CellInterest::none(), before, leaf({d})));
-  EXPECT_TRUE(interest_changed(box, k, CellInterest::none(), before, CellState{}));  // absent
+  EXPECT_FALSE(interest_changed(box, k, CellInterest::none(), before, CellState{}));  // absent
+  EXPECT_FALSE(interest_changed(box, k, CellInterest::none(), before, CellState::split()));
+}
+
+// follow_cell: when a read's leaf split or merged away, the cell it moves to must hold, inside
+// the used box, exactly the vertices the step saw there, and its new interest must hold every
+// point of the used box that lies in the old cell (so that a later change there is seen).
+// Random cells, used boxes and vertex sets, a third of them with a vertex that came inside
+// the used box; the test counts both outcomes.
+TEST(FollowCell, TheCellItFollowsToHoldsWhatTheStepUsed) {
+  std::mt19937_64 rng(20261129);
+  std::printf("seed 20261129\n");
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int followed[2] = {0, 0}, refused[2] = {0, 0};
+  for (int t = 0; t < 4000; ++t) {
+    sac::Engine e;
+    const Box<2> box{{-3.7 + u(rng), 1e3 * u(rng)}, 0.1 + 100 * u(rng)};
+    CellDirectory dir(box);
+    const int level = 1 + static_cast<int>(rng() % 20);
+    const std::uint64_t side = std::uint64_t{1} << level;
+    CellNode* n = dir.node(e, CellKey{level, rng() % side, rng() % side});
+    const bool up = t % 2 == 1;  // a merge above n, else a split of n
+    CellNode* p = dir.node(e, n->key.parent());
+    for (unsigned c = 0; c < 4; ++c) dir.node(e, (up ? p : n)->key.child(c));
+    const CellFrame fn(box, n->key);
+    const double w = 256.0 / fn.inv;
+    const auto in_cell = [&](const CellKey& k, const Point<2>& x) {
+      return k.contains(CellDirectory::cell_at(dir.position(x), k.level));
+    };
+    // Points of a region: of n, or of n's parent for a merge.
+    const CellKey region = up ? p->key : n->key;
+    const CellFrame fr(box, region);
+    std::deque<CellVertex> store;
+    const auto point_in = [&](const CellKey& k) {
+      const CellFrame f(box, k);
+      const double wk = 256.0 / f.inv;
+      for (;;) {
+        const Point<2> x{f.ox + wk * u(rng), f.oy + wk * u(rng)};
+        if (in_cell(k, x)) return &store.emplace_back(x);
+      }
+    };
+    std::vector<const CellVertex*> seen_v, now_v;
+    const int k_seen = 1 + static_cast<int>(rng() % 6);
+    for (int i = 0; i < k_seen; ++i) seen_v.push_back(point_in(n->key));
+    now_v = seen_v;
+    // The used box, near n.
+    const double x0 = fn.ox + w * (1.4 * u(rng) - 0.2), x1 = x0 + w * 0.6 * u(rng);
+    const double y0 = fn.oy + w * (1.4 * u(rng) - 0.2), y1 = y0 + w * 0.6 * u(rng);
+    const auto in_used = [&](const Point<2>& x) { return x[0] >= x0 && x[0] <= x1 && x[1] >= y0 && x[1] <= y1; };
+    if (up)
+      for (int i = static_cast<int>(rng() % 3); i > 0; --i) now_v.push_back(point_in(region));  // siblings'
+    switch (rng() % 3) {
+      case 0:  // one came, anywhere
+        now_v.push_back(point_in(region));
+        break;
+      case 1:  // one came inside the used box, in n, when there is room
+        for (int i = 0; i < 50; ++i) {
+          const Point<2> x{x0 + (x1 - x0) * u(rng), y0 + (y1 - y0) * u(rng)};
+          if (in_used(x) && in_cell(n->key, x)) {
+            now_v.push_back(&store.emplace_back(x));
+            break;
+          }
+        }
+        break;
+      default:  // one of n's left
+        if (now_v.size() > 1) now_v.erase(now_v.begin() + static_cast<std::ptrdiff_t>(rng() % seen_v.size()));
+    }
+    if (now_v.size() > CellState::kCapacity) continue;
+    CellInterest in = fn.interest(x0, y0, x1, y1);
+    const CellState seen = CellState::leaf(seen_v.begin(), seen_v.end());
+    // The store at the read's time: n split into four leaves, or n's parent one leaf.
+    std::vector<std::pair<CellNode*, CellState>> values;
+    if (up) {
+      values.emplace_back(p, CellState::leaf(now_v.begin(), now_v.end()));
+    } else {
+      values.emplace_back(n, CellState::split());
+      for (unsigned c = 0; c < 4; ++c) {
+        std::vector<const CellVertex*> mine;
+        for (const CellVertex* v : now_v)
+          if (in_cell(n->child[c]->key, v->p)) mine.push_back(v);
+        values.emplace_back(n->child[c], CellState::leaf(mine.begin(), mine.end()));
+      }
+    }
+    const auto value = [&](const CellNode* x) -> const CellState* {
+      for (const auto& [node, s] : values)
+        if (node == x) return &s;
+      return nullptr;  // never written: absent
+    };
+    const CellState now = up ? CellState{} : CellState::split();
+    CellInterest moved = in;
+    CellNode* d = follow_cell(box, dir, n, &moved, seen, now, value);
+    // Did the vertices inside the used box, in n, change?
+    std::vector<const CellVertex*> a, b;
+    for (const CellVertex* v : seen_v)
+      if (in_used(v->p)) a.push_back(v);
+    for (const CellVertex* v : now_v)
+      if (in_used(v->p) && in_cell(n->key, v->p)) b.push_back(v);
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    const bool changed = a != b;
+    if (!d) {
+      ++refused[changed];
+      continue;
+    }
+    ++followed[changed];
+    ASSERT_FALSE(changed) << "followed a read whose used vertices changed, try " << t;
+    ASSERT_NE(value(d), nullptr);
+    ASSERT_EQ(value(d)->kind, CellState::Leaf) << "try " << t;
+    ASSERT_TRUE(up ? d->key.contains(n->key) : n->key.contains(d->key)) << "try " << t;
+    // Every vertex inside the used box in n is in d, and inside d's new interest; so is any
+    // point of the used box in n (a vertex that may come later).
+    const CellFrame fd(box, d->key);
+    for (const CellVertex* v : now_v)
+      if (in_used(v->p) && in_cell(n->key, v->p)) {
+        ASSERT_TRUE(in_cell(d->key, v->p)) << "try " << t;
+        ASSERT_TRUE(fd.inside(moved, v->p)) << "try " << t;
+      }
+    for (int i = 0; i < 20; ++i) {
+      const Point<2> x{x0 + (x1 - x0) * u(rng), y0 + (y1 - y0) * u(rng)};
+      if (in_used(x) && in_cell(n->key, x)) {
+        ASSERT_TRUE(in_cell(d->key, x)) << "try " << t;
+        ASSERT_TRUE(fd.inside(moved, x)) << "try " << t;
+      }
+    }
+  }
+  std::printf("followed %d (changed %d), refused %d (changed %d)\n", followed[0] + followed[1], followed[1],
+              refused[0] + refused[1], refused[1]);
+  EXPECT_GT(followed[0], 200);
+  EXPECT_GT(refused[1], 200);
+}
+
+TEST(FollowCell, AWholeCellOrALeafStillALeafNeverFollows) {
+  sac::Engine e;
+  const Box<2> box{{0, 0}, 16};
+  CellDirectory dir(box);
+  CellNode* n = dir.node(e, CellKey{2, 1, 1});  // [4, 8] × [4, 8]
+  for (unsigned c = 0; c < 4; ++c) dir.node(e, n->key.child(c));
+  std::deque<CellVertex> vs;
+  const CellVertex* a = &vs.emplace_back(Point<2>{4.5, 4.5});
+  const CellVertex* b = &vs.emplace_back(Point<2>{7.5, 7.5});
+  const CellState seen = CellState::leaf(&a, &a + 1);
+  const CellState lower_left = CellState::leaf(&a, &a + 1), upper_right = CellState::leaf(&b, &b + 1);
+  const auto value = [&](const CellNode* x) -> const CellState* {
+    static const CellState split = CellState::split(), empty = CellState::leaf(&a, &a);
+    if (x == n) return &split;
+    if (x == n->child[0]) return &lower_left;
+    if (x == n->child[3]) return &upper_right;
+    return &empty;
+  };
+  // Used near a, in the lower left quarter: follows there.
+  CellInterest in = CellFrame(box, n->key).interest(4.2, 4.2, 5, 5);
+  EXPECT_EQ(follow_cell(box, dir, n, &in, seen, CellState::split(), value), n->child[0]);
+  // The whole cell (an insertion's leaf): never.
+  in = CellInterest{};
+  EXPECT_EQ(follow_cell(box, dir, n, &in, seen, CellState::split(), value), nullptr);
+  // Across the children's border: no one child holds it.
+  in = CellFrame(box, n->key).interest(4.2, 4.2, 6.5, 5);
+  EXPECT_EQ(follow_cell(box, dir, n, &in, seen, CellState::split(), value), nullptr);
+  // Still a leaf: a change of its vertices, not of its cell.
+  in = CellFrame(box, n->key).interest(4.2, 4.2, 5, 5);
+  EXPECT_EQ(follow_cell(box, dir, n, &in, seen, CellState::leaf(&b, &b + 1), value), nullptr);
 }
 
 TEST(CellDirectory, NodesLinkTheirParentAndChildrenWhateverTheOrderMade) {

@@ -4,6 +4,8 @@
 // writes or writes inside its interval, changes outside a read of a projection's
 // projection), the version it sees when a modifiable is written
 // several times or a write it saw is undone, defaults (init_default), that it is one event,
+// that a change undone before propagation reaches a read does not re-run it, that a read
+// with follow() moves a slot instead of re-running and then depends on the new modifiable,
 // and random differential programs (plain and inside memoized regions) against the same
 // programs written with k nested reads: equal outputs after every propagate(), a live trace
 // of a from-scratch run's size, and check_invariants() after every update.
@@ -786,4 +788,164 @@ TEST(ReadMany, AReexecutedWriteMovesTheReadsBeforeItsOldVersion) {
     for (auto& o : late) ASSERT_EQ(o.get(), va * 10 + vsel) << "change " << t;
     e.check_invariants();
   }
+}
+
+// --- affected when propagation reaches it, and reads that follow -----------------------------
+
+TEST(ReadManyLazy, AChangeUndoneBeforePropagationReachesAReadDoesNotRerunIt) {
+  // A writes m = 7 when sel is 0, B (later) when sel is 1, and R (later still) reads m. Going
+  // from 0 to 1 undoes A's write (R sees m's base value for a while) and B writes 7 again
+  // before R's time: when propagation reaches R it sees what it saw, so it does not re-run.
+  for (const bool many : {false, true}) {
+    Mod<int> sel, m, out;
+    Engine e;
+    e.set(sel, 0);
+    e.set(m, 0);
+    int runs = 0;
+    e.run([&](Engine& en) {
+      en.read(sel, [&m](Engine& x, int s) {
+        if (s == 0) x.write(m, 7);
+      });
+      en.read(sel, [&m](Engine& x, int s) {
+        if (s == 1) x.write(m, 7);
+      });
+      if (many)
+        en.read_many({&m}, [&](Engine& x, Vals v) {
+          ++runs;
+          x.write(out, *v[0]);
+        });
+      else
+        en.read(m, [&](Engine& x, int v) {
+          ++runs;
+          x.write(out, v);
+        });
+    });
+    ASSERT_EQ(out.get(), 7);
+    ASSERT_EQ(runs, 1);
+    e.set(sel, 1);
+    e.propagate();
+    EXPECT_EQ(out.get(), 7);
+    EXPECT_EQ(runs, 1) << "many " << many;
+    EXPECT_EQ(e.stats().reads_unaffected, 1u);
+    e.check_invariants();
+    // Neither writes: R sees the base value and re-runs.
+    e.set(sel, 2);
+    e.propagate();
+    EXPECT_EQ(out.get(), 0);
+    EXPECT_EQ(runs, 2);
+    e.check_invariants();
+  }
+}
+
+// Sums its slots' values; a slot whose modifiable changes may move to the first modifiable
+// of `pool` that holds, at the read's time, the value it saw: the sum stays what it was.
+struct FollowingSum {
+  Mod<int>* out;
+  int* runs;
+  std::span<Mod<int>> pool;
+  std::array<int, 4>* names;  // which pool member slot i reads: follow() keeps it (test-owned)
+  void operator()(Engine& x, Vals v) const {
+    ++*runs;
+    x.write(*out, sum(v));
+  }
+  bool affected(std::size_t, const int& before, const int& after) const { return before != after; }
+  const Mod<int>* follow(std::size_t i, const int& seen, const int&, const Engine::At& at) const {
+    for (std::size_t j = 0; j < pool.size(); ++j)
+      if (const int* v = at.value(pool[j]); v && *v == seen) {
+        (*names)[i] = static_cast<int>(j);
+        return &pool[j];
+      }
+    return nullptr;
+  }
+};
+
+TEST(ReadManyFollow, AReadMovesToAModifiableThatHoldsWhatItSaw) {
+  Mod<int> out;
+  std::array<Mod<int>, 3> pool;
+  Engine e;
+  e.set(pool[0], 1);
+  e.set(pool[1], 2);
+  e.set(pool[2], 1);
+  int runs = 0;
+  std::array<int, 4> names{0, 1, 0, 0};
+  e.run([&](Engine& en) { en.read_many({&pool[0], &pool[1]}, FollowingSum{&out, &runs, pool, &names}); });
+  ASSERT_EQ(out.get(), 12);
+  // pool[0] becomes 5: slot 0 saw 1, which pool[2] holds: it reads pool[2], no re-run.
+  e.set(pool[0], 5);
+  e.propagate();
+  EXPECT_EQ(runs, 1);
+  EXPECT_EQ(out.get(), 12);
+  EXPECT_EQ(e.stats().reads_followed, 1u);
+  EXPECT_EQ(names[0], 2);
+  e.check_invariants();
+  // pool[0] is no longer read ...
+  e.set(pool[0], 6);
+  e.propagate();
+  EXPECT_EQ(runs, 1);
+  EXPECT_EQ(out.get(), 12);
+  // ... pool[2] is: 3 is held by no pool member (follow() says null), so it re-runs.
+  e.set(pool[2], 3);
+  e.propagate();
+  EXPECT_EQ(runs, 2);
+  EXPECT_EQ(out.get(), 32);
+  e.check_invariants();
+}
+
+TEST(ReadManyFollow, MatchesTheValuesOfTheModifiablesItNamesAfterEveryChange) {
+  // mid[i] is in[i] when sel[i] is set (a version written before the reads, made, replaced
+  // and undone by the changes), else its base value; four following sums read four of mid
+  // each and may move to any mid[j] holding what they saw, at their time. After every
+  // propagate(), each sum must be that of the values its closure names.
+  constexpr int kN = 8, kReads = 4;
+  std::array<Mod<int>, kN> in, mid, sel;
+  std::array<Mod<int>, kReads> outs;
+  std::array<int, kN> vin{}, vsel{}, vmid{};
+  std::mt19937 rng(20261129);
+  std::printf("seed 20261129\n");
+  Engine e;
+  for (int i = 0; i < kN; ++i) {
+    vin[i] = static_cast<int>(rng() % 6);
+    vsel[i] = static_cast<int>(rng() % 2);
+    vmid[i] = static_cast<int>(rng() % 6);
+    e.set(in[i], vin[i]);
+    e.set(sel[i], vsel[i]);
+    e.set(mid[i], vmid[i]);
+  }
+  int runs = 0;
+  std::array<std::array<int, 4>, kReads> names{};
+  e.run([&](Engine& en) {
+    for (int i = 0; i < kN; ++i)
+      en.read(sel[i], [&, i](Engine& x, int s) {
+        if (s) x.read(in[i], [&, i](Engine& y, int v) { y.write(mid[i], v); });
+      });
+    for (int r = 0; r < kReads; ++r) {
+      names[r] = {r, (r + 1) % kN, (r + 3) % kN, (r + 5) % kN};
+      const auto& s = names[r];
+      en.read_many({&mid[s[0]], &mid[s[1]], &mid[s[2]], &mid[s[3]]},
+                   FollowingSum{&outs[r], &runs, std::span<Mod<int>>(mid), &names[r]});
+    }
+  });
+  const auto check = [&](int t) {
+    std::array<int, kN> m{};
+    for (int k = 0; k < kN; ++k) m[k] = vsel[k] ? vin[k] : vmid[k];
+    for (int r = 0; r < kReads; ++r) {
+      int want = 0;
+      for (int i = 0; i < 4; ++i) want = want * 10 + m[names[r][i]];
+      ASSERT_EQ(outs[r].get(), want) << "change " << t << " read " << r;
+    }
+  };
+  check(-1);
+  for (int t = 0; t < 400; ++t) {
+    const int i = static_cast<int>(rng() % kN);
+    switch (rng() % 3) {
+      case 0: e.set(in[i], vin[i] = static_cast<int>(rng() % 6)); break;
+      case 1: e.set(sel[i], vsel[i] = 1 - vsel[i]); break;
+      default: e.set(mid[i], vmid[i] = static_cast<int>(rng() % 6)); break;
+    }
+    e.propagate();
+    check(t);
+    e.check_invariants();
+  }
+  std::printf("%llu slots followed, %d runs\n", static_cast<unsigned long long>(e.stats().reads_followed), runs);
+  EXPECT_GT(e.stats().reads_followed, 0u);
 }

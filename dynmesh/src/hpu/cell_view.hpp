@@ -92,20 +92,90 @@ struct CellFrame {
   }
 };
 
-/// Does replacing a cell's value `before` by `after` change what `in` used of it? A change of
-/// kind always does; for two leaves, the vertices inside the box, in order, must be the same.
-inline bool interest_changed(const Box<2>& box, const CellKey& k, const CellInterest& in, const CellState& before,
-                             const CellState& after) {
-  if (before.kind != after.kind) return true;
-  if (before.kind != CellState::Leaf) return before != after;
-  const CellFrame f(box, k);
+/// Are the vertices of `a` inside `in` of frame f the same, in order, as those of `b` inside
+/// it that `keep` accepts?
+template <class Keep>
+bool same_inside(const CellFrame& f, const CellInterest& in, const CellState& a, const CellState& b, Keep&& keep) {
   std::size_t i = 0, j = 0;
   for (;; ++i, ++j) {
-    while (i < before.count && !f.inside(in, before.items[i]->p)) ++i;
-    while (j < after.count && !f.inside(in, after.items[j]->p)) ++j;
-    if (i == before.count || j == after.count) return (i == before.count) != (j == after.count);
-    if (before.items[i] != after.items[j]) return true;
+    while (i < a.count && !f.inside(in, a.items[i]->p)) ++i;
+    while (j < b.count && !(f.inside(in, b.items[j]->p) && keep(b.items[j]))) ++j;
+    if (i == a.count || j == b.count) return (i == a.count) == (j == b.count);
+    if (a.items[i] != b.items[j]) return false;
   }
+}
+
+/// Does replacing a cell's value `before` by `after` change what `in` used of it? Nothing
+/// when it used none of it: its answers held whatever the cell held (a split cell whose
+/// children a search all pruned, a cell a round read that the run then did not use). Else a
+/// change of kind always does; for two leaves, the vertices inside the box, in order, must be
+/// the same.
+inline bool interest_changed(const Box<2>& box, const CellKey& k, const CellInterest& in, const CellState& before,
+                             const CellState& after) {
+  if (in.x0 > in.x1) return false;
+  if (before.kind != after.kind) return true;
+  if (before.kind != CellState::Leaf) return before != after;
+  return !same_inside(CellFrame(box, k), in, before, after, [](const CellVertex*) { return true; });
+}
+
+/// A read of a leaf n with interest `in` whose value at the read's time is no longer a leaf:
+/// the cell that now holds what it used, or null (then the step re-runs). `seen`: n's leaf
+/// when the step ran; value(node): a cell's value at the read's time (null: none). On
+/// success, *in becomes the interest in the returned cell's frame.
+///   - n split: down to the leaf inside which the used box lies, at least one 256th from its
+///     children's border on each axis, so that every vertex inside it lies in that child
+///     (the rounding of a 256th is far below one).
+///   - n absent (a merge above it): up to the leaf that holds its region now.
+/// Either way the cell must hold, inside the used box in n's frame, exactly the vertices
+/// `seen` held there, in order: the step's answers used no others (each vertex they used
+/// lies inside it), so they stand. The new interest widens the old one by a 256th on each
+/// side of each level's change of frame: a vertex inside the old is inside it however the
+/// two frames round.
+/// An interest of the whole cell (an insertion's leaf, which the insertion writes) never
+/// follows.
+template <class Value>
+CellNode* follow_cell(const Box<2>& box, const CellDirectory& dir, CellNode* n, CellInterest* in,
+                      const CellState& seen, const CellState& now, Value&& value) {
+  const CellInterest u = *in;
+  if (seen.kind != CellState::Leaf || now.kind == CellState::Leaf) return nullptr;
+  if (u.x0 == 0 && u.y0 == 0 && u.x1 == 255 && u.y1 == 255) return nullptr;
+  const auto clamp = [](int v) { return static_cast<std::uint8_t>(std::clamp(v, 0, 255)); };
+  CellInterest b = u;
+  CellNode* d = n;
+  const CellState* s = nullptr;
+  if (now.kind == CellState::Split) {
+    for (;;) {
+      const int qx = b.x1 <= 126 ? 0 : b.x0 >= 129 ? 1 : -1;
+      const int qy = b.y1 <= 126 ? 0 : b.y0 >= 129 ? 1 : -1;
+      if (qx < 0 || qy < 0) return nullptr;
+      d = d->child[static_cast<unsigned>(qx | (qy << 1))];
+      if (!d) return nullptr;
+      b = CellInterest{clamp(2 * b.x0 - 256 * qx - 1), clamp(2 * b.y0 - 256 * qy - 1),
+                       clamp(2 * b.x1 + 2 - 256 * qx), clamp(2 * b.y1 + 2 - 256 * qy)};
+      s = value(d);
+      if (!s || s->kind == CellState::Absent) return nullptr;
+      if (s->kind == CellState::Leaf) break;
+    }
+    if (!same_inside(CellFrame(box, n->key), u, seen, *s, [](const CellVertex*) { return true; })) return nullptr;
+  } else {
+    for (;;) {
+      if (!d->parent) return nullptr;
+      const int qx = static_cast<int>(d->key.ix & 1), qy = static_cast<int>(d->key.iy & 1);
+      b = CellInterest{clamp((b.x0 + 256 * qx) / 2 - 1), clamp((b.y0 + 256 * qy) / 2 - 1),
+                       clamp((b.x1 + 1 + 256 * qx) / 2 + 1), clamp((b.y1 + 1 + 256 * qy) / 2 + 1)};
+      d = d->parent;
+      s = value(d);
+      if (!s) return nullptr;
+      if (s->kind == CellState::Leaf) break;
+      if (s->kind == CellState::Split) return nullptr;
+    }
+    // The leaf holds the vertices of its siblings' regions too: only n's count.
+    const CellKey& k = n->key;
+    const auto in_n = [&](const CellVertex* v) { return k.contains(CellDirectory::cell_at(dir.position(v->p), k.level)); };
+    if (!same_inside(CellFrame(box, k), u, seen, *s, in_n)) return nullptr;
+  }
+  *in = b;
+  return d;
 }
 
 class CellView {
@@ -613,7 +683,7 @@ struct CellRoundHead {
 template <std::size_t N>
 struct CellRoundCells {
   CellRoundHead head;
-  std::array<CellNode*, N> cells;
+  mutable std::array<CellNode*, N> cells;  // follow() may move a read to another cell
   mutable std::array<CellInterest, N> used;
 };
 
@@ -657,6 +727,19 @@ struct CellRound {
 
   bool affected(std::size_t i, const CellState& before, const CellState& after) const {
     return interest_changed(step.box(), c.cells[i]->key, c.used[i], before, after);
+  }
+
+  /// A leaf that split or merged away: its read moves to the cell that holds what the step
+  /// used of it, when that is unchanged (follow_cell).
+  const sac::Mod<CellState>* follow(std::size_t i, const CellState& seen, const CellState& now,
+                                    const sac::Engine::At& at) const {
+    CellInterest in = c.used[i];
+    CellNode* d = follow_cell(step.box(), step.dir(), c.cells[i], &in, seen, now,
+                              [&](const CellNode* x) { return at.value(x->state); });
+    if (!d) return nullptr;
+    c.cells[i] = d;
+    c.used[i] = in;
+    return &d->state;
   }
 };
 

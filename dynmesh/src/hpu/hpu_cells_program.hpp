@@ -265,6 +265,7 @@ struct HpuCellsProgram {
     int mn, hint;
     CellView* view(sac::Engine&) const { return &pg->view; }
     const Box<2>& box() const noexcept { return pg->box(); }
+    const CellDirectory& dir() const noexcept { return *pg->dir; }
     bool run(sac::Engine& e, CellView& v) const {
       const double scale = hint == INT_MAX ? pg->box().side / 4 : scale_of(hint);
       if (!v.kept()) pg->first_class = pg->q.first_class(cell->v, scale);
@@ -418,6 +419,7 @@ struct HpuCellsProgram {
     HcEntry* ent;
     CellView* view(sac::Engine&) const { return &pg->view; }
     const Box<2>& box() const noexcept { return pg->box(); }
+    const CellDirectory& dir() const noexcept { return *pg->dir; }
     bool run(sac::Engine& e, CellView& v) const {
       const int j = cs->j;
       if (!v.kept()) pg->go_on = pg->q.collect(ent->v, j, ent->birth, pg->pairs);
@@ -524,6 +526,7 @@ struct HpuCellsProgram {
     Ctx c;
     CellView* view(sac::Engine&) const { return &c.pg->view; }
     const Box<2>& box() const noexcept { return c.pg->box(); }
+    const CellDirectory& dir() const noexcept { return *c.pg->dir; }
     bool run(sac::Engine& e, CellView& v) const {
       HpuCellsProgram* pg = c.pg;
       if (!v.kept()) pg->decision = pg->q.decide(c.pc->p, c.pc->q, c.cs->j);
@@ -581,6 +584,7 @@ struct HpuCellsProgram {
     K k;
     CellView* view(sac::Engine&) const { return &pg->view; }
     const Box<2>& box() const noexcept { return pg->box(); }
+    const CellDirectory& dir() const noexcept { return *pg->dir; }
     bool run(sac::Engine& e, CellView& v) const {
       if (!v.kept()) std::tie(pg->at_node, pg->at_state) = v.locate(pg->dir->position(x->p), scale_of(j));
       if (!v.done()) return false;
@@ -646,6 +650,7 @@ struct HpuCellsProgram {
     HV a;
     CellView* view(sac::Engine&) const { return &pg->view; }
     const Box<2>& box() const noexcept { return pg->box(); }
+    const CellDirectory& dir() const noexcept { return *pg->dir; }
     bool run(sac::Engine& e, CellView& v) const {
       const double scale = std::ldexp(pg->box().side, -n->key.level) / 4;
       if (!v.kept()) {

@@ -43,7 +43,11 @@
 // modifiable; a write inside propagate() also finds the older version's readers timed after
 // it: by walking the trace up to the next version when that is at most 64 events away (a
 // re-executed write), else by scanning the older version's readers;
-// propagate() O(trace distance x log(queue size)) for monotone programs.
+// propagate() O(trace distance x log(queue size)) for monotone programs. A read is affected
+// by what it sees when propagation reaches it, not by each change on the way: the queue
+// keeps, per changed slot, the version it had seen (undone versions, and the old values
+// set() replaced, are freed when propagate() ends), so a change undone or redone before
+// its time costs no re-execution.
 // The machinery (records, ops tables, order list, queue, pool, trampoline) is in sac/detail/.
 #pragma once
 
@@ -156,8 +160,36 @@ class Engine {
   /// identity), and affected() must answer from them as they were when body last ran. It
   /// runs during propagate() and in set(), so it must not call the engine. O(1) per changed
   /// slot, plus affected().
+  ///
+  /// A read that can follow its values: when the closure also has
+  ///   const Mod<T>* follow(std::size_t i, const T& seen, const T& now, const Engine::At& at) const,
+  /// and a change of mods[i]'s value from `seen` (what body last ran on) to `now` affects
+  /// body, propagate() first asks follow(), when it reaches the read. It may name another
+  /// modifiable m whose value at the read's time (at.value(m), not null) holds everything
+  /// body used of `seen`; slot i then reads m instead (body's span shows m's value from then
+  /// on), and body is not re-run for this change. The closure changes its own state for
+  /// slot i to m's terms before it returns m (as affected()'s, it is the read's own state).
+  /// null: re-run. A change made by set() is asked too when T is swappable (set() keeps
+  /// the old value until propagate() ends). Like affected(), it must not call the engine,
+  /// at.value() apart.
   template <class T, class F>
   void read_many(std::span<const Mod<T>* const> mods, F&& body);
+
+  /// The time of a read whose closure follow() is asked (read_many): the values there.
+  class At {
+   public:
+    At(const Engine& e, const detail::ReadNode* r) : e_(&e), r_(r) {}
+    /// The value of m visible at the read's time; null when m has no version there.
+    template <class T>
+    const T* value(const Mod<T>& m) const {
+      const detail::VersionBase* v = e_->visible(m, &r_->start);
+      return v ? &static_cast<const detail::Version<T>*>(v)->value : nullptr;
+    }
+
+   private:
+    const Engine* e_;
+    const detail::ReadNode* r_;
+  };
   template <class T, class F>
   void read_many(std::initializer_list<const Mod<T>*> mods, F&& body) {
     read_many(std::span<const Mod<T>* const>(mods.begin(), mods.size()), std::forward<F>(body));
@@ -253,7 +285,21 @@ class Engine {
   friend struct EngineTestAccess;
 
   // A queued read waits with the modifiable it reads (ReadNode does not keep it).
-  using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits, const ModBase*>;
+  static constexpr std::uint32_t kSeenNone = 0xffffffffu, kSeenForced = 0xfffffffeu;
+  /// What a queued read waits with: the modifiable of a plain read (null for a multi-read),
+  /// and the head of its list in seen_ (kSeenForced: re-run it whatever it sees).
+  struct QueueAux {
+    const ModBase* mod = nullptr;
+    std::uint32_t seen = kSeenForced;
+  };
+  using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits, QueueAux>;
+  /// A slot of a queued read whose value changed after its last execution, and the version
+  /// it had seen then (or one equal to it in what the read depends on).
+  struct Seen {
+    const detail::VersionBase* v;
+    std::uint32_t slot;  // 0 for a plain read
+    std::uint32_t next;  // the read's next entry, or kSeenNone
+  };
 
   // Work of the trampoline (sac/detail/trampoline.hpp).
   using TaskKind = detail::TaskKind;
@@ -334,8 +380,10 @@ class Engine {
   void link_memo(detail::MemoNode* n, std::size_t h);
   /// Makes fresh m's base value: a new base version, or, with `assign`, moved into the base
   /// version m has (nothing happens when the values are equal, and readers the change
-  /// affects are queued).
-  void set_base(ModBase& m, detail::VersionBase* fresh, void (*assign)(detail::VersionBase*, detail::VersionBase*));
+  /// affects are queued). assign(base, fresh) gives base fresh's value and returns true when
+  /// it swapped them (fresh then holds the old value, which queued readers may keep as what
+  /// they saw: note_change).
+  void set_base(ModBase& m, detail::VersionBase* fresh, bool (*assign)(detail::VersionBase*, detail::VersionBase*));
   detail::ReadNode* find_read_match(const ModBase& m, std::uint32_t ops_id,
                                     const void* closure) const;
   detail::AllocNode* find_alloc_match(const detail::AllocOps* ops, std::size_t h,
@@ -351,12 +399,21 @@ class Engine {
   static void* closure_of(detail::ReadNode* r) { return static_cast<detail::ReadNode*>(r) + 1; }
   void undo_between(Stamp* a, Stamp* b);
   void undo(Stamp* s);
-  /// Queues the read of l, which reads m through l, for re-execution (no-op if queued).
-  /// A multi-read waits with no modifiable: its slots name theirs.
-  void enqueue(detail::ReaderLink* l, const ModBase& m);
-  /// Does a change of the value reader l sees from `before` to `after` (not equal) affect
-  /// it? Always, unless l's read is a read of a projection that says no, or it is queued.
-  static bool affects(detail::ReaderLink* l, const detail::VersionBase* before, const detail::VersionBase* after);
+  /// Reader l of m saw `before` and now sees `after`, a different value. Queues its read
+  /// for re-execution unless it is a read of a projection that says the change does not
+  /// affect it (a multi-read waits with no modifiable: its slots name theirs). With `lazy`,
+  /// `before` stays alive until propagate() ends (undone versions are freed then), and the
+  /// read is re-run only if what it sees when it is popped still differs from `before`:
+  /// the trace before it is final by then, and a change undone or redone in between (a
+  /// version undone and written again) costs no re-execution. A read already queued
+  /// records `before` for a slot not yet recorded. Without `lazy` (a value that will not
+  /// stay alive: a default, a base value of a type set() cannot swap) the read is re-run
+  /// whatever it sees.
+  /// Returns whether it recorded `before`.
+  bool note_change(detail::ReaderLink* l, const ModBase& m, const detail::VersionBase* before,
+                   const detail::VersionBase* after, bool lazy);
+  /// Does r, just popped, see anything other than what it saw when it last ran?
+  bool still_affected(detail::ReadNode* r, const QueueAux& a);
   /// Re-executes r, a read of m (null for a multi-read), inside its own interval (an
   /// affected read just popped).
   void rerun(detail::ReadNode* r, const ModBase* m);
@@ -429,6 +486,8 @@ class Engine {
   detail::IntrusiveHash<detail::AllocNode> allocs_;
   detail::IntrusiveHash<detail::MemoNode> memos_;
   std::vector<detail::AllocNode*> deferred_;   // undone allocations, freed by propagate()
+  std::vector<detail::VersionBase*> dead_versions_;  // undone versions, freed by propagate()
+  std::vector<Seen> seen_;                      // the queued reads' lists (note_change)
   // Keyed allocations of the running run() with their hashes: nothing can look them up
   // before the run ends (there is no re-execution window), so they are indexed in one
   // presized pass at its end, reading this array sequentially and only storing into the
@@ -469,11 +528,14 @@ void Engine::set(Mod<T>& m, U&& value) {
   set_base(m, v, [](detail::VersionBase* old_base, detail::VersionBase* fresh) {
     auto* o = static_cast<V*>(old_base);
     auto* f = static_cast<V*>(fresh);
-    if constexpr (std::is_move_assignable_v<T>) {
-      o->value = std::move(f->value);
+    if constexpr (std::is_swappable_v<T>) {
+      using std::swap;
+      swap(o->value, f->value);
+      return true;
     } else {
       o->value.~T();
       new (&o->value) T(std::move(f->value));
+      return false;
     }
   });
 }

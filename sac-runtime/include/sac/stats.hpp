@@ -23,6 +23,12 @@ struct Stats {
   std::uint64_t queue_pushes = 0;
   std::uint64_t queue_pops = 0;
   std::uint64_t queue_removes = 0;
+  /// Reads popped that saw, at their time, what they had seen when they last ran (a change
+  /// undone, or redone to an equal value, before propagation reached them): not re-executed.
+  std::uint64_t reads_unaffected = 0;
+  /// Slots of multi-reads moved to another modifiable by their closure's follow() instead of
+  /// re-running (Engine::read_many).
+  std::uint64_t reads_followed = 0;
   std::uint64_t propagations = 0;
   std::uint64_t live_events = 0;
   /// Trace distance (created + undone) of the last propagate().
@@ -35,7 +41,8 @@ struct Stats {
               << " reexecuted=" << s.reads_reexecuted << " memo_hits=" << s.memo_hits
               << " memo_misses=" << s.memo_misses << " alloc_reuses=" << s.alloc_reuses
               << " queue_pushes=" << s.queue_pushes << " queue_pops=" << s.queue_pops
-              << " queue_removes=" << s.queue_removes << " live_events=" << s.live_events
+              << " queue_removes=" << s.queue_removes << " unaffected=" << s.reads_unaffected
+              << " followed=" << s.reads_followed << " live_events=" << s.live_events
               << " last_trace_distance=" << s.last_trace_distance;
   }
 };

@@ -119,6 +119,13 @@ concept ProjectedRead = requires(const F& f, std::size_t i, const T& a, const T&
   { f.affected(i, a, b) } -> std::convertible_to<bool>;
 };
 
+/// Can closure F of a multi-read of T values move a slot to another modifiable rather than
+/// re-run (Engine::read_many)? E is the Engine, complete where this is asked.
+template <class F, class T, class E>
+concept FollowingRead = requires(const F& f, std::size_t i, const T& a, const T& b, const typename E::At& at) {
+  { f.follow(i, a, b, at) } -> std::convertible_to<const ModBase*>;
+};
+
 /// A multi-read of k modifiables of type T with closure F (ReadManyHeader): the body gets
 /// (Engine&,) std::span<const T* const> of the k values, in the order of the modifiables.
 template <class T, class F>
@@ -149,13 +156,22 @@ struct ReadManyOpsFor {
     else
       return true;
   }
+  template <class E>
+  static const ModBase* follow(E& e, ReadNode* r, std::uint32_t i, const VersionBase* seen, const VersionBase* now) {
+    if constexpr (FollowingRead<F, T, E>)
+      return closure(r)->follow(i, static_cast<const Version<T>*>(seen)->value,
+                                static_cast<const Version<T>*>(now)->value, typename E::At(e, r));
+    else
+      return nullptr;
+  }
   static constexpr ReadOps ops{nullptr,
                                &destroy,
                                nullptr,
                                &VersionOpsFor<T>::ops,
                                static_cast<std::uint32_t>(sizeof(ReadManyHeader) + sizeof(F)),
                                &invoke_many,
-                               ProjectedRead<F, T> ? &affected : nullptr};
+                               ProjectedRead<F, T> ? &affected : nullptr,
+                               FollowingRead<F, T, Engine> ? &follow<Engine> : nullptr};
   static std::uint32_t id() {
     static const std::uint32_t i = register_read_ops(&ops);
     return i;

@@ -50,6 +50,8 @@ class StampQueue {
   }
 
   void remove(T* t) { remove_at(Traits::pos(t)); }
+  /// The Aux of t, which is queued.
+  Aux& aux(const T* t) { return heap_[Traits::pos(t)].aux; }
 
   std::size_t memory_bytes() const { return heap_.capacity() * sizeof(Entry); }
 

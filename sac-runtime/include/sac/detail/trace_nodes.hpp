@@ -95,6 +95,11 @@ struct ReadOps {
   /// replacing the value slot i sees, `before`, by `after` change what the body depends on?
   /// Null: every change does.
   bool (*affected)(const ReadNode*, std::uint32_t slot, const VersionBase* before, const VersionBase* after) = nullptr;
+  /// A multi-read whose closure has follow(): after a change of slot i from `seen` to `now`
+  /// that affects it, the modifiable that holds what it used of `seen` at its time, which
+  /// slot i then reads instead of re-running; null: re-run. Null: never.
+  const ModBase* (*follow)(Engine&, ReadNode*, std::uint32_t slot, const VersionBase* seen,
+                           const VersionBase* now) = nullptr;
 };
 
 /// The read ops tables by number, so that a read stores 4 bytes for its ops instead of 8.
