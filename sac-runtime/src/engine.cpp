@@ -467,7 +467,7 @@ void Engine::execute(const Task& t) {
         ReadNode* r = queue_.pop(&a);
         ++stats_.queue_pops;
         tasks_.push_back(t);  // drain on after this re-execution
-        if (still_affected(r, a)) rerun(r, a.mod);
+        if (a.forced() || still_affected(r, a)) rerun(r, a.mod());
       } else {
         now_ = end;
       }
@@ -501,45 +501,50 @@ void Engine::discard_pending() noexcept {
 bool Engine::note_change(ReaderLink* l, const ModBase& m, const VersionBase* before, const VersionBase* after,
                          bool lazy) {
   ReadNode* r = owner_of(l);
-  const std::uint32_t slot = detail::is_slot(l) ? l->qpos : 0;
   if (r->link.qpos != kNotQueued) {  // queued already (a multi-read with several changed slots)
     QueueAux& a = queue_.aux(r);
+    if (a.forced()) return false;  // a plain read's always is: it re-runs
     if (!lazy) {
-      a.seen = kSeenForced;
+      a.force();
       return false;
     }
-    if (a.seen == kSeenForced) return false;
-    for (std::uint32_t i = a.seen; i != kSeenNone; i = seen_[i].next)
-      if (seen_[i].slot == slot) return false;  // what it saw last is recorded
-    seen_.push_back(Seen{before, slot, a.seen});
-    a.seen = static_cast<std::uint32_t>(seen_.size() - 1);
+    const std::uint32_t slot = l->qpos;  // a listed read is a multi-read
+    a.mark_again();
+    for (std::uint32_t i = a.seen(); i != kSeenNone; i = seen_[i].next)
+      if (seen_[i].slot == slot) {  // what it saw last is recorded
+        seen_[i].now = after;
+        return false;
+      }
+    seen_.push_back(Seen{before, after, slot, a.seen()});
+    a.prepend(static_cast<std::uint32_t>(seen_.size() - 1));
     return true;
   }
+  const std::uint32_t slot = detail::is_slot(l) ? l->qpos : 0;
   const auto f = r->ops()->affected;
-  if (f && !f(r, slot, before, after)) return false;
-  std::uint32_t head = kSeenForced;
-  if (lazy) {
-    seen_.push_back(Seen{before, slot, kSeenNone});
-    head = static_cast<std::uint32_t>(seen_.size() - 1);
+  if (f && after && !f(r, slot, before, after)) return false;  // no `after`: a default, re-run
+  // A plain read is not listed: its value changed and it re-runs; a record per change
+  // would cost it more than it saves.
+  QueueAux a = QueueAux::read_of(detail::is_slot(l) ? nullptr : &m);
+  if (lazy && f) {
+    seen_.push_back(Seen{before, after, slot, kSeenNone});
+    a = QueueAux::listed(static_cast<std::uint32_t>(seen_.size() - 1));
   }
-  queue_.push(r, QueueAux{detail::is_slot(l) ? nullptr : &m, head});
+  queue_.push(r, a);
   ++stats_.queue_pushes;
-  return lazy;
+  return !a.forced();
 }
 
 bool Engine::still_affected(ReadNode* r, const QueueAux& a) {
-  if (a.seen == kSeenForced) return true;
+  // Queued by one change that affected it, and none since: it is, unless it can follow.
+  if (!a.again() && !r->ops()->follow) return true;
   const auto f = r->ops()->affected;
-  for (std::uint32_t i = a.seen; i != kSeenNone; i = seen_[i].next) {
+  for (std::uint32_t i = a.seen(); i != kSeenNone; i = seen_[i].next) {
     const Seen& s = seen_[i];
-    const ModBase& m = a.mod ? *a.mod : *detail::many_of(r)->slots()[s.slot].mod;
-    const VersionBase* now = visible(m, &r->start);
+    const VersionBase* now = s.now;
     if (now == s.v) continue;
-    // A default seen or seen now (no version to compare): re-run, as before.
-    if (!now || !s.v || m.default_only()) return true;
     if (now->ops->equal(now, s.v)) continue;
     if (f && !f(r, s.slot, s.v, now)) continue;
-    const ModBase* to = (a.mod || !r->ops()->follow) ? nullptr : r->ops()->follow(*this, r, s.slot, s.v, now);
+    const ModBase* to = r->ops()->follow ? r->ops()->follow(*this, r, s.slot, s.v, now) : nullptr;
     if (!to) return true;
     // The slot reads `to` from now on, with no re-execution.
     ReadSlot& sl = detail::many_of(r)->slots()[s.slot];
@@ -587,8 +592,8 @@ void Engine::propagate() {
       QueueAux a;
       ReadNode* r = queue_.pop(&a);
       ++stats_.queue_pops;
-      if (!still_affected(r, a)) continue;
-      rerun(r, a.mod);
+      if (!a.forced() && !still_affected(r, a)) continue;
+      rerun(r, a.mod());
       drain(0);
     }
   } catch (...) {
@@ -756,8 +761,8 @@ void Engine::undo(Stamp* s) {
           r = nx;
         }
       }
-      // A queued read may have seen v (note_change): freed once propagate() ends.
-      if (in_computation_) dead_versions_.push_back(v);
+      // A queued read may have seen v, or see it (note_change): freed once propagate() ends.
+      if (in_computation_ && !seen_.empty()) dead_versions_.push_back(v);
       else destroy(v);
     } else if constexpr (K == StampKind::Alloc) {
       AllocNode* n = rec;

@@ -43,11 +43,11 @@
 // modifiable; a write inside propagate() also finds the older version's readers timed after
 // it: by walking the trace up to the next version when that is at most 64 events away (a
 // re-executed write), else by scanning the older version's readers;
-// propagate() O(trace distance x log(queue size)) for monotone programs. A read is affected
-// by what it sees when propagation reaches it, not by each change on the way: the queue
-// keeps, per changed slot, the version it had seen (undone versions, and the old values
-// set() replaced, are freed when propagate() ends), so a change undone or redone before
-// its time costs no re-execution.
+// propagate() O(trace distance x log(queue size)) for monotone programs. A read of a
+// projection is affected by what it sees when propagation reaches it, not by each change on
+// the way: the queue keeps, per changed slot, the version it had seen (undone versions, and
+// the old values set() replaced, are then freed when propagate() ends), so a change undone
+// or redone before its time costs no re-execution.
 // The machinery (records, ops tables, order list, queue, pool, trampoline) is in sac/detail/.
 #pragma once
 
@@ -284,19 +284,40 @@ class Engine {
   // and see check_invariants() fail. Nothing else may define it.
   friend struct EngineTestAccess;
 
-  // A queued read waits with the modifiable it reads (ReadNode does not keep it).
-  static constexpr std::uint32_t kSeenNone = 0xffffffffu, kSeenForced = 0xfffffffeu;
-  /// What a queued read waits with: the modifiable of a plain read (null for a multi-read),
-  /// and the head of its list in seen_ (kSeenForced: re-run it whatever it sees).
-  struct QueueAux {
-    const ModBase* mod = nullptr;
-    std::uint32_t seen = kSeenForced;
+  static constexpr std::uint32_t kSeenNone = 0xffffffffu;
+  /// What a queued read waits with, in 8 bytes (a heap entry stays 16): a plain read, the
+  /// modifiable it reads (ReadNode does not keep it); a multi-read, none (its slots name
+  /// theirs) and, when it reads a projection, the head of its list in seen_ (note_change)
+  /// and whether a slot changed again after it was queued (the list is then not what
+  /// note_change() found affected when it queued it, and only then can popping find it
+  /// unaffected). Forced: re-run it whatever it sees.
+  class QueueAux {
+   public:
+    QueueAux() = default;
+    static QueueAux read_of(const ModBase* m) { return QueueAux(reinterpret_cast<std::uintptr_t>(m)); }
+    static QueueAux listed(std::uint32_t head) { return QueueAux((std::uintptr_t{head} << 32) | kListed); }
+    const ModBase* mod() const { return (bits_ & kListed) ? nullptr : reinterpret_cast<const ModBase*>(bits_); }
+    bool forced() const { return !(bits_ & kListed); }
+    std::uint32_t seen() const { return static_cast<std::uint32_t>(bits_ >> 32); }
+    bool again() const { return bits_ & kAgain; }
+    void force() { bits_ = 0; }  // a multi-read's (a plain read is never listed)
+    void prepend(std::uint32_t head) { bits_ = (std::uintptr_t{head} << 32) | (bits_ & 0xffffffffu); }
+    void mark_again() { bits_ |= kAgain; }
+
+   private:
+    explicit QueueAux(std::uintptr_t b) : bits_(b) {}
+    static constexpr std::uintptr_t kListed = 1, kAgain = 2;  // a ModBase* is 8-aligned
+    std::uintptr_t bits_ = 0;
   };
+  static_assert(sizeof(std::uintptr_t) == 8);
   using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits, QueueAux>;
   /// A slot of a queued read whose value changed after its last execution, and the version
   /// it had seen then (or one equal to it in what the read depends on).
   struct Seen {
     const detail::VersionBase* v;
+    // What the slot sees now: the version note_change() last moved it onto, or one equal to
+    // it (a move to an equal value is not noted), so popping needs no walk of the versions.
+    const detail::VersionBase* now;
     std::uint32_t slot;  // 0 for a plain read
     std::uint32_t next;  // the read's next entry, or kSeenNone
   };
@@ -401,7 +422,8 @@ class Engine {
   void undo(Stamp* s);
   /// Reader l of m saw `before` and now sees `after`, a different value. Queues its read
   /// for re-execution unless it is a read of a projection that says the change does not
-  /// affect it (a multi-read waits with no modifiable: its slots name theirs). With `lazy`,
+  /// affect it (a multi-read waits with no modifiable: its slots name theirs). For a read of
+  /// a projection with `lazy`,
   /// `before` stays alive until propagate() ends (undone versions are freed then), and the
   /// read is re-run only if what it sees when it is popped still differs from `before`:
   /// the trace before it is final by then, and a change undone or redone in between (a
