@@ -318,7 +318,7 @@ class Engine {
     // What the slot sees now: the version note_change() last moved it onto, or one equal to
     // it (a move to an equal value is not noted), so popping needs no walk of the versions.
     const detail::VersionBase* now;
-    std::uint32_t slot;  // 0 for a plain read
+    std::uint32_t slot;  // its index in the multi-read (only multi-reads are listed)
     std::uint32_t next;  // the read's next entry, or kSeenNone
   };
 
@@ -422,16 +422,15 @@ class Engine {
   void undo(Stamp* s);
   /// Reader l of m saw `before` and now sees `after`, a different value. Queues its read
   /// for re-execution unless it is a read of a projection that says the change does not
-  /// affect it (a multi-read waits with no modifiable: its slots name theirs). For a read of
-  /// a projection with `lazy`,
-  /// `before` stays alive until propagate() ends (undone versions are freed then), and the
-  /// read is re-run only if what it sees when it is popped still differs from `before`:
-  /// the trace before it is final by then, and a change undone or redone in between (a
-  /// version undone and written again) costs no re-execution. A read already queued
-  /// records `before` for a slot not yet recorded. Without `lazy` (a value that will not
-  /// stay alive: a default, a base value of a type set() cannot swap) the read is re-run
-  /// whatever it sees.
-  /// Returns whether it recorded `before`.
+  /// affect it (a multi-read waits with no modifiable: its slots name theirs). A read of a
+  /// projection, with `lazy`, is listed: `before` stays alive until propagate() ends
+  /// (undone versions are freed then), and the read is re-run only if what it sees when it
+  /// is popped still differs from `before` (or a follow() fails): the trace before it is
+  /// final by then, and a change undone or redone in between (a version undone and written
+  /// again) costs no re-execution. A listed read already queued records `before` for a
+  /// slot not yet recorded, and what the slot sees now. Without `lazy` (a value that will
+  /// not stay alive: a default, a base value of a type set() cannot swap) and for a plain
+  /// read, it is re-run whatever it sees. Returns whether it recorded `before`.
   bool note_change(detail::ReaderLink* l, const ModBase& m, const detail::VersionBase* before,
                    const detail::VersionBase* after, bool lazy);
   /// Does r, just popped, see anything other than what it saw when it last ran?
