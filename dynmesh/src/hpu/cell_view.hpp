@@ -13,7 +13,11 @@
 // and it re-runs only when what it used of one of them changes: each read is a read of a
 // projection (Engine::read_many with affected()) that keeps, per cell, the box of the
 // vertices the step's searches could see (CellInterest); a vertex entering or leaving the
-// cell outside it is no change, a split or a merge always is.
+// cell outside it is no change, nor is anything in a cell the step used none of. A leaf that
+// split or merged away moves the read to the cell that now holds the used box, when the
+// vertices inside it are the same (follow_cell, Engine::read_many's follow()); else the step
+// re-runs. The runtime asks when propagation reaches the read, so a change undone before
+// then costs nothing.
 // Which cells a step depends on: the leaves a search hands vertices from, a split cell whose
 // children it all prunes, and the leaf an insertion locates. The leaves tile the region the
 // search covers, so any change there (a vertex, a split, a merge) changes one of them; the
