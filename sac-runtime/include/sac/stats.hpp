@@ -23,8 +23,9 @@ struct Stats {
   std::uint64_t queue_pushes = 0;
   std::uint64_t queue_pops = 0;
   std::uint64_t queue_removes = 0;
-  /// Reads popped that saw, at their time, what they had seen when they last ran (a change
-  /// undone, or redone to an equal value, before propagation reached them): not re-executed.
+  /// Reads of a projection popped and not re-executed: at their time, each changed slot
+  /// showed what the read had seen when it last ran (a change undone, or redone to an equal
+  /// value, before propagation reached it), or follow() moved it (reads_followed).
   std::uint64_t reads_unaffected = 0;
   /// Slots of multi-reads moved to another modifiable by their closure's follow() instead of
   /// re-running (Engine::read_many).
