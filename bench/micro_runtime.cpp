@@ -255,6 +255,82 @@ void BM_EngineMemoMapPropagate(benchmark::State& state) {
 }
 BENCHMARK(BM_EngineMemoMapPropagate)->Arg(1 << 10)->Arg(1 << 16);
 
+// The same map with each element's own work (64 multiply-adds) memoized apart from the list
+// step, on the element alone: memo() (Near = false) or memo_near(16). The list steps' keys
+// hold the element and its predecessor, so only the work's reuse can reach far. Each iteration moves a random element to a random
+// place and back: four places change, the moved element's work is far from its old call.
+struct NearOut {
+  long value = 0;
+  Mod<long> work;
+  Mod<NearOut*> next;
+};
+void near_work(Engine& e, Cell* c, NearOut* o) {
+  long x = c->value;
+  for (int k = 0; k < 64; ++k) x = x * 6364136223846793005L + 1442695040888963407L;
+  e.write(o->work, x);
+}
+// pred, grand: the two elements before c (the key of the read of c->next holds c and pred).
+template <bool Near>
+void near_step(Engine& e, Cell* c, Mod<NearOut*>* dst, Cell* pred, Cell* grand) {
+  (void)grand;
+  if (!c) return e.write(*dst, static_cast<NearOut*>(nullptr));
+  NearOut* o = e.alloc<NearOut>(c->id);
+  e.write(*dst, o);
+  if constexpr (Near) e.memo_near(16, sac::fn<near_work>(c, o));
+  else e.memo(sac::fn<near_work>(c, o));
+  e.memo_read(c->next, sac::fn<near_step<Near>>(&o->next, c, pred));
+}
+
+template <bool Near>
+void BM_EngineMemoNearMove(benchmark::State& state) {
+  const auto n = static_cast<std::size_t>(state.range(0));
+  Engine e;
+  Mod<Cell*> head;
+  Mod<NearOut*> out;
+  std::vector<std::unique_ptr<Cell>> cells;
+  std::vector<Cell*> order;
+  for (std::size_t i = 0; i < n; ++i) {
+    cells.push_back(std::make_unique<Cell>(static_cast<int>(i), i));
+    order.push_back(cells.back().get());
+  }
+  const auto relink = [&] {
+    e.set(head, order.front());
+    for (std::size_t i = 0; i < n; ++i) e.set(order[i]->next, i + 1 < n ? order[i + 1] : nullptr);
+  };
+  relink();
+  // After a move between places a and b, only the links around them can differ.
+  const auto fix = [&](std::size_t a, std::size_t b) {
+    e.set(head, order.front());
+    for (const std::size_t p : {a, b})
+      for (std::size_t i = p >= 2 ? p - 2 : 0; i < std::min(n, p + 2); ++i)
+        e.set(order[i]->next, i + 1 < n ? order[i + 1] : nullptr);
+  };
+  e.run([&](Engine& en) { en.memo_read(head, sac::fn<near_step<Near>>(&out, static_cast<Cell*>(nullptr), static_cast<Cell*>(nullptr))); });
+  std::mt19937_64 rng(5);
+  const std::uint64_t d0 = e.stats().events_created + e.stats().events_undone;
+  std::uint64_t propagations = 0;
+  for (auto _ : state) {
+    const std::size_t from = rng() % n, to = rng() % n;
+    Cell* c = order[from];
+    order.erase(order.begin() + static_cast<long>(from));
+    order.insert(order.begin() + static_cast<long>(to), c);
+    fix(from, to);
+    e.propagate();
+    order.erase(order.begin() + static_cast<long>(to));
+    order.insert(order.begin() + static_cast<long>(from), c);
+    fix(from, to);
+    e.propagate();
+    propagations += 2;
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(propagations));
+  state.counters["distance_per_propagate"] =
+      propagations ? static_cast<double>(e.stats().events_created + e.stats().events_undone - d0) /
+                         static_cast<double>(propagations)
+                   : 0.0;
+}
+BENCHMARK_TEMPLATE(BM_EngineMemoNearMove, true)->Arg(1 << 10)->Arg(1 << 14);
+BENCHMARK_TEMPLATE(BM_EngineMemoNearMove, false)->Arg(1 << 10)->Arg(1 << 14);
+
 // Steps that each read k = 4 modifiables (step i: in[i..i+3] cyclically, overlapping as the
 // mesh's neighbouring cells do) and write their sum: one read_many, or 4 nested reads.
 constexpr int kManyK = 4;

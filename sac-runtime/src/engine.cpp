@@ -390,11 +390,11 @@ void Engine::push_close(Stamp* end, TaskKind kind, void* node) {
     Task& top = tasks_.back();
     end->link = reinterpret_cast<std::uintptr_t>(top.node) |
                 (top.kind == TaskKind::CloseMemo ? std::uintptr_t{1} : 0);
-    top = Task{kind, node};
+    top = Task{kind, 0, node};
     return;
   }
   end->link = 0;
-  tasks_.push_back(Task{kind, node});
+  tasks_.push_back(Task{kind, 0, node});
 }
 
 void Engine::close_chain(TaskKind kind, void* node) {
@@ -434,7 +434,12 @@ void Engine::execute(const Task& t) {
       auto* n = static_cast<MemoNode*>(t.node);
       const std::size_t h = n->ops->hash(n);
       if (window_end_) {
-        if (MemoNode* hit = find_memo_match(n->ops, h, reinterpret_cast<const MemoNode*>(n) + 1)) {
+        MemoNode* hit = find_memo_match(n->ops, h, reinterpret_cast<const MemoNode*>(n) + 1);
+        if (hit && t.arg != detail::kAnyDistance && !within(now_, &hit->start, t.arg)) {
+          hit = nullptr;
+          ++stats_.memo_far;
+        }
+        if (hit) {
           destroy(n);
           memo_hit(&hit->start, &hit->end);
           break;
@@ -561,7 +566,7 @@ bool Engine::still_affected(ReadNode* r, const QueueAux& a) {
 
 void Engine::rerun(ReadNode* r, const ModBase* mp) {
   reruns_.push_back(RerunContext{now_, window_end_});
-  tasks_.push_back(Task{TaskKind::FinishRerun, r});
+  tasks_.push_back(Task{TaskKind::FinishRerun, 0, r});
   now_ = &r->start;
   window_end_ = &r->end;
   ++stats_.reads_reexecuted;
@@ -665,10 +670,17 @@ MemoNode* Engine::find_memo_match(const detail::MemoOps* ops, std::size_t h,
       [&](const MemoNode* n) { return n->ops == ops && ops->equal(n, closure); });
 }
 
+bool Engine::within(const Stamp* from, const Stamp* to, std::uint32_t k) const noexcept {
+  const Stamp* s = from->next();
+  for (std::uint32_t i = 0; s && i <= k; ++i, s = s->next())
+    if (s == to) return true;
+  return false;
+}
+
 void Engine::memo_hit(Stamp* start, Stamp* end) {
   ++stats_.memo_hits;
   undo_between(now_, start);
-  tasks_.push_back(Task{TaskKind::DrainUntil, end});
+  tasks_.push_back(Task{TaskKind::DrainUntil, 0, end});
 }
 
 void Engine::reuse_alloc(AllocNode* n) {

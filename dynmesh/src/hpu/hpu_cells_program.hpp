@@ -89,6 +89,14 @@ struct HcEntry {
   sac::Mod<HcEntry*> cont;  // its collect's continuation into Q_{j+1} (null: none)
 };
 
+/// The births of one pair's tries, in order: the first, and the last one's `next` (where
+/// the births after them link in). head null: none.
+struct HcBirths {
+  HcEntry* head = nullptr;
+  sac::Mod<HcEntry*>* tail = nullptr;
+  friend bool operator==(const HcBirths&, const HcBirths&) = default;
+};
+
 /// A collected pair p→q, keyed by (its collector's entry, p, q).
 struct HcPair {
   HcPair(HV a, HV b) : p(a), q(b) {}
@@ -97,6 +105,7 @@ struct HcPair {
   HV p;
   HV q;
   sac::Mod<HcPair*> next;
+  sac::Mod<HcBirths> births;  // its tries' births (try_pair)
 };
 
 /// An initial vertex, keyed by it: its class, and the rest of the list.
@@ -439,14 +448,14 @@ struct HpuCellsProgram {
     }
   };
 
-  /// The collect of ent, memoized apart from the list step: its key holds no destination,
-  /// but it holds ent's place (the entry before it). Without it, an entry that an update
-  /// moved matched its old collect far ahead, and the memo hit discarded all the trace in
-  /// between (a deletion at uniform 32,000 re-ran 10,020 collects). With the entry before
-  /// that one too, collects re-ran a fifth more often.
-  static void collect_entry(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcRound* rs, HcEntry* ent,
-                            HcEntry* owner) {
-    (void)owner;
+  /// The collect of ent, memoized apart from the list step: its key holds no destination
+  /// and no place, so an entry that an update gave another predecessor keeps its collect.
+  /// The old call is reused only when it is at most kCollectReach stamps ahead
+  /// (Engine::memo_near): an entry that an update moved matched its old collect far ahead,
+  /// and the hit discarded all the trace in between (a deletion at uniform 32,000 re-ran
+  /// 10,020 collects when the key held ent alone and the reuse had no bound).
+  static constexpr std::uint32_t kCollectReach = 64;
+  static void collect_entry(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcRound* rs, HcEntry* ent) {
     run_step(e, CollectStep{pg, cs, rs, ent});
   }
 
@@ -462,7 +471,7 @@ struct HpuCellsProgram {
     // goes changes it for every entry up to the next one that continues. So the collect
     // itself is a memo of its own, which such a change re-runs as a hit, and only this
     // link step runs again.
-    e.memo(sac::fn<&collect_entry>(pg, cs, rs, ent, owner));
+    e.memo_near(kCollectReach, sac::fn<&collect_entry>(pg, cs, rs, ent));
     e.read(ent->cont, [pg, cs, rs, cdest, ent, owner](sac::Engine& e2, HcEntry* c) {
       sac::Mod<HcEntry*>* cd = cdest;
       if (c) {
@@ -475,16 +484,15 @@ struct HpuCellsProgram {
 
   // ---------------------------------------------------------------- process
 
-  /// Where a pair's processing stands: the pair and the births' tail.
+  /// Where a pair's tries stand: the pair, and the births so far (the first, and where the
+  /// next goes; null: none yet).
   struct Ctx {
     HpuCellsProgram* pg;
     HcClass* cs;
     HcRound* rs;
     HcPair* pc;
+    HcEntry* head;
     sac::Mod<HcEntry*>* bdest;
-    HcPair* prev;       // the pair before pc in its entry's list (null: pc is first)
-    HcEntry* ent;       // pc's entry
-    HcEntry* ent_prev;  // the entry before it (null: ent is first)
   };
 
   static void process_entry(sac::Engine& e, HcEntry* nent, HpuCellsProgram* pg, HcClass* cs, HcRound* rs,
@@ -499,18 +507,34 @@ struct HpuCellsProgram {
                            HcPair* owner_pred) {
     (void)owner_pred;
     if (!pc) return e.memo_read(ent->next, sac::fn<&process_entry>(pg, cs, rs, bdest, ent, ent_prev));
-    run_step(e, TryStep{Ctx{pg, cs, rs, pc, bdest, owner, ent, ent_prev}});
+    // The tries are a memo of their own, as a collect is: their key holds neither the births'
+    // tail nor the pair's place, which an earlier pair's births or an update to the lists
+    // change for every pair after it. They hand their births over in pc->births, and only
+    // this link step runs again for such a change.
+    e.memo_near(kTryReach, sac::fn<&try_pair>(pg, cs, rs, pc));
+    e.read(pc->births, [pg, cs, rs, bdest, ent, ent_prev, pc, owner](sac::Engine& e2, const HcBirths& b) {
+      sac::Mod<HcEntry*>* bd = bdest;
+      if (b.head) {
+        e2.write(*bd, b.head);
+        bd = b.tail;
+      }
+      e2.memo_read(pc->next, sac::fn<&process_step>(pg, cs, rs, bd, ent, ent_prev, pc, owner));
+    });
   }
 
-  /// The pair is done: the next one.
-  static void done(sac::Engine& e, const Ctx& c) {
-    e.memo_read(c.pc->next, sac::fn<&process_step>(c.pg, c.cs, c.rs, c.bdest, c.ent, c.ent_prev, c.pc, c.prev));
+  static constexpr std::uint32_t kTryReach = 64;
+  static void try_pair(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcRound* rs, HcPair* pc) {
+    run_step(e, TryStep{Ctx{pg, cs, rs, pc, nullptr, nullptr}});
   }
 
-  /// x was inserted: its birth entry joins the next round.
+  /// The pair is done: its births go to the link step.
+  static void done(sac::Engine& e, const Ctx& c) { e.write(c.pc->births, HcBirths{c.head, c.bdest}); }
+
+  /// x was inserted: its birth entry joins the next round, after the pair's births before it.
   static Ctx birth(sac::Engine& e, Ctx c, HV x) {
     HcEntry* ent = e.alloc<HcEntry>(std::tuple{x, c.cs->j, true}, x, true);
-    e.write(*c.bdest, ent);
+    if (c.head) e.write(*c.bdest, ent);
+    else c.head = ent;
     c.bdest = &ent->next;
     return c;
   }
@@ -633,29 +657,29 @@ struct HpuCellsProgram {
       if (s.kind == CellState::Split) {
         for (unsigned k = 0; k < 4; ++k) e2.memo(sac::fn<&final_node>(pg, pg->dir->node(e2, n->key.child(k))));
       } else if (s.kind == CellState::Leaf) {
-        // One step a vertex, each memoized: when the leaf gains or loses a vertex, the
-        // others' steps are found again with their reads, and a change near one vertex
-        // re-runs its star walk only, not the leaf's.
-        for (std::size_t i = 0; i < s.count; ++i) e2.memo(sac::fn<&final_vertex>(pg, n, s.items[i]));
+        // One step a vertex, each memoized on the vertex alone: when the leaf gains or loses
+        // a vertex, splits or merges, the others' steps are found again with their reads,
+        // and a change near one vertex re-runs its star walk only, not the leaf's.
+        for (std::size_t i = 0; i < s.count; ++i) e2.memo(sac::fn<&final_vertex>(pg, s.items[i]));
       }
     });
   }
 
-  static void final_vertex(sac::Engine& e, HpuCellsProgram* pg, CellNode* n, HV a) { run_step(e, FinalStep{pg, n, a}); }
+  static void final_vertex(sac::Engine& e, HpuCellsProgram* pg, HV a) { run_step(e, FinalStep{pg, a}); }
 
-  /// The triangles whose (x, y)-smallest corner is a (a vertex of leaf n), as one block.
+  /// The triangles whose (x, y)-smallest corner is a, as one block.
   struct FinalStep {
     HpuCellsProgram* pg;
-    CellNode* n;
     HV a;
     CellView* view(sac::Engine&) const { return &pg->view; }
     const Box<2>& box() const noexcept { return pg->box(); }
     const CellDirectory& dir() const noexcept { return *pg->dir; }
     bool run(sac::Engine& e, CellView& v) const {
-      const double scale = std::ldexp(pg->box().side, -n->key.level) / 4;
       if (!v.kept()) {
         pg->block.clear();
-        pg->q.triangles_of(a, scale, pg->tris);
+        // The view's nearest search starts at a's leaf and ignores the scale, so the step
+        // is a function of a alone, whichever leaf holds it.
+        pg->q.triangles_of(a, 0.0, pg->tris);
         for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
       }
       if (!v.done()) return false;

@@ -15,6 +15,7 @@
 //   rt.memo(fn)             memoized call: an equal call of the old trace inside the window is
 //                           reused (trace between is undone, affected reads inside it are
 //                           propagated, execution jumps to its end).
+//   rt.memo_near(k, fn)     memo(fn), reusing an old call only when at most k stamps ahead.
 //   rt.memo_read(m, fn)     read(m, fn) memoized on (m, fn) with no extra record.
 //   rt.read_many(ms, body)  k nested reads as one record and one interval: body(values);
 //                           with body.affected(i, before, after), a read of a projection.
@@ -238,6 +239,15 @@ class Engine {
   template <class F>
   void memo(F&& f);
 
+  /// memo(f), but an old call is reused only when at most max_skip stamps of the old trace
+  /// lie between now and its start (those are undone by the reuse); a call further ahead is
+  /// run anew and left to be undone or reused in its place. For a call whose arguments do
+  /// not say where it stands in a list: a change of its place then costs no re-execution of
+  /// it, and an element moved far ahead is not reused at the price of all between
+  /// (Stats::memo_far counts the calls refused so). O(max_skip) per match.
+  template <class F>
+  void memo_near(std::uint32_t max_skip, F&& f);
+
   // ---------------------------------------------------------------- context
   /// Gives the computation a context: a pointer its bodies reach through the Engine
   /// (context<T>()) instead of carrying it in every closure, for what is the same for the
@@ -369,7 +379,7 @@ class Engine {
   }
 
   // Trace machinery (engine.cpp).
-  void issue(TaskKind k, void* node) { issued_.push_back(Task{k, node}); }
+  void issue(TaskKind k, void* node, std::uint32_t arg = 0) { issued_.push_back(Task{k, arg, node}); }
   void flush_if_pending() {
     if (issued_.size() > body_mark_) [[unlikely]]
       flush();
@@ -417,6 +427,8 @@ class Engine {
   N* earliest_match(Candidates&& candidates, Matches&& matches) const;
   void reuse_alloc(detail::AllocNode* n);
   void memo_hit(Stamp* start, Stamp* end);
+  /// Is `to` at most k stamps after from's successor? O(k).
+  bool within(const Stamp* from, const Stamp* to, std::uint32_t k) const noexcept;
   static void* closure_of(detail::ReadNode* r) { return static_cast<detail::ReadNode*>(r) + 1; }
   void undo_between(Stamp* a, Stamp* b);
   void undo(Stamp* s);
@@ -710,6 +722,11 @@ T* Engine::make(A&&... args) {
 
 template <class F>
 void Engine::memo(F&& f) {
+  memo_near(detail::kAnyDistance, std::forward<F>(f));
+}
+
+template <class F>
+void Engine::memo_near(std::uint32_t max_skip, F&& f) {
   using Fn = std::decay_t<F>;
   using N = detail::MemoNodeT<Fn>;
   static_assert(std::equality_comparable<Fn> && Hashable<Fn>,
@@ -717,7 +734,7 @@ void Engine::memo(F&& f) {
   require_computation("memo");
   N* n = construct<N>(std::forward<F>(f));
   n->ops = &detail::MemoOpsFor<Fn>::ops;
-  issue(TaskKind::ExecMemo, n);
+  issue(TaskKind::ExecMemo, n, max_skip);
 }
 
 template <class Body>

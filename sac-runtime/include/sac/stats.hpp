@@ -19,6 +19,8 @@ struct Stats {
   std::uint64_t reads_reexecuted = 0;
   std::uint64_t memo_hits = 0;
   std::uint64_t memo_misses = 0;
+  /// memo_near calls whose equal old call lay too far ahead (counted in memo_misses too).
+  std::uint64_t memo_far = 0;
   std::uint64_t alloc_reuses = 0;
   std::uint64_t queue_pushes = 0;
   std::uint64_t queue_pops = 0;
@@ -40,7 +42,7 @@ struct Stats {
   friend std::ostream& operator<<(std::ostream& os, const Stats& s) {
     return os << "created=" << s.events_created << " undone=" << s.events_undone
               << " reexecuted=" << s.reads_reexecuted << " memo_hits=" << s.memo_hits
-              << " memo_misses=" << s.memo_misses << " alloc_reuses=" << s.alloc_reuses
+              << " memo_misses=" << s.memo_misses << " memo_far=" << s.memo_far << " alloc_reuses=" << s.alloc_reuses
               << " queue_pushes=" << s.queue_pushes << " queue_pops=" << s.queue_pops
               << " queue_removes=" << s.queue_removes << " unaffected=" << s.reads_unaffected
               << " followed=" << s.reads_followed << " live_events=" << s.live_events

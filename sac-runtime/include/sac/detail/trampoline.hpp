@@ -28,9 +28,14 @@ enum class TaskKind : std::uint8_t {
   DrainUntil     // re-execute the affected reads before a stamp, then continue after it
 };
 
+/// An ExecMemo task's arg: how many stamps of the old trace a reused call may lie ahead of
+/// now (Engine::memo_near); kAnyDistance for memo().
+inline constexpr std::uint32_t kAnyDistance = ~std::uint32_t{0};
+
 struct Task {
   TaskKind kind;
-  void* node;   // the record, or for DrainUntil the stamp to drain up to
+  std::uint32_t arg;  // ExecMemo: the bound above; 0 otherwise (in the padding: 16 bytes)
+  void* node;         // the record, or for DrainUntil the stamp to drain up to
 };
 
 /// The insertion point and window a re-execution replaces, restored when it finishes.
