@@ -30,9 +30,12 @@
 // predecessor's predecessor, and phases that follow a list pass are issued after it as
 // siblings. Q_j's initial entries are the exception: they append at a tail held in a
 // modifiable per (class, block), so a vertex that joins or leaves class j re-runs the next
-// member's append, not every step up to it. Each step reads its cells as a few multi-reads
-// (cell_view.hpp), so its cost is a few events however many vertices it looks at, and it
-// re-runs only when a cell it read changes.
+// member's append, not every step up to it. A step that does not depend on its place (an
+// entry's collect, a pair's tries, a vertex's final triangles) is a memo of its own keyed
+// without it: the collect and the tries with Engine::memo_near, so that an entry that an
+// update moved far runs anew rather than undoing all the trace up to its old step. Each step
+// reads its cells as a few multi-reads (cell_view.hpp), so its cost is a few events however
+// many vertices it looks at, and it re-runs only when a cell it read changes.
 // Invariants: those of the twin's rules; every list is terminated by its pass before a later
 // phase reads it; a vertex has at most one entry per class, so the entry keys are unique in a
 // run; a step writes, allocates and issues only in the round whose view did not fail.
