@@ -181,8 +181,10 @@ TEST(MemoNear, RandomMovesMatchTheExpectedListAndAFromScratchTrace) {
   List l(e, n);
   l.start(16);
   std::vector<Item*> absent;
+  int calls = 0, changes = 0;
   for (int step = 0; step < 300; ++step) {
     const int op = static_cast<int>(rng() % 3);
+    ++changes;
     if (op == 0 && l.order.size() > 1) {  // move one element
       const std::size_t from = rng() % l.order.size();
       Item* it = l.order[from];
@@ -196,13 +198,19 @@ TEST(MemoNear, RandomMovesMatchTheExpectedListAndAFromScratchTrace) {
       Item* it = absent.back();
       absent.pop_back();
       l.order.insert(l.order.begin() + static_cast<long>(rng() % (l.order.size() + 1)), it);
+    } else {
+      --changes;
     }
     const int w0 = g_work;
     l.relink();
     e.propagate();
     expect_healthy(e);
     ASSERT_EQ(l.result(), l.expected()) << "seed " << seed << " step " << step;
-    EXPECT_LE(g_work - w0, 1) << "only an element that moved far or came back runs its call";
+    // The element that moved or came back runs its call anew; a reuse within the reach may
+    // also undo the calls of the elements whose trace lies before it (an element moved two
+    // places earlier: two elements of about 7 stamps each), which then run anew.
+    EXPECT_LE(g_work - w0, 3) << "seed " << seed << " step " << step;
+    calls += g_work - w0;
     if (step % 50 == 49) {
       // The same ids in the same order, on items of its own.
       Engine fresh;
@@ -216,6 +224,8 @@ TEST(MemoNear, RandomMovesMatchTheExpectedListAndAFromScratchTrace) {
       EXPECT_EQ(fresh.live_events(), e.live_events()) << "step " << step;
     }
   }
+  std::printf("MemoNear random differential: %d calls for %d changes\n", calls, changes);
+  EXPECT_LE(calls, changes + changes / 10) << "about one call a change";
 }
 
 }  // namespace
