@@ -4,7 +4,9 @@
 // triangles equal the static twin HpuMesh's on the current points at 20.7°, 25° and 30°;
 // the change feed replays; the engine's, the feed's, the input list's and the store's
 // invariants hold, and the store's newest cells are the static bucket tree of the mesh's
-// vertices; the per-update trace distance is printed against the from-scratch trace.
+// vertices; the per-update trace distance is printed against the from-scratch trace, and
+// stays within budgets on curves and spirals; the collects and tries an update re-runs stay
+// within budgets on uniform points.
 #include "hpu/hpu_cells_program.hpp"
 
 #include <gtest/gtest.h>
