@@ -209,6 +209,7 @@ class CellView {
     pending_.clear();
     if (++gen_ == 0) {
       dir_->clear_marks();
+      start_memo_ = {};
       gen_ = 1;
     }
     read_.clear();
@@ -574,7 +575,7 @@ class CellView {
     std::size_t n = 0;
     for (std::uint64_t iy = a[1] >> s; iy <= b[1] >> s; ++iy)
       for (std::uint64_t ix = a[0] >> s; ix <= b[0] >> s; ++ix) {
-        CellNode* k = deepest_present(CellKey{g, ix, iy});
+        CellNode* k = start_cell(CellKey{g, ix, iy});
         const auto end = out.begin() + static_cast<std::ptrdiff_t>(n);
         if (std::find(out.begin(), end, k) != end) continue;
         double x0, y0, x1, y1;
@@ -589,6 +590,22 @@ class CellView {
         dist[i] = d;
       }
     return n;
+  }
+
+  /// deepest_present(k) for a start cell, remembered for the step: the probes of one
+  /// step (a star walk's left searches around one vertex) ask for the same few cells of a
+  /// level again and again, and the walk to each costs a resolve() per cell on its way.
+  CellNode* start_cell(const CellKey& k) {
+    StartMemo& m = start_memo_[(k.ix * 5 + k.iy * 3 + static_cast<std::uint64_t>(k.level)) & (kStartMemo - 1)];
+    if (m.gen == gen_ && m.level == k.level && m.ix == k.ix && m.iy == k.iy) {
+#ifdef SAC_DEBUG_CHECKS
+      if (m.node != probe_deepest_present(k))
+        throw InvariantError("dynmesh: CellView: a remembered start cell and the lookups disagree");
+#endif
+      return m.node;
+    }
+    m = StartMemo{gen_, k.level, k.ix, k.iy, deepest_present(k)};
+    return m.node;
   }
 
   CellNode* root() {
@@ -662,6 +679,15 @@ class CellView {
   // deepest_present's last answer: where the next starts (its walk, or its lookups at the
   // answer's level first), a hint only, whose state is looked up again.
   CellNode* finger_ = nullptr;
+  // start_cell()'s answers of this generation, by key (direct-mapped).
+  struct StartMemo {
+    std::uint32_t gen = 0;
+    int level = 0;
+    std::uint64_t ix = 0, iy = 0;
+    CellNode* node = nullptr;
+  };
+  static constexpr std::size_t kStartMemo = 16;
+  std::array<StartMemo, kStartMemo> start_memo_{};
   std::size_t leaves_read_ = 0;
   Counts counts_;
   // The run the view was last filled for, when it failed (see reset()).
