@@ -186,9 +186,10 @@ VersionBase* Engine::default_base(ModBase& m, bool defaulted, const detail::Vers
   ReaderLink* readers = m.default_readers();
   VersionBase* base = ops->make_default(allocate(ops->size));
   set_base(m, base, nullptr);
-  if (readers) {
-    base->readers = readers;
-    readers->rpprev = &base->readers;
+  if (readers) {  // a default's list has no order
+    base->unordered_readers = readers;
+    readers->rpprev = &base->unordered_readers;
+    for (ReaderLink* r = readers; r; r = r->rnext) r->unordered = 1;
   }
   return base;
 }
@@ -209,20 +210,110 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
   if (older) v->set_older(older);
   else v->link = newer ? newer->link : end_link(m, m.default_only());  // v is the oldest now
   v->readers = nullptr;
+  v->unordered_readers = nullptr;
   if (newer) newer->set_older(v);
   else m.set_newest(v);
   // Readers of the older version that come after v now see v. When v is the last stamp of
   // the whole trace (every from-scratch write) none can.
-  if (older && older->readers && v->stamp.next() != nullptr) {
+  if (older && (older->readers || older->unordered_readers) && v->stamp.next() != nullptr) {
     const bool same = v->ops->equal(v, older);
-    if (newer && older->readers->rnext && move_readers_between(m, older, v, newer, same)) return;
-    for (ReaderLink* r = older->readers; r;) {
-      ReaderLink* nx = r->rnext;
-      // A slot's time is its multi-read's.
-      if (order_.less(&v->stamp, &owner_of(r)->start)) move_reader(r, m, older, v, same);
-      r = nx;
-    }
+    const bool one = !older->unordered_readers ? !older->readers->rnext
+                                               : !older->readers && !older->unordered_readers->rnext;
+    if (newer && !one && move_readers_between(m, older, v, newer, same)) return;
+    move_readers_after(m, older, v, same);
   }
+}
+
+void Engine::move_readers_after(ModBase& m, VersionBase* older, VersionBase* v, bool same) {
+  // Each unordered reader is tested; the ordered ones, newest first, up to the first before
+  // v. A slot's time is its multi-read's.
+  std::vector<ReaderLink*>& moved = order_scratch_;
+  std::vector<ReaderLink*>& kept = fold_scratch_;
+  moved.clear();
+  kept.clear();
+  for (ReaderLink* r = older->unordered_readers; r; r = r->rnext) {
+    ++stats_.readers_tested;
+    (order_.less(&v->stamp, &owner_of(r)->start) ? moved : kept).push_back(r);
+  }
+  ReaderLink* first = older->readers;  // the ordered readers after v: first up to stop
+  ReaderLink* stop = first;
+  ReaderLink* last = nullptr;
+  for (; stop; last = stop, stop = stop->rnext) {
+    ++stats_.readers_tested;
+    if (!order_.less(&v->stamp, &owner_of(stop)->start)) break;
+  }
+  if (first != stop) {  // cut the run out of older's list
+    older->readers = stop;
+    if (stop) stop->rpprev = &older->readers;
+    last->rnext = nullptr;
+  }
+  for (ReaderLink* x : moved) detach(x);
+  if (!kept.empty()) {
+    for (ReaderLink* x : kept) detach(x);
+    fold_unordered(older);
+  }
+  if (moved.empty() && first == stop) return;
+  // v had no readers: they are the run merged with the unordered readers moved.
+  *link_merged(&v->readers, first != stop ? first : nullptr) = nullptr;
+  if (same) return;
+  for (ReaderLink* x = v->readers; x; x = x->rnext) note_change(x, m, older, v, true);
+}
+
+void Engine::fold_unordered(VersionBase* older) {
+  // Each reader of fold_scratch_ goes in its place among older's ordered readers, as far
+  // as a walk of about as many of those as there are to fold reaches: a step of the walk
+  // costs a cache miss, as testing each of these did. The others go back unordered.
+  std::vector<ReaderLink*>& xs = fold_scratch_;
+  if (xs.size() > 1)
+    std::sort(xs.begin(), xs.end(), [this](const ReaderLink* a, const ReaderLink* b) {
+      return order_.less(&owner_of(b)->start, &owner_of(a)->start);
+    });
+  std::size_t budget = xs.size() + 2, i = 0;
+  ReaderLink** at = &older->readers;
+  while (i < xs.size()) {
+    ReaderLink* x = *at;
+    if (x && order_.less(&owner_of(xs[i])->start, &owner_of(x)->start)) {  // xs[i] goes after x
+      if (budget == 0) break;
+      --budget;
+      ++stats_.readers_tested;
+      at = &x->rnext;
+      continue;
+    }
+    ReaderLink* y = xs[i++];
+    y->rpprev = at;
+    y->rnext = x;
+    *at = y;
+    if (x) x->rpprev = &y->rnext;
+    y->unordered = 0;
+    at = &y->rnext;
+  }
+  for (; i < xs.size(); ++i) attach_unordered(xs[i], older);
+  xs.clear();
+}
+
+ReaderLink** Engine::link_merged(ReaderLink** at, ReaderLink* run) {
+  std::vector<ReaderLink*>& xs = order_scratch_;
+  // Readers at one time (slots of one multi-read) may come out in either order.
+  if (xs.size() > 1)
+    std::sort(xs.begin(), xs.end(), [this](const ReaderLink* a, const ReaderLink* b) {
+      return order_.less(&owner_of(b)->start, &owner_of(a)->start);
+    });
+  std::size_t i = 0;
+  while (run || i < xs.size()) {
+    ReaderLink* x;
+    if (!run || (i < xs.size() && order_.less(&owner_of(run)->start, &owner_of(xs[i])->start))) {
+      x = xs[i++];
+    } else {
+      x = run;
+      run = run->rnext;
+    }
+    x->rpprev = at;
+    *at = x;
+    at = &x->rnext;
+    x->unordered = 0;
+  }
+  xs.clear();
+  return at;
 }
 
 bool Engine::move_readers_between(ModBase& m, VersionBase* older, VersionBase* v, VersionBase* newer, bool same) {
@@ -254,8 +345,10 @@ bool Engine::move_readers_between(ModBase& m, VersionBase* older, VersionBase* v
 }
 
 void Engine::move_reader(ReaderLink* r, ModBase& m, VersionBase* older, VersionBase* v, bool same) {
+  // Moved oldest first onto v, which had no readers: v's list comes out ordered.
   detach(r);
   attach(r, v);
+  r->unordered = 0;
   if (!same) note_change(r, m, older, v, true);
 }
 
@@ -270,7 +363,8 @@ void Engine::set_base(ModBase& m, VersionBase* fresh, bool (*assign)(VersionBase
     if (!base->ops->equal(base, fresh)) {
       const bool swapped = assign(base, fresh);
       bool kept = false;
-      for (ReaderLink* r = base->readers; r; r = r->rnext) kept |= note_change(r, m, fresh, base, swapped);
+      for (ReaderLink* l : {base->readers, base->unordered_readers})
+        for (ReaderLink* r = l; r; r = r->rnext) kept |= note_change(r, m, fresh, base, swapped);
       if (kept) {
         dead_versions_.push_back(fresh);
         return;
@@ -285,6 +379,7 @@ void Engine::set_base(ModBase& m, VersionBase* fresh, bool (*assign)(VersionBase
   fresh->stamp.label = static_cast<std::uint32_t>(bases_.size());
   fresh->link = last ? last->link : end_link(m, m.default_only());
   fresh->readers = nullptr;
+  fresh->unordered_readers = nullptr;
   bases_.push_back(fresh);
   input_bytes_ += (fresh->ops->size + 7) & ~std::size_t{7};
   if (last) last->set_older(fresh);
@@ -294,7 +389,7 @@ void Engine::set_base(ModBase& m, VersionBase* fresh, bool (*assign)(VersionBase
 bool Engine::unused(const ModBase& m) const noexcept {
   if (m.default_only()) return !m.default_readers();
   const VersionBase* v = m.newest();
-  return !v || (v->is_base() && !v->older() && !v->readers);
+  return !v || (v->is_base() && !v->older() && !v->readers && !v->unordered_readers);
 }
 
 void Engine::retire(ModBase& m) {
@@ -307,7 +402,7 @@ void Engine::retire(ModBase& m) {
   }
   if (!v->is_base() || v->older())
     throw UsageError("sac::Engine::retire: the modifiable has versions written by the computation");
-  if (v->readers) throw UsageError("sac::Engine::retire: the modifiable is still read");
+  if (v->readers || v->unordered_readers) throw UsageError("sac::Engine::retire: the modifiable is still read");
   const std::uint32_t i = v->stamp.label;
   bases_[i] = bases_.back();
   bases_[i]->stamp.label = i;
@@ -363,7 +458,7 @@ void Engine::exec_read_many(ReadNode* r) {
   attach_and_invoke_many(r);
 }
 
-void Engine::attach_and_invoke_many(ReadNode* r) {
+void Engine::attach_and_invoke_many(ReadNode* r, bool attached) {
   detail::ReadManyHeader* h = detail::many_of(r);
   const detail::VersionOps* ops = r->ops()->value;
   const VersionBase* vs[detail::kMaxReadMany];
@@ -371,7 +466,7 @@ void Engine::attach_and_invoke_many(ReadNode* r) {
   for (std::uint32_t i = 0; i < h->k; ++i) {
     const VersionBase* v = visible_or_default(*slots[i].mod, &r->start, ops);
     if (!v) throw UsageError("sac::Engine::read_many: a modifiable has no value at the time of this read");
-    attach_seen(&slots[i].link, *slots[i].mod, v);
+    if (!attached || !slots[i].link.rpprev) attach_seen(&slots[i].link, *slots[i].mod, v);
     vs[i] = v;
   }
   exec_body([&] { r->ops()->invoke_many(*this, r, vs); });
@@ -556,7 +651,7 @@ bool Engine::still_affected(ReadNode* r, const QueueAux& a) {
     VersionBase* v = visible(*to, &r->start);
     if (!v) throw UsageError("sac::Engine::read_many: follow() named a modifiable with no value at the read's time");
     detach(&sl.link);
-    attach(&sl.link, v);
+    attach_timed(&sl.link, v);
     sl.mod = to;
     ++stats_.reads_followed;
   }
@@ -571,17 +666,18 @@ void Engine::rerun(ReadNode* r, const ModBase* mp) {
   window_end_ = &r->end;
   ++stats_.reads_reexecuted;
   ++stats_.last_reexecuted;
-  if (!mp) {  // a multi-read: every slot re-hangs on what its modifiable shows now
-    detail::ReadManyHeader* h = detail::many_of(r);
-    for (std::uint32_t i = 0; i < h->k; ++i) detach(&h->slots()[i].link);
-    attach_and_invoke_many(r);
+  // A read (each slot) that hangs on a version hangs on the one visible at its time: link_write
+  // and undo move readers as versions come and go. Left where it is, it keeps its place
+  // among the version's ordered readers, which a re-attachment would lose. One whose
+  // version was undone with none before it hangs nowhere, and is attached here.
+  if (!mp) {  // a multi-read
+    attach_and_invoke_many(r, true);
     return;
   }
   const ModBase& m = *mp;
-  detach(&r->link);
   const VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
-  attach_seen(&r->link, m, v);
+  if (!r->link.rpprev) attach_seen(&r->link, m, v);
   exec_body([&] { r->ops()->invoke(*this, r, v); });
 }
 
@@ -650,7 +746,10 @@ ReadNode* Engine::find_read_match(const ModBase& m, std::uint32_t ops_id,
           for (; l; l = l->rnext)
             if (!detail::is_slot(l)) offer(owner_of(l));
         };
-        for (VersionBase* v = m.newest(); v; v = v->older()) offer_all(v->readers);
+        for (VersionBase* v = m.newest(); v; v = v->older()) {
+          offer_all(v->readers);
+          offer_all(v->unordered_readers);
+        }
         offer_all(m.default_readers());
       },
       [&](const ReadNode* r) { return r->link.ops_id == ops_id && ops->equal(r, closure); });
@@ -755,7 +854,7 @@ void Engine::undo(Stamp* s) {
       ModBase* m = v->mod();
       const bool defaulted = !older && (v->link & VersionBase::kDefaulted);
       unlink_version(m, v);
-      if (v->readers) {
+      if (v->readers || v->unordered_readers) {
         // Its readers see the default now when v was the oldest: on m itself if m has no
         // version left, else on the default made a base version. Either way they are cut
         // off when v held the default value too.
@@ -763,14 +862,26 @@ void Engine::undo(Stamp* s) {
         if (defaulted)
           seen = m->default_only() ? v->ops->shared_default() : (older = default_base(*m, true, v->ops));
         const bool same = seen && v->ops->equal(v, seen);
-        for (ReaderLink* r = v->readers; r;) {
-          ReaderLink* nx = r->rnext;
-          r->rpprev = nullptr;
-          r->rnext = nullptr;
-          if (older) attach(r, older);
-          else if (defaulted) attach_default(r, *m);
-          if (!same) note_change(r, *m, v, seen, seen != nullptr);
-          r = nx;
+        if (older) {
+          // v's readers are all timed after older's: in order, they go first among older's
+          // ordered readers.
+          for (ReaderLink* r = v->unordered_readers; r; r = r->rnext) order_scratch_.push_back(r);
+          ReaderLink* rest = older->readers;
+          ReaderLink** end = link_merged(&older->readers, v->readers);
+          *end = rest;
+          if (rest) rest->rpprev = end;
+          if (!same)
+            for (ReaderLink* r = older->readers; r != rest; r = r->rnext) note_change(r, *m, v, seen, seen != nullptr);
+        } else {
+          for (ReaderLink* l : {v->readers, v->unordered_readers})
+            for (ReaderLink* r = l; r;) {
+              ReaderLink* nx = r->rnext;
+              r->rpprev = nullptr;
+              r->rnext = nullptr;
+              if (defaulted) attach_default(r, *m);
+              if (!same) note_change(r, *m, v, seen, seen != nullptr);
+              r = nx;
+            }
         }
       }
       // A queued read may have seen v, or see it (note_change): freed once propagate() ends.
@@ -1005,8 +1116,10 @@ void Engine::check_invariants() const {
         if (!v->stamp.linked()) fail("version with unlinked stamp");
         if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("versions out of order");
       }
-      const ReaderLink* const* back = &v->readers;
-      for (const ReaderLink* r = v->readers; r; back = &r->rnext, r = r->rnext) {
+      for (int list = 0; list < 2; ++list) {
+      const ReaderLink* const* back = list == 0 ? &v->readers : &v->unordered_readers;
+      const Stamp* last_ordered = nullptr;  // the time of the last ordered reader seen
+      for (const ReaderLink* r = *back; r; back = &r->rnext, r = r->rnext) {
         if (r->rpprev != back) fail("a version's reader list has a broken back link");
         // Membership first: only then may r be decoded (a slot's owner from its index).
         if (!reads.contains(r)) fail("a version's reader is not a live read of the trace");
@@ -1015,7 +1128,13 @@ void Engine::check_invariants() const {
         const Stamp* t = &owner_of(r)->start;
         if (!v->is_base() && !order_.less(&v->stamp, t)) fail("reader before its version");
         if (newer && !order_.less(t, &newer->stamp)) fail("reader after the next version");
+        if (r->unordered != list) fail("a version's reader is on the other list than its flag says");
+        if (list == 0) {
+          if (last_ordered && order_.less(last_ordered, t)) fail("a version's ordered readers are not newest first");
+          last_ordered = t;
+        }
         ++attached;
+      }
       }
       newer = v;
     }
@@ -1062,7 +1181,10 @@ void Engine::dump_dot(std::ostream& os) const {
   const auto note_list = [&](const ReaderLink* l, const ModBase* m) {
     for (; l; l = l->rnext) read_mod.emplace(owner_of(l), m);
   };
-  const auto note_readers = [&](const VersionBase* v) { note_list(v->readers, v->mod()); };
+  const auto note_readers = [&](const VersionBase* v) {
+    note_list(v->readers, v->mod());
+    note_list(v->unordered_readers, v->mod());
+  };
   for (const VersionBase* b : bases_) note_readers(b);
   for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
     if (s->kind() == StampKind::Write) note_readers(detail::version_of(const_cast<Stamp*>(s)));

@@ -36,6 +36,9 @@
 
 namespace sac {
 
+/// The bytes of one int input (a base version), as Engine::input_bytes counts them.
+constexpr std::size_t kIntInput = (sizeof(detail::Version<int>) + 7) & ~std::size_t{7};
+
 /// The test-only hook declared in Engine: the private trace, so that the checker tests below
 /// can corrupt one part of it and see check_invariants() fail.
 struct EngineTestAccess {
@@ -1237,7 +1240,7 @@ TEST(EngineInitDefault, ReadsTheDefaultAndBehavesAsAWrittenModifiable) {
   expect_healthy(e);
   // set() on a default that a read saw: the default becomes a base version, then changes.
   e.set(d, 4);
-  EXPECT_EQ(e.input_bytes(), 48u);
+  EXPECT_EQ(e.input_bytes(), sac::kIntInput);
   e.propagate();
   EXPECT_EQ(out.get(), 5);
   expect_healthy(e);
@@ -1267,7 +1270,7 @@ TEST(EngineInitDefault, ReadsOfADefaultHangOnTheModifiableUntilItHasAVersion) {
   EXPECT_EQ(out2.get(), 2);
   EXPECT_EQ(out3.get(), 0);
   EXPECT_EQ(runs, 1);
-  EXPECT_EQ(e.input_bytes(), 48u) << "sel's base version only: the three reads of d hang on d";
+  EXPECT_EQ(e.input_bytes(), sac::kIntInput) << "sel's base version only: the three reads of d hang on d";
   EXPECT_FALSE(e.unused(d));
   expect_healthy(e);
 
@@ -1278,7 +1281,7 @@ TEST(EngineInitDefault, ReadsOfADefaultHangOnTheModifiableUntilItHasAVersion) {
   e.propagate();
   expect_healthy(e);
   EXPECT_EQ(runs, 2);
-  EXPECT_EQ(e.input_bytes(), 48u);
+  EXPECT_EQ(e.input_bytes(), sac::kIntInput);
 
   e.set(sel, 1);  // a version before the reads: the default becomes a base version
   e.propagate();
@@ -1286,7 +1289,7 @@ TEST(EngineInitDefault, ReadsOfADefaultHangOnTheModifiableUntilItHasAVersion) {
   EXPECT_EQ(out1.get(), 8);
   EXPECT_EQ(out2.get(), 9);
   EXPECT_EQ(out3.get(), 7) << "the memo_read saw the write";
-  EXPECT_EQ(e.input_bytes(), 96u);
+  EXPECT_EQ(e.input_bytes(), 2 * sac::kIntInput);
 
   e.set(sel, 0);  // undone: the readers see the default again
   e.propagate();
@@ -1322,7 +1325,7 @@ TEST(EngineInitDefault, MemoReadOfADefaultWithoutVersionIsReused) {
   EXPECT_EQ(out.get(), 2);
   EXPECT_EQ(runs, 1) << "the old read of the default was found on d and reused";
   EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 1u);
-  EXPECT_EQ(e.input_bytes(), 48u);
+  EXPECT_EQ(e.input_bytes(), sac::kIntInput);
 }
 
 /// The program of the differential test below: for each input a[i] (in order), a value
@@ -1385,7 +1388,7 @@ TEST(EngineInitDefault, DifferentialAgainstFromScratch) {
       }
       std::size_t read_then_written = 0;
       for (std::size_t c = 0; c < k; ++c) read_then_written += read_first[c] && written[c];
-      ASSERT_EQ(f.input_bytes(), (n + read_then_written) * 48)
+      ASSERT_EQ(f.input_bytes(), (n + read_then_written) * sac::kIntInput)
           << "base versions: the inputs and the defaults read first and written later";
     }
     expect_healthy(e);
@@ -1875,6 +1878,39 @@ TEST(EngineChecker, ReadAttachedToAnOlderVersion) {
   EXPECT_NO_THROW(t.e.check_invariants());
 }
 
+TEST(EngineChecker, ReadersOutOfOrderOrOnTheWrongList) {
+  // Two reads of one input: its ordered readers are the second, then the first.
+  Mod<int> in, out1, out2;
+  Engine e;
+  e.set(in, 1);
+  e.run([&](Engine& en) {
+    en.read(in, [&out1](Engine& x, int v) { x.write(out1, v); });
+    en.read(in, [&out2](Engine& x, int v) { x.write(out2, v); });
+  });
+  ASSERT_NO_THROW(e.check_invariants());
+  ReadNode* first = nullptr;
+  for (Stamp* s = EngineTestAccess::order(e).base()->next(); s && !first; s = s->next())
+    if (s->kind() == StampKind::ReadStart) first = sac::detail::read_of_start(s);
+  ASSERT_NE(first, nullptr);
+  // The list is the second read, then the first: the first's back link is the second's
+  // rnext (a ReaderLink's first field), and the second's is the version's head.
+  ReadNode* second = sac::detail::owner_of(reinterpret_cast<sac::detail::ReaderLink*>(first->link.rpprev));
+  ASSERT_NE(second, first);
+  auto* v = reinterpret_cast<VersionBase*>(reinterpret_cast<char*>(second->link.rpprev) - offsetof(VersionBase, readers));
+  EngineTestAccess::detach(first);
+  EngineTestAccess::attach(first, v);  // ahead of the newer read
+  EXPECT_THAT(invariant_message(e), HasSubstr("ordered readers are not newest first"));
+  EngineTestAccess::detach(first);
+  EngineTestAccess::detach(second);
+  EngineTestAccess::attach(first, v);
+  EngineTestAccess::attach(second, v);
+  EXPECT_NO_THROW(e.check_invariants());
+  second->link.unordered = 1;
+  EXPECT_THAT(invariant_message(e), HasSubstr("on the other list than its flag says"));
+  second->link.unordered = 0;
+  EXPECT_NO_THROW(e.check_invariants());
+}
+
 TEST(EngineChecker, VersionsOutOfOrder) {
   SmallTrace t;
   ASSERT_NO_THROW(t.e.check_invariants());
@@ -2026,6 +2062,51 @@ void differential(std::uint64_t seed, int n, int steps) {
     ASSERT_EQ(got, scratch_result);
     ASSERT_EQ(figures(e), scratch) << "live trace differs from a from-scratch run";
   }
+}
+
+TEST(EngineReaderOrder, AReexecutedWriteTestsTheReadersAfterItNotAllOfThem) {
+  // m is read 2,000 times, then a read of sel writes m when sel is odd, then m is read 5
+  // more times. A write of m that re-execution adds must find the 5 later readers of m's
+  // base version among its 2,005: the version's ordered readers are newest first, so it
+  // tests those 5 and one more, not all. Changes of m re-run every reader, which keep their
+  // places; the outputs and the checker are tested after every change (seed printed).
+  constexpr int kBefore = 2000, kAfter = 5;
+  Mod<int> sel, m;
+  auto outs = std::make_unique<Mod<int>[]>(kBefore + kAfter);
+  Engine e;
+  int vsel = 0, vm = 1;
+  e.set(sel, vsel);
+  e.set(m, vm);
+  e.run([&](Engine& en) {
+    for (int i = 0; i < kBefore; ++i) en.read(m, [o = &outs[i]](Engine& x, int v) { x.write(*o, v); });
+    en.read(sel, [&m](Engine& x, int s) {
+      if (s % 2 == 1) x.write(m, 100 + s);
+    });
+    for (int i = kBefore; i < kBefore + kAfter; ++i) en.read(m, [o = &outs[i]](Engine& x, int v) { x.write(*o, v); });
+  });
+  std::mt19937 rng(20261129);
+  std::printf("seed 20261129\n");
+  int writes_added = 0;
+  for (int t = 0; t < 60; ++t) {
+    const std::uint64_t tested0 = e.stats().readers_tested;
+    const bool was_odd = vsel % 2 == 1;
+    if (rng() % 3 == 0) {
+      e.set(m, vm = static_cast<int>(rng() % 50));
+    } else {
+      e.set(sel, vsel = static_cast<int>(rng() % 9));
+    }
+    e.propagate();
+    const bool adds_write = !was_odd && vsel % 2 == 1;
+    if (adds_write) {
+      ++writes_added;
+      EXPECT_LE(e.stats().readers_tested - tested0, std::uint64_t{kAfter + 1}) << "change " << t;
+    }
+    for (int i = 0; i < kBefore; ++i) ASSERT_EQ(outs[i].get(), vm) << "change " << t;
+    for (int i = kBefore; i < kBefore + kAfter; ++i)
+      ASSERT_EQ(outs[i].get(), vsel % 2 == 1 ? 100 + vsel : vm) << "change " << t;
+    e.check_invariants();
+  }
+  EXPECT_GT(writes_added, 5);
 }
 
 TEST(EngineDifferential, MapWithMemoReadAndKeyedCells) {

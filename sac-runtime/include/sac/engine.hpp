@@ -36,14 +36,17 @@
 // Invariants (check_invariants()): the order list, queue and tables are valid; the trace is
 // well nested (every read's interval contains exactly the events its body created); every
 // live read (each slot of a multi-read) is attached to the version visible at its start
-// time, and a multi-read's own link to none; versions of a modifiable
-// are ordered by time; every memo entry and keyed allocation is in its table; outside
+// time, and a multi-read's own link to none; a version's ordered readers are newest first;
+// versions of a modifiable are ordered by time; every memo entry and keyed allocation is in its table; outside
 // propagate() the queue is empty. Built with the CMake option SAC_DEBUG_CHECKS, propagate()
 // runs the check at its end and throws InvariantError on a violation.
 // Complexity: read/write/alloc O(1) amortized plus the version walk of the touched
 // modifiable; a write inside propagate() also finds the older version's readers timed after
 // it: by walking the trace up to the next version when that is at most 64 events away (a
-// re-executed write), else by scanning the older version's readers;
+// re-executed write), else by testing the older version's unordered readers (those a
+// re-execution attached among older ones) and its ordered readers up to the first before
+// the write, then folding the unordered ones it tested into order as far as a walk of as
+// many ordered readers reaches;
 // propagate() O(trace distance x log(queue size)) for monotone programs. A read of a
 // projection is affected by what it sees when propagation reaches it, not by each change on
 // the way: the queue keeps, per changed slot, the version it had seen (undone versions, and
@@ -393,7 +396,7 @@ class Engine {
   void exec_read_many(detail::ReadNode* r);
   /// Hangs each slot of the multi-read r on what its modifiable shows at r's start and
   /// runs r's body on those values (first execution and re-execution alike).
-  void attach_and_invoke_many(detail::ReadNode* r);
+  void attach_and_invoke_many(detail::ReadNode* r, bool attached = false);
   [[noreturn]] static void throw_read_many_size();
   void push_close(Stamp* end, TaskKind kind, void* node);
   void close_chain(TaskKind kind, void* node);
@@ -406,6 +409,28 @@ class Engine {
   /// Hangs r, a reader of older timed after v, on v; queues it when the new value (`same`:
   /// equal to older's) affects it.
   void move_reader(detail::ReaderLink* r, ModBase& m, detail::VersionBase* older, detail::VersionBase* v, bool same);
+  /// link_write's move of older's readers timed after v onto v (which has none): older's
+  /// unordered readers, and its ordered ones up to the first before v. v's readers come out
+  /// ordered. O(moved + older's unordered readers).
+  void move_readers_after(ModBase& m, detail::VersionBase* older, detail::VersionBase* v, bool same);
+  /// Hangs the readers in fold_scratch_ (detached unordered readers of older) back on
+  /// older: among its ordered readers, in their places, as far as a walk of about as many
+  /// of those reaches; the others on its unordered readers. Empties fold_scratch_.
+  void fold_unordered(detail::VersionBase* older);
+  /// Links `run` (a null-ended chain of readers, newest first) and the readers in
+  /// order_scratch_ into one chain, newest first and all ordered, from *at on; empties
+  /// order_scratch_ and returns the last reader's rnext slot (or `at`), for the caller to
+  /// link what follows.
+  detail::ReaderLink** link_merged(detail::ReaderLink** at, detail::ReaderLink* run);
+  /// Hangs r, a read at its start's time, on v: at the head of v's ordered readers when it
+  /// is at the trace's end (every from-scratch read) or v has none, else on v's unordered
+  /// readers. Testing r against the head's time instead costs a cache miss per read that
+  /// re-execution adds, and most of them land among older readers anyway; link_write folds
+  /// the unordered readers it tests into order.
+  static void attach_timed(detail::ReaderLink* r, detail::VersionBase* v) {
+    if (!v->readers || detail::owner_of(r)->start.next() == nullptr) attach(r, v);
+    else attach_unordered(r, v);
+  }
   void unlink_version(ModBase* m, detail::VersionBase* v);  // v a version of m
   void link_alloc(detail::AllocNode* n, std::size_t h);
   void link_memo(detail::MemoNode* n, std::size_t h);
@@ -463,7 +488,7 @@ class Engine {
   /// Hangs r on what it sees, v (from visible_or_default).
   static void attach_seen(detail::ReaderLink* r, const ModBase& m, const detail::VersionBase* v) {
     if (m.default_only()) attach_default(r, m);
-    else attach(r, const_cast<detail::VersionBase*>(v));
+    else attach_timed(r, const_cast<detail::VersionBase*>(v));
   }
   /// m's default made into its base version, if m has a default (init_default) and no base
   /// version yet (m's default readers move onto it); else null. `defaulted`: whether m has
@@ -477,11 +502,17 @@ class Engine {
   bool in_window(const Stamp* start, const Stamp* end) const {
     return order_.less(now_, start) && order_.less(end, window_end_);
   }
-  static void attach(detail::ReaderLink* r, detail::VersionBase* v) {
-    r->rnext = v->readers;
-    if (v->readers) v->readers->rpprev = &r->rnext;
-    v->readers = r;
-    r->rpprev = &v->readers;
+  /// Hangs r at the head of v's ordered readers (the caller knows it is the newest).
+  static void attach(detail::ReaderLink* r, detail::VersionBase* v) { push_reader(r, &v->readers, 0); }
+  static void attach_unordered(detail::ReaderLink* r, detail::VersionBase* v) {
+    push_reader(r, &v->unordered_readers, 1);
+  }
+  static void push_reader(detail::ReaderLink* r, detail::ReaderLink** head, std::uint16_t unordered) {
+    r->rnext = *head;
+    if (*head) (*head)->rpprev = &r->rnext;
+    *head = r;
+    r->rpprev = head;
+    r->unordered = unordered;
   }
   /// The first of a modifiable's default readers has this bit in its rpprev, which then
   /// points at the modifiable's head_ (whose kDefaultOnly mark a plain store would lose).
@@ -521,6 +552,8 @@ class Engine {
   std::vector<detail::AllocNode*> deferred_;   // undone allocations, freed by propagate()
   std::vector<detail::VersionBase*> dead_versions_;  // undone versions, freed by propagate()
   std::vector<Seen> seen_;                      // the queued reads' lists (note_change)
+  std::vector<detail::ReaderLink*> order_scratch_;  // readers being put in time order
+  std::vector<detail::ReaderLink*> fold_scratch_;   // unordered readers being folded (fold_unordered)
   // Keyed allocations of the running run() with their hashes: nothing can look them up
   // before the run ends (there is no re-execution window), so they are indexed in one
   // presized pass at its end, reading this array sequentially and only storing into the
@@ -616,7 +649,7 @@ void Engine::read(const Mod<T>& m, F&& body) {
   require_computation("read");
   N* r = construct<N>(std::forward<F>(body));
   r->link.issued_mod = &m;
-  r->link.ops_id = detail::ReadOpsFor<T, Fn>::id();
+  r->link.ops_id = static_cast<std::uint16_t>(detail::ReadOpsFor<T, Fn>::id());
   r->link.qpos = kNotQueued;
   issue(TaskKind::ExecRead, r);
 }
@@ -640,7 +673,7 @@ void Engine::read_many(std::span<const Mod<T>* const> mods, F&& body) {
   }
   H* h = new (mem) H{};
   h->k = static_cast<std::uint32_t>(k);
-  h->read.link.ops_id = detail::ReadManyOpsFor<T, Fn>::id();
+  h->read.link.ops_id = static_cast<std::uint16_t>(detail::ReadManyOpsFor<T, Fn>::id());
   h->read.link.qpos = kNotQueued;
   detail::ReadSlot* slots = h->slots();
   for (std::size_t i = 0; i < k; ++i) {

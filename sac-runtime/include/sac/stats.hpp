@@ -32,6 +32,10 @@ struct Stats {
   /// Slots of multi-reads moved to another modifiable by their closure's follow() instead of
   /// re-running (Engine::read_many).
   std::uint64_t reads_followed = 0;
+  /// Readers whose time a re-executed write tested, to find those that see it now: the
+  /// version's unordered readers and its ordered ones up to the first before the write
+  /// (Engine::link_write).
+  std::uint64_t readers_tested = 0;
   std::uint64_t propagations = 0;
   std::uint64_t live_events = 0;
   /// Trace distance (created + undone) of the last propagate().
@@ -45,7 +49,7 @@ struct Stats {
               << " memo_misses=" << s.memo_misses << " memo_far=" << s.memo_far << " alloc_reuses=" << s.alloc_reuses
               << " queue_pushes=" << s.queue_pushes << " queue_pops=" << s.queue_pops
               << " queue_removes=" << s.queue_removes << " unaffected=" << s.reads_unaffected
-              << " followed=" << s.reads_followed << " live_events=" << s.live_events
+              << " followed=" << s.reads_followed << " readers_tested=" << s.readers_tested << " live_events=" << s.live_events
               << " last_trace_distance=" << s.last_trace_distance;
   }
 };

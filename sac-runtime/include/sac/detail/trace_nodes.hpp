@@ -53,7 +53,12 @@ struct VersionBase {
   // The next older version; after the oldest, the modifiable | kEnd (| kDefaulted when
   // Engine::init_default() gave it a default).
   std::uintptr_t link;
-  ReaderLink* readers;   // the reads (or multi-read slots) that see this version
+  // The reads (or multi-read slots) that see this version, in two lists: `readers`,
+  // newest first (every from-scratch read, and those Engine::link_write or an undo put in
+  // order), and `unordered_readers`, in no order (attached by a re-execution among older
+  // ones). So the readers after a time are the unordered ones and a prefix of the others.
+  ReaderLink* readers;
+  ReaderLink* unordered_readers;
 
   static constexpr std::uintptr_t kEnd = 1;
   static constexpr std::uintptr_t kDefaulted = 2;
@@ -113,16 +118,20 @@ std::uint32_t register_read_ops(const ReadOps* ops);
 /// An entry of a version's reader list (and of a modifiable's default readers): a plain
 /// read's `link`, or one slot of a multi-read. ops_id tells which: a read's ops number is
 /// never 0 (read_ops_table), a slot's ops_id is kSlotOps and its qpos field its index.
+/// `unordered` says which of its version's two lists it is on (VersionBase::readers);
+/// on a default's list it means nothing.
 struct ReaderLink {
   union {
     ReaderLink* rnext;           // attached: the next reader of the same version
     const ModBase* issued_mod;   // a plain read issued, not yet run: the modifiable it will read
   };
-  ReaderLink** rpprev;   // null when attached to no version
-  std::uint32_t ops_id;  // read: read_ops_table's index of its ops; slot: kSlotOps
-  std::uint32_t qpos;    // read: its index in the queue; slot: its index in its multi-read
+  ReaderLink** rpprev;       // null when attached to no version
+  std::uint16_t ops_id;      // read: read_ops_table's index of its ops; slot: kSlotOps
+  std::uint16_t unordered;   // 1: on its version's unordered_readers
+  std::uint32_t qpos;        // read: its index in the queue; slot: its index in its multi-read
 };
-inline constexpr std::uint32_t kSlotOps = 0;
+static_assert(sizeof(ReaderLink) == 24);
+inline constexpr std::uint16_t kSlotOps = 0;
 
 /// A read. It does not name its modifiable: a live read hangs on a version of it (whose
 /// chain ends at the modifiable), a queued read's modifiable waits with it in the queue, and
