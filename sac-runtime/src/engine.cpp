@@ -348,7 +348,6 @@ void Engine::move_reader(ReaderLink* r, ModBase& m, VersionBase* older, VersionB
   // Moved oldest first onto v, which had no readers: v's list comes out ordered.
   detach(r);
   attach(r, v);
-  r->unordered = 0;
   if (!same) note_change(r, m, older, v, true);
 }
 

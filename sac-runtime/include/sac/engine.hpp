@@ -37,9 +37,10 @@
 // well nested (every read's interval contains exactly the events its body created); every
 // live read (each slot of a multi-read) is attached to the version visible at its start
 // time, and a multi-read's own link to none; a version's ordered readers are newest first;
-// versions of a modifiable are ordered by time; every memo entry and keyed allocation is in its table; outside
-// propagate() the queue is empty. Built with the CMake option SAC_DEBUG_CHECKS, propagate()
-// runs the check at its end and throws InvariantError on a violation.
+// versions of a modifiable are ordered by time; every memo entry and keyed allocation is in
+// its table; outside propagate() the queue is empty. Built with the CMake option
+// SAC_DEBUG_CHECKS, propagate() runs the check at its end and throws InvariantError on a
+// violation.
 // Complexity: read/write/alloc O(1) amortized plus the version walk of the touched
 // modifiable; a write inside propagate() also finds the older version's readers timed after
 // it: by walking the trace up to the next version when that is at most 64 events away (a

@@ -33,8 +33,8 @@ struct Stats {
   /// re-running (Engine::read_many).
   std::uint64_t reads_followed = 0;
   /// Readers whose time a re-executed write tested, to find those that see it now: the
-  /// version's unordered readers and its ordered ones up to the first before the write
-  /// (Engine::link_write).
+  /// version's unordered readers, its ordered ones up to the first before the write, and
+  /// those the fold of the unordered ones into order walked (Engine::link_write).
   std::uint64_t readers_tested = 0;
   std::uint64_t propagations = 0;
   std::uint64_t live_events = 0;
