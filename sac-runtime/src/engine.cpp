@@ -248,10 +248,7 @@ void Engine::move_readers_after(ModBase& m, VersionBase* older, VersionBase* v, 
     last->rnext = nullptr;
   }
   for (ReaderLink* x : moved) detach(x);
-  if (!kept.empty()) {
-    for (ReaderLink* x : kept) detach(x);
-    fold_unordered(older);
-  }
+  if (!kept.empty()) fold_unordered(older);
   if (moved.empty() && first == stop) return;
   // v had no readers: they are the run merged with the unordered readers moved.
   *link_merged(&v->readers, first != stop ? first : nullptr) = nullptr;
@@ -259,15 +256,20 @@ void Engine::move_readers_after(ModBase& m, VersionBase* older, VersionBase* v, 
   for (ReaderLink* x = v->readers; x; x = x->rnext) note_change(x, m, older, v, true);
 }
 
-void Engine::fold_unordered(VersionBase* older) {
-  // Each reader of fold_scratch_ goes in its place among older's ordered readers, as far
-  // as a walk of about as many of those as there are to fold reaches: a step of the walk
-  // costs a cache miss, as testing each of these did. The others go back unordered.
-  std::vector<ReaderLink*>& xs = fold_scratch_;
+void Engine::sort_newest_first(std::vector<ReaderLink*>& xs) const {
+  // Readers at one time (slots of one multi-read) may come out in either order.
   if (xs.size() > 1)
     std::sort(xs.begin(), xs.end(), [this](const ReaderLink* a, const ReaderLink* b) {
       return order_.less(&owner_of(b)->start, &owner_of(a)->start);
     });
+}
+
+void Engine::fold_unordered(VersionBase* older) {
+  // Each reader of fold_scratch_ goes in its place among older's ordered readers, as far
+  // as a walk of about as many of those as there are to fold reaches: a step of the walk
+  // costs a cache miss, as testing each of these did. The others stay unordered.
+  std::vector<ReaderLink*>& xs = fold_scratch_;
+  sort_newest_first(xs);
   std::size_t budget = xs.size() + 2, i = 0;
   ReaderLink** at = &older->readers;
   while (i < xs.size()) {
@@ -280,6 +282,7 @@ void Engine::fold_unordered(VersionBase* older) {
       continue;
     }
     ReaderLink* y = xs[i++];
+    detach(y);
     y->rpprev = at;
     y->rnext = x;
     *at = y;
@@ -287,17 +290,12 @@ void Engine::fold_unordered(VersionBase* older) {
     y->unordered = 0;
     at = &y->rnext;
   }
-  for (; i < xs.size(); ++i) attach_unordered(xs[i], older);
   xs.clear();
 }
 
 ReaderLink** Engine::link_merged(ReaderLink** at, ReaderLink* run) {
   std::vector<ReaderLink*>& xs = order_scratch_;
-  // Readers at one time (slots of one multi-read) may come out in either order.
-  if (xs.size() > 1)
-    std::sort(xs.begin(), xs.end(), [this](const ReaderLink* a, const ReaderLink* b) {
-      return order_.less(&owner_of(b)->start, &owner_of(a)->start);
-    });
+  sort_newest_first(xs);
   std::size_t i = 0;
   while (run || i < xs.size()) {
     ReaderLink* x;

@@ -414,10 +414,12 @@ class Engine {
   /// unordered readers, and its ordered ones up to the first before v. v's readers come out
   /// ordered. O(moved + older's unordered readers).
   void move_readers_after(ModBase& m, detail::VersionBase* older, detail::VersionBase* v, bool same);
-  /// Hangs the readers in fold_scratch_ (detached unordered readers of older) back on
-  /// older: among its ordered readers, in their places, as far as a walk of about as many
-  /// of those reaches; the others on its unordered readers. Empties fold_scratch_.
+  /// Moves readers in fold_scratch_ (unordered readers of older) to their places among
+  /// older's ordered readers, as far as a walk of about as many of those reaches; the others
+  /// stay unordered. Empties fold_scratch_.
   void fold_unordered(detail::VersionBase* older);
+  /// Sorts xs newest first by their reads' start times.
+  void sort_newest_first(std::vector<detail::ReaderLink*>& xs) const;
   /// Links `run` (a null-ended chain of readers, newest first) and the readers in
   /// order_scratch_ into one chain, newest first and all ordered, from *at on; empties
   /// order_scratch_ and returns the last reader's rnext slot (or `at`), for the caller to
