@@ -1114,24 +1114,26 @@ void Engine::check_invariants() const {
         if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("versions out of order");
       }
       for (int list = 0; list < 2; ++list) {
-      const ReaderLink* const* back = list == 0 ? &v->readers : &v->unordered_readers;
-      const Stamp* last_ordered = nullptr;  // the time of the last ordered reader seen
-      for (const ReaderLink* r = *back; r; back = &r->rnext, r = r->rnext) {
-        if (r->rpprev != back) fail("a version's reader list has a broken back link");
-        // Membership first: only then may r be decoded (a slot's owner from its index).
-        if (!reads.contains(r)) fail("a version's reader is not a live read of the trace");
-        if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
-          fail("a multi-read's slot hangs on another modifiable's version");
-        const Stamp* t = &owner_of(r)->start;
-        if (!v->is_base() && !order_.less(&v->stamp, t)) fail("reader before its version");
-        if (newer && !order_.less(t, &newer->stamp)) fail("reader after the next version");
-        if (r->unordered != list) fail("a version's reader is on the other list than its flag says");
-        if (list == 0) {
-          if (last_ordered && order_.less(last_ordered, t)) fail("a version's ordered readers are not newest first");
-          last_ordered = t;
+        const ReaderLink* const* back = list == 0 ? &v->readers : &v->unordered_readers;
+        const Stamp* last_ordered = nullptr;  // the time of the last ordered reader seen
+        for (const ReaderLink* r = *back; r; back = &r->rnext, r = r->rnext) {
+          if (r->rpprev != back) fail("a version's reader list has a broken back link");
+          // Membership first: only then may r be decoded (a slot's owner from its index).
+          if (!reads.contains(r)) fail("a version's reader is not a live read of the trace");
+          if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
+            fail("a multi-read's slot hangs on another modifiable's version");
+          const Stamp* t = &owner_of(r)->start;
+          if (!v->is_base() && !order_.less(&v->stamp, t)) fail("reader before its version");
+          if (newer && !order_.less(t, &newer->stamp)) fail("reader after the next version");
+          if (r->unordered != list)
+            fail("a version's reader is on the other list than its flag says");
+          if (list == 0) {
+            if (last_ordered && order_.less(last_ordered, t))
+              fail("a version's ordered readers are not newest first");
+            last_ordered = t;
+          }
+          ++attached;
         }
-        ++attached;
-      }
       }
       newer = v;
     }
