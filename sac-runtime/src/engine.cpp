@@ -859,7 +859,15 @@ void Engine::undo(Stamp* s) {
         if (defaulted)
           seen = m->default_only() ? v->ops->shared_default() : (older = default_base(*m, true, v->ops));
         const bool same = seen && v->ops->equal(v, seen);
-        if (older) {
+        if (older && !v->unordered_readers && !older->readers) {
+          // Mostly older is the re-executed write that replaces v, and has no readers yet:
+          // v's ordered list becomes older's whole, and when the value is the same no
+          // reader but the first is touched.
+          older->readers = v->readers;
+          older->readers->rpprev = &older->readers;
+          if (!same)
+            for (ReaderLink* r = older->readers; r; r = r->rnext) note_change(r, *m, v, seen, seen != nullptr);
+        } else if (older) {
           // v's readers are all timed after older's: in order, they go first among older's
           // ordered readers.
           for (ReaderLink* r = v->unordered_readers; r; r = r->rnext) order_scratch_.push_back(r);

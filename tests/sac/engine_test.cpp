@@ -2109,6 +2109,50 @@ TEST(EngineReaderOrder, AReexecutedWriteTestsTheReadersAfterItNotAllOfThem) {
   EXPECT_GT(writes_added, 5);
 }
 
+TEST(EngineReaderOrder, AnUndoneVersionsReadersMoveOntoTheWriteThatReplacesIt) {
+  // A read of sel writes m, and 50 reads of m follow. A change of sel re-executes the write:
+  // the new version lands before the old one, which is then undone, and its readers move
+  // onto the new version whole. They re-run only when m's value changed. Outputs, re-runs
+  // and the checker are tested after every change (seed printed).
+  constexpr int kAfter = 50;
+  Mod<int> sel, m, tag;
+  auto outs = std::make_unique<Mod<int>[]>(kAfter);
+  Engine e;
+  int vsel = 0, reruns = 0;
+  e.set(sel, vsel);
+  e.set(m, -1);
+  e.run([&](Engine& en) {
+    en.read(m, [&tag](Engine& x, int v) { x.write(tag, v); });  // a reader of the older version
+    en.read(sel, [&m](Engine& x, int s) { x.write(m, s / 3); });
+    for (int i = 0; i < kAfter; ++i)
+      en.read(m, [o = &outs[i], &reruns](Engine& x, int v) {
+        ++reruns;
+        x.write(*o, v + 1);
+      });
+  });
+  std::mt19937 rng(20261130);
+  std::printf("seed 20261130\n");
+  int same_value = 0, new_value = 0;
+  for (int t = 0; t < 80; ++t) {
+    const int before = vsel / 3;
+    e.set(sel, vsel = static_cast<int>(rng() % 12));
+    reruns = 0;
+    e.propagate();
+    if (vsel / 3 == before) {
+      ++same_value;
+      EXPECT_EQ(reruns, 0) << "change " << t;
+    } else {
+      ++new_value;
+      EXPECT_EQ(reruns, kAfter) << "change " << t;
+    }
+    for (int i = 0; i < kAfter; ++i) ASSERT_EQ(outs[i].get(), vsel / 3 + 1) << "change " << t;
+    ASSERT_EQ(tag.get(), -1) << "change " << t;
+    e.check_invariants();
+  }
+  EXPECT_GT(same_value, 5);
+  EXPECT_GT(new_value, 5);
+}
+
 TEST(EngineDifferential, MapWithMemoReadAndKeyedCells) {
   for (std::uint64_t seed : {1u, 2u, 3u}) differential<MapProgram>(seed, 120 / kScale, 200 / kScale);
 }
