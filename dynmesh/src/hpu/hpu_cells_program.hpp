@@ -11,9 +11,9 @@
 //      hpu_inputs.hpp), whose vertices are also the store's base values (cell_store.hpp);
 //   2. each initial vertex's class (its shortest Delaunay edge's): a step; and, per block of
 //      the initial list (cut where a vertex's coordinates hash to it, about 32 long), the set
-//      of its classes;
+//      of its classes and its vertices linked by class mod 64, in list order;
 //   3. per class j, smallest first: Q_j = (initial entries of class j, in initial order, from
-//      the blocks whose set holds j) ++
+//      the blocks whose set holds j, each walked along its links of j's class mod 64) ++
 //      (continuations made during class j − 1); rounds: collect every entry of the round (a
 //      step, memoized apart from the list: its loose pairs into the entry's own list, and its
 //      continuation into the entry's `cont`, which the list step links into Q_{j+1}),
@@ -119,6 +119,7 @@ struct HcCell {
   HV v;
   sac::Mod<int> cls;
   sac::Mod<HcCell*> next;
+  sac::Mod<HcCell*> next_same;  // the next vertex of its block whose class is ≡ its own mod 64
 };
 
 /// A size class, keyed by j.
@@ -149,6 +150,11 @@ struct HcCellBlock {
   HcCell* first;
   sac::Mod<HcClassSet> classes;
   sac::Mod<HcCellBlock*> next;
+  // The block's vertices by class mod 64, in list order: the first of each (head), and where
+  // the next goes (tail, while the walk of the block runs). A class's walk of the block
+  // passes its own members only (HpuCellsProgram::class_member).
+  std::array<sac::Mod<HcCell*>, 64> head;  // written only for the classes the block holds
+  std::array<sac::Mod<sac::Mod<HcCell*>*>, 64> tail;
 };
 
 /// Class j's place in a block of the initial vertices, keyed by (j, the block's first
@@ -317,12 +323,23 @@ struct HpuCellsProgram {
   }
 
   /// The classes of block b's initial vertices from `cell` on, given those before it (mask,
-  /// max). A class that changes re-runs the steps after it in its block only.
+  /// max), and the block's vertices linked by class: `cell` goes after the last vertex of its
+  /// class mod 64, through that class's tail. A class that changes re-runs the steps after it
+  /// in its block only, and the next member's link of the classes it left and joined.
   static void block_classes(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, HcCellBlock* b, std::uint64_t mask,
                             int max) {
     e.read(cell->cls, [cell, pg, b, mask, max](sac::Engine& e2, int c) {
-      e2.memo_read(cell->next, sac::fn<&block_classes_next>(pg, b, mask | std::uint64_t{1} << (static_cast<unsigned>(c) & 63),
-                                                            std::max(max, c)));
+      const unsigned k = static_cast<unsigned>(c) & 63;
+      if (!((mask >> k) & 1)) {
+        e2.write(b->head[k], cell);
+        e2.write(b->tail[k], &cell->next_same);
+      } else {
+        e2.read(b->tail[k], [cell, b, k](sac::Engine& e3, sac::Mod<HcCell*>* qd) {
+          e3.write(*qd, cell);
+          e3.write(b->tail[k], &cell->next_same);
+        });
+      }
+      e2.memo_read(cell->next, sac::fn<&block_classes_next>(pg, b, mask | std::uint64_t{1} << k, std::max(max, c)));
     });
   }
 
@@ -330,6 +347,9 @@ struct HpuCellsProgram {
                                  int max) {
     if (nx && !opens_block(nx->v)) return block_classes(e, nx, pg, b, mask, max);
     e.write(b->classes, HcClassSet{mask, max});
+    for (std::uint64_t m = mask; m; m &= m - 1)
+      e.read(b->tail[static_cast<unsigned>(std::countr_zero(m))],
+             [](sac::Engine& e2, sac::Mod<HcCell*>* qd) { e2.write(*qd, nullptr); });
     if (!nx) return e.write(b->next, nullptr);
     HcCellBlock* nb = e.alloc<HcCellBlock>(nx->v, nx);
     e.write(b->next, nb);
@@ -356,7 +376,7 @@ struct HpuCellsProgram {
   /// "Class lists by block").
   static void class_block(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b, bool more) {
     e.read(cb->classes, [cb, pg, cs, b, more](sac::Engine& e2, const HcClassSet& set) {
-      if (set.has(cs->j)) class_cell(e2, cb->first, pg, cs, b);
+      if (set.has(cs->j)) e2.memo_read(cb->head[static_cast<unsigned>(cs->j) & 63], sac::fn<&class_member>(pg, cs, b));
       HcBlock* nb = e2.alloc<HcBlock>(std::tuple{cs->j, cb->first->v});
       e2.read(b->init_tail, [nb](sac::Engine& e3, sac::Mod<HcEntry*>* qd) { e3.write(nb->init_tail, qd); });
       e2.memo_read(cb->next, sac::fn<&class_block_next>(pg, cs, nb, more || set.max > cs->j));
@@ -373,9 +393,12 @@ struct HpuCellsProgram {
     });
   }
 
-  /// One initial vertex of a block that holds class j: appended to Q_j's initial entries if
-  /// of class j.
-  static void class_cell(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
+  /// One initial vertex of class j mod 64 in a block: appended to Q_j's initial entries if of
+  /// class j. The walk passes the block's members of j's class mod 64 only: it used to pass
+  /// every vertex of the block, five for each member (bench/RESULTS.md, "Class walks over a
+  /// block's members").
+  static void class_member(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
+    if (!cell) return;
     e.read(cell->cls, [cell, cs, b](sac::Engine& e2, int c) {
       if (c != cs->j) return;
       HcEntry* ent = e2.alloc<HcEntry>(std::tuple{cell->v, cs->j, true}, cell->v, true);
@@ -384,11 +407,7 @@ struct HpuCellsProgram {
         e3.write(b->init_tail, &ent->next);
       });
     });
-    e.memo_read(cell->next, sac::fn<&class_cell_next>(pg, cs, b));
-  }
-
-  static void class_cell_next(sac::Engine& e, HcCell* nx, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
-    if (nx && !opens_block(nx->v)) class_cell(e, nx, pg, cs, b);
+    e.memo_read(cell->next_same, sac::fn<&class_member>(pg, cs, b));
   }
 
   /// A round of class j on the entries from `head`: collect all, then process the pairs,
