@@ -859,22 +859,21 @@ void Engine::undo(Stamp* s) {
         if (defaulted)
           seen = m->default_only() ? v->ops->shared_default() : (older = default_base(*m, true, v->ops));
         const bool same = seen && v->ops->equal(v, seen);
-        if (older && !v->unordered_readers && !older->readers) {
-          // Mostly older is the re-executed write that replaces v, and has no readers yet:
-          // v's ordered list becomes older's whole, and when the value is the same no
-          // reader but the first is touched.
-          older->readers = v->readers;
-          older->readers->rpprev = &older->readers;
-          if (!same)
-            for (ReaderLink* r = older->readers; r; r = r->rnext) note_change(r, *m, v, seen, seen != nullptr);
-        } else if (older) {
+        if (older) {
           // v's readers are all timed after older's: in order, they go first among older's
-          // ordered readers.
-          for (ReaderLink* r = v->unordered_readers; r; r = r->rnext) order_scratch_.push_back(r);
+          // ordered readers. Mostly older is the re-executed write that replaces v and has
+          // no readers yet: then v's ordered list becomes older's whole, with no reader
+          // touched but the first (none more when the value is the same).
           ReaderLink* rest = older->readers;
-          ReaderLink** end = link_merged(&older->readers, v->readers);
-          *end = rest;
-          if (rest) rest->rpprev = end;
+          if (!v->unordered_readers && !rest) {
+            older->readers = v->readers;
+            older->readers->rpprev = &older->readers;
+          } else {
+            for (ReaderLink* r = v->unordered_readers; r; r = r->rnext) order_scratch_.push_back(r);
+            ReaderLink** end = link_merged(&older->readers, v->readers);
+            *end = rest;
+            if (rest) rest->rpprev = end;
+          }
           if (!same)
             for (ReaderLink* r = older->readers; r != rest; r = r->rnext) note_change(r, *m, v, seen, seen != nullptr);
         } else {
