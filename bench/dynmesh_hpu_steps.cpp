@@ -12,10 +12,13 @@
 // events created, the reads re-executed, and the steps re-run by kind. An update that creates
 // far more events than its steps explain has re-run a list pass (bench/RESULTS.md, "Fewer
 // collects"). --breakdown prints where the trace's bytes go after each build; --engine-stats
-// the engine's counters (sac::Stats) after each series.
+// the engine's counters (sac::Stats) after each series; --search-stats what the steps'
+// searches walked, per input point from scratch and per update: left searches, cells
+// visited, leaves read (and the share of them empty), and vertices handed to the questions.
 //
 //   dynmesh_hpu_steps [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
 //                     [--seed 1] [--angle 20.7] [--verify] [--tail K] [--breakdown] [--engine-stats]
+//                     [--search-stats]
 #include <algorithm>
 #include <array>
 #include <cstdint>
@@ -81,6 +84,7 @@ int main(int argc, char** argv) {
   bool verify = false;
   bool breakdown = false;
   bool engine_stats = false;
+  bool search_stats = false;
   std::size_t tail = 0;
   app.add_option("--dist", dists, "distributions, comma-separated")->delimiter(',');
   app.add_option("--n", sizes, "sizes, comma-separated")->delimiter(',');
@@ -90,6 +94,8 @@ int main(int argc, char** argv) {
   app.add_flag("--verify", verify, "compare the final mesh with HpuMesh's");
   app.add_option("--tail", tail, "after each row, print its K costliest propagations (by trace distance)");
   app.add_flag("--engine-stats", engine_stats, "after each series, print the engine's counters (sac::Stats)");
+  app.add_flag("--search-stats", search_stats,
+               "after each series, print what the searches walked, per point from scratch and per update");
   app.add_flag("--breakdown", breakdown, "after each build, print where the trace's bytes go (sac::MemoryBreakdown)");
   CLI11_PARSE(app, argc, argv);
 
@@ -113,6 +119,7 @@ int main(int argc, char** argv) {
       const HcStepCounts s0 = run.program.steps;
       if (breakdown) std::cout << run.engine.memory_breakdown() << std::flush;
       const auto c0 = run.program.view.counts();
+      const std::size_t asks0 = run.program.stats.neighbour_asks;
       const double steps0 = static_cast<double>(s0.total());
       std::mt19937_64 rng(seed * 7919 + n);
       std::vector<double> dist_v, us_v;
@@ -171,6 +178,26 @@ int main(int argc, char** argv) {
                     static_cast<unsigned long long>(c.steps[4]));
       std::fflush(stdout);
       if (engine_stats) std::cout << "  engine: " << st << "\n" << std::flush;
+      if (search_stats) {
+        const auto c1 = run.program.view.counts();
+        const double asks1 = static_cast<double>(run.program.stats.neighbour_asks - asks0);
+        const auto share = [](std::uint64_t part, std::uint64_t whole) {
+          return whole ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
+        };
+        const double pn = static_cast<double>(n);
+        std::printf("  searches, per point from scratch: left searches %.1f, cells visited %.1f, leaves read %.1f "
+                    "(%.1f%% empty), vertices handed %.1f\n",
+                    static_cast<double>(asks0) / pn, static_cast<double>(c0.visits) / pn,
+                    static_cast<double>(c0.leaves) / pn, share(c0.empty_leaves, c0.leaves),
+                    static_cast<double>(c0.vertices) / pn);
+        std::printf("  searches, per update: left searches %.0f, cells visited %.0f, leaves read %.0f (%.1f%% empty), "
+                    "vertices handed %.0f\n",
+                    asks1 / m, static_cast<double>(c1.visits - c0.visits) / m,
+                    static_cast<double>(c1.leaves - c0.leaves) / m,
+                    share(c1.empty_leaves - c0.empty_leaves, c1.leaves - c0.leaves),
+                    static_cast<double>(c1.vertices - c0.vertices) / m);
+        std::fflush(stdout);
+      }
       if (verify) {
         const bool same = run.state.feed.triangles() == HpuMesh(box, pts, angle).triangles();
         std::printf("  verified against HpuMesh: %s\n", same ? "yes" : "NO");

@@ -280,9 +280,12 @@ class CellView {
   std::span<CellNode* const> pending() const noexcept { return pending_; }
   std::size_t leaves_read() const noexcept { return leaves_read_; }
 
-  /// What the steps' reads cost so far: rounds issued (read_many events) and cells in them.
+  /// What the steps' reads cost so far: rounds issued (read_many events) and cells in them;
+  /// and what their searches walked: cells visited (pruned or not), leaves read, of them
+  /// empty, and vertices handed to the questions (dynmesh_hpu_steps --search-stats).
   struct Counts {
     std::uint64_t rounds = 0, cells = 0;
+    std::uint64_t visits = 0, leaves = 0, empty_leaves = 0, vertices = 0;
   };
   const Counts& counts() const noexcept { return counts_; }
   void count_round(std::size_t cells) noexcept {
@@ -619,6 +622,7 @@ class CellView {
   template <class Keep, class F>
   void search_node(CellNode* n, const Point<2>& focus, double margin, Keep& keep, F& f, bool& stop) {
     const CellKey& k = n->key;
+    ++counts_.visits;
     double x0, y0, x1, y1;
     cell_box(k, margin, x0, y0, x1, y1);
     if (!keep(x0, y0, x1, y1)) return;
@@ -630,11 +634,15 @@ class CellView {
         if (region_) widen(x, region_c_, region_r_);
         else visited_.push_back(n);
         const CellState& s = *x.state;
+        ++counts_.leaves;
+        counts_.empty_leaves += s.count == 0;
         for (std::size_t i = 0; i < s.count; ++i)
           if (f(s.items[i])) {
+            counts_.vertices += i + 1;
             stop = true;
             return;
           }
+        counts_.vertices += s.count;
         return;
       }
       case Tag::Split: {
