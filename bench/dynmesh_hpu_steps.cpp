@@ -120,6 +120,7 @@ int main(int argc, char** argv) {
       if (breakdown) std::cout << run.engine.memory_breakdown() << std::flush;
       const auto c0 = run.program.view.counts();
       const std::size_t asks0 = run.program.stats.neighbour_asks;
+      const std::size_t leaves0 = run.program.view.leaves_read();
       const double steps0 = static_cast<double>(s0.total());
       std::mt19937_64 rng(seed * 7919 + n);
       std::vector<double> dist_v, us_v;
@@ -181,6 +182,7 @@ int main(int argc, char** argv) {
       if (search_stats) {
         const auto c1 = run.program.view.counts();
         const double asks1 = static_cast<double>(run.program.stats.neighbour_asks - asks0);
+        const std::uint64_t leaves1 = run.program.view.leaves_read() - leaves0;
         const auto share = [](std::uint64_t part, std::uint64_t whole) {
           return whole ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
         };
@@ -188,13 +190,12 @@ int main(int argc, char** argv) {
         std::printf("  searches, per point from scratch: left searches %.1f, cells visited %.1f, leaves read %.1f "
                     "(%.1f%% empty), vertices handed %.1f\n",
                     static_cast<double>(asks0) / pn, static_cast<double>(c0.visits) / pn,
-                    static_cast<double>(c0.leaves) / pn, share(c0.empty_leaves, c0.leaves),
+                    static_cast<double>(leaves0) / pn, share(c0.empty_leaves, leaves0),
                     static_cast<double>(c0.vertices) / pn);
         std::printf("  searches, per update: left searches %.0f, cells visited %.0f, leaves read %.0f (%.1f%% empty), "
                     "vertices handed %.0f\n",
                     asks1 / m, static_cast<double>(c1.visits - c0.visits) / m,
-                    static_cast<double>(c1.leaves - c0.leaves) / m,
-                    share(c1.empty_leaves - c0.empty_leaves, c1.leaves - c0.leaves),
+                    static_cast<double>(leaves1) / m, share(c1.empty_leaves - c0.empty_leaves, leaves1),
                     static_cast<double>(c1.vertices - c0.vertices) / m);
         std::fflush(stdout);
       }

@@ -281,11 +281,12 @@ class CellView {
   std::size_t leaves_read() const noexcept { return leaves_read_; }
 
   /// What the steps' reads cost so far: rounds issued (read_many events) and cells in them;
-  /// and what their searches walked: cells visited (pruned or not), leaves read, of them
-  /// empty, and vertices handed to the questions (dynmesh_hpu_steps --search-stats).
+  /// and what their searches walked besides leaves_read(): cells visited (pruned or not),
+  /// empty leaves read, and vertices handed to the questions (dynmesh_hpu_steps
+  /// --search-stats).
   struct Counts {
     std::uint64_t rounds = 0, cells = 0;
-    std::uint64_t visits = 0, leaves = 0, empty_leaves = 0, vertices = 0;
+    std::uint64_t visits = 0, empty_leaves = 0, vertices = 0;
   };
   const Counts& counts() const noexcept { return counts_; }
   void count_round(std::size_t cells) noexcept {
@@ -634,7 +635,6 @@ class CellView {
         if (region_) widen(x, region_c_, region_r_);
         else visited_.push_back(n);
         const CellState& s = *x.state;
-        ++counts_.leaves;
         counts_.empty_leaves += s.count == 0;
         for (std::size_t i = 0; i < s.count; ++i)
           if (f(s.items[i])) {
