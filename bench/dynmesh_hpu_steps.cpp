@@ -13,8 +13,9 @@
 // far more events than its steps explain has re-run a list pass (bench/RESULTS.md, "Fewer
 // collects"). --breakdown prints where the trace's bytes go after each build; --engine-stats
 // the engine's counters (sac::Stats) after each series; --search-stats what the steps'
-// searches walked, per input point from scratch and per update: left searches, cells
-// visited, leaves read (and the share of them empty), and vertices handed to the questions.
+// searches asked and read, per input point from scratch and per update: left searches and
+// leaves read (counters the program keeps anyway: counting more inside the view's leaf loop
+// cost 2% of an update's instructions, bench/RESULTS.md).
 //
 //   dynmesh_hpu_steps [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
 //                     [--seed 1] [--angle 20.7] [--verify] [--tail K] [--breakdown] [--engine-stats]
@@ -95,7 +96,7 @@ int main(int argc, char** argv) {
   app.add_option("--tail", tail, "after each row, print its K costliest propagations (by trace distance)");
   app.add_flag("--engine-stats", engine_stats, "after each series, print the engine's counters (sac::Stats)");
   app.add_flag("--search-stats", search_stats,
-               "after each series, print what the searches walked, per point from scratch and per update");
+               "after each series, print the left searches and leaves read, per point from scratch and per update");
   app.add_flag("--breakdown", breakdown, "after each build, print where the trace's bytes go (sac::MemoryBreakdown)");
   CLI11_PARSE(app, argc, argv);
 
@@ -180,23 +181,13 @@ int main(int argc, char** argv) {
       std::fflush(stdout);
       if (engine_stats) std::cout << "  engine: " << st << "\n" << std::flush;
       if (search_stats) {
-        const auto c1 = run.program.view.counts();
         const double asks1 = static_cast<double>(run.program.stats.neighbour_asks - asks0);
         const std::uint64_t leaves1 = run.program.view.leaves_read() - leaves0;
-        const auto share = [](std::uint64_t part, std::uint64_t whole) {
-          return whole ? 100.0 * static_cast<double>(part) / static_cast<double>(whole) : 0.0;
-        };
         const double pn = static_cast<double>(n);
-        std::printf("  searches, per point from scratch: left searches %.1f, cells visited %.1f, leaves read %.1f "
-                    "(%.1f%% empty), vertices handed %.1f\n",
-                    static_cast<double>(asks0) / pn, static_cast<double>(c0.visits) / pn,
-                    static_cast<double>(leaves0) / pn, share(c0.empty_leaves, leaves0),
-                    static_cast<double>(c0.vertices) / pn);
-        std::printf("  searches, per update: left searches %.0f, cells visited %.0f, leaves read %.0f (%.1f%% empty), "
-                    "vertices handed %.0f\n",
-                    asks1 / m, static_cast<double>(c1.visits - c0.visits) / m,
-                    static_cast<double>(leaves1) / m, share(c1.empty_leaves - c0.empty_leaves, leaves1),
-                    static_cast<double>(c1.vertices - c0.vertices) / m);
+        std::printf("  searches, per point from scratch: left searches %.1f, leaves read %.1f\n",
+                    static_cast<double>(asks0) / pn, static_cast<double>(leaves0) / pn);
+        std::printf("  searches, per update: left searches %.0f, leaves read %.0f\n", asks1 / m,
+                    static_cast<double>(leaves1) / m);
         std::fflush(stdout);
       }
       if (verify) {

@@ -334,9 +334,6 @@ TEST(CellView, TheNearestSearchFromTheLeafUpVisitsWhatTheSearchFromTheRootVisits
     for (const CellVertex& v : vs) {
       NearestRecord down{v.p, std::numeric_limits<double>::infinity(), {}};
       NearestRecord up = down;
-      const std::uint64_t handed_before = view.counts().vertices, visits_before = view.counts().visits,
-                          empty_before = view.counts().empty_leaves;
-      const std::size_t leaves_before = view.leaves_read();
       view.reset();
       view.search(v.p, 0.0, dir.margin_for(v.p, 0.0), [&](double a, double b, double c, double d) { return down.keep(a, b, c, d); },
                   [&](const CellVertex* w) { return down.see(w); });
@@ -346,13 +343,6 @@ TEST(CellView, TheNearestSearchFromTheLeafUpVisitsWhatTheSearchFromTheRootVisits
                        [&](const CellVertex* w) { return up.see(w); }, [&] { return up.reach(); });
       view.used_all();
       ASSERT_EQ(up.seen, down.seen) << "at (" << v.p[0] << ", " << v.p[1] << ")";
-      // The view's counts: every vertex handed once; a leaf read is a cell visited, and an
-      // empty one is a leaf read.
-      const CellView::Counts& c = view.counts();
-      const std::size_t leaves = view.leaves_read() - leaves_before;
-      ASSERT_EQ(c.vertices - handed_before, down.seen.size() + up.seen.size());
-      ASSERT_GE(c.visits - visits_before, leaves);
-      ASSERT_LE(c.empty_leaves - empty_before, leaves);
       focused += up.seen.size() < 200;
     }
   });

@@ -280,13 +280,9 @@ class CellView {
   std::span<CellNode* const> pending() const noexcept { return pending_; }
   std::size_t leaves_read() const noexcept { return leaves_read_; }
 
-  /// What the steps' reads cost so far: rounds issued (read_many events) and cells in them;
-  /// and what their searches walked besides leaves_read(): cells visited (pruned or not),
-  /// empty leaves read, and vertices handed to the questions (dynmesh_hpu_steps
-  /// --search-stats).
+  /// What the steps' reads cost so far: rounds issued (read_many events) and cells in them.
   struct Counts {
     std::uint64_t rounds = 0, cells = 0;
-    std::uint64_t visits = 0, empty_leaves = 0, vertices = 0;
   };
   const Counts& counts() const noexcept { return counts_; }
   void count_round(std::size_t cells) noexcept {
@@ -623,7 +619,6 @@ class CellView {
   template <class Keep, class F>
   void search_node(CellNode* n, const Point<2>& focus, double margin, Keep& keep, F& f, bool& stop) {
     const CellKey& k = n->key;
-    ++counts_.visits;
     double x0, y0, x1, y1;
     cell_box(k, margin, x0, y0, x1, y1);
     if (!keep(x0, y0, x1, y1)) return;
@@ -635,14 +630,11 @@ class CellView {
         if (region_) widen(x, region_c_, region_r_);
         else visited_.push_back(n);
         const CellState& s = *x.state;
-        counts_.empty_leaves += s.count == 0;
         for (std::size_t i = 0; i < s.count; ++i)
           if (f(s.items[i])) {
-            counts_.vertices += i + 1;
             stop = true;
             return;
           }
-        counts_.vertices += s.count;
         return;
       }
       case Tag::Split: {
