@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <memory>
 #include <random>
@@ -357,6 +358,43 @@ TEST(HpuCellsProgram, AChangeOfPlaceInAListReRunsNoCollectOrTry) {
   EXPECT_LT(collects, 33.0);
   EXPECT_LT(tries, 17.0);
   EXPECT_TRUE(same_triangles(h.triangles(), HpuMesh(box, pts, kHpuDefaultMinAngle).triangles()));
+  EXPECT_NO_THROW(h.check());
+}
+
+/// The least initial class is the blocks' (HpuCellsProgram::block_min), not a running
+/// minimum in the first-class steps' keys: an update that makes a new least class, a point
+/// put next to another, used to re-run the first class of every initial vertex after it in
+/// the list (7,488 in one update at uniform 10^5, `dynmesh_hpu_steps --tail`). Per
+/// propagation the first classes re-run stay a handful, wherever the pair falls in the list.
+TEST(HpuCellsProgram, ANewLeastClassReRunsAFewFirstClasses) {
+  const std::uint64_t seed = 11;
+  SCOPED_TRACE(seed_note(seed));
+  const std::size_t n = kSanitized ? 800 : 4000;
+  std::vector<Point<2>> pts = generate<2>(Distribution::Uniform, n, seed);
+  const Box<2> box = derive_box<2>(pts);
+  double least = std::numeric_limits<double>::infinity();  // the closest pair's distance
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    for (std::size_t k = i + 1; k < pts.size(); ++k)
+      least = std::min(least, std::hypot(pts[i][0] - pts[k][0], pts[i][1] - pts[k][1]));
+  HpuHarness h(box, pts, kHpuDefaultMinAngle);
+  std::mt19937_64 rng(seed);
+  std::uint64_t most = 0;
+  for (int k = 0; k < (kSanitized ? 2 : 6); ++k) {
+    const Point<2> q = pts[rng() % pts.size()];
+    const Point<2> x{q[0] + least / 16, q[1] + least / 32};  // a pair well below the least class
+    for (const bool insert : {true, false}) {
+      const std::uint64_t before = h.steps().done[detail::HcStepCounts::FirstClass];
+      if (insert) pts.push_back(x);
+      else pts.pop_back();
+      h.set_points(pts);
+      const std::uint64_t ran = h.steps().done[detail::HcStepCounts::FirstClass] - before;
+      most = std::max(most, ran);
+      EXPECT_LE(ran, 24u) << (insert ? "inserting " : "deleting ") << x[0] << ", " << x[1];
+      EXPECT_TRUE(same_triangles(h.triangles(), HpuMesh(box, pts, kHpuDefaultMinAngle).triangles()));
+    }
+  }
+  std::printf("[ HpuCells ] uniform n = %zu: at most %llu first classes re-run by a new least class\n", n,
+              static_cast<unsigned long long>(most));
   EXPECT_NO_THROW(h.check());
 }
 
