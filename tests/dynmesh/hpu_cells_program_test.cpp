@@ -361,7 +361,7 @@ TEST(HpuCellsProgram, AChangeOfPlaceInAListReRunsNoCollectOrTry) {
   EXPECT_NO_THROW(h.check());
 }
 
-/// The least initial class is the blocks' (HpuCellsProgram::block_min), not a running
+/// The least initial class is the blocks' (HpuCellsProgram::block_bounds), not a running
 /// minimum in the first-class steps' keys: an update that makes a new least class, a point
 /// put next to another, used to re-run the first class of every initial vertex after it in
 /// the list (7,488 in one update at uniform 10^5, `dynmesh_hpu_steps --tail`). Per

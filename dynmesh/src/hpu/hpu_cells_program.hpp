@@ -12,7 +12,7 @@
 //   2. each initial vertex's class (its shortest Delaunay edge's): a step; and, per block of
 //      the initial list (cut where a vertex's coordinates hash to it, about 32 long), the set
 //      of its classes and its vertices linked by class mod 64, in list order; the smallest
-//      class from the blocks' sets;
+//      and the largest class from the blocks' sets;
 //   3. per class j, smallest first: Q_j = (initial entries of class j, in initial order, from
 //      the blocks whose set holds j, each walked along its links of j's class mod 64) ++
 //      (continuations made during class j − 1); rounds: collect every entry of the round (a
@@ -131,7 +131,6 @@ struct HcClass {
   int j;
   sac::Mod<HcEntry*> init;  // Q_j: the initial entries of class j, then `cont`
   sac::Mod<HcEntry*> cont;  // the continuations made during class j − 1
-  sac::Mod<bool> more;      // some initial vertex is of a class above j
 };
 
 /// The classes of a block's initial vertices: bit c mod 64 for each class c, the largest and
@@ -186,6 +185,7 @@ struct HcStart {
   HcStart& operator=(const HcStart&) = delete;
   sac::Mod<HcCell*> cells;  // the initial vertices, in order
   sac::Mod<int> min_class;  // the smallest initial class
+  sac::Mod<int> max_class;  // the largest
   HcCellBlock* blocks = nullptr;  // the first block of the initial vertices
 };
 
@@ -260,7 +260,7 @@ struct HpuCellsProgram {
     // The corners come first, so the list's head is a fixed cell.
     pg->start->blocks = e.alloc<HcCellBlock>(HV{nullptr}, head);
     e.memo(sac::fn<&block_classes>(pg->start->blocks->first, pg, pg->start->blocks, std::uint64_t{0}, INT_MIN, INT_MAX));
-    e.memo(sac::fn<&block_min>(pg->start->blocks, pg, INT_MAX));
+    e.memo(sac::fn<&block_bounds>(pg->start->blocks, pg, INT_MAX, INT_MIN));
     e.memo(sac::fn<&refine_start>(pg));
     e.memo(sac::fn<&final_start>(pg));
   }
@@ -282,7 +282,7 @@ struct HpuCellsProgram {
   /// The class of an initial vertex. Its key holds nothing of the vertices before it: with
   /// the least class so far in it, an update that changed that least class ran every step
   /// after again (7,488 nearest searches in one update at uniform 10^5); the least class is
-  /// now the blocks' (block_min). The view's searches take no scale, so none is guessed.
+  /// now the blocks' (block_bounds). The view's searches take no scale, so none is guessed.
   struct FirstClassStep {
     HpuCellsProgram* pg;
     HcCell* cell;
@@ -359,18 +359,22 @@ struct HpuCellsProgram {
     block_classes(e, nx, pg, nb, 0, INT_MIN, INT_MAX);
   }
 
-  /// The smallest initial class: the least of the blocks', in a walk of the blocks. A block
-  /// that changes the least so far re-runs this walk up to the next block below it, a step
-  /// per block with no question asked.
-  static void block_min(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, int mn) {
-    e.read(cb->classes, [cb, pg, mn](sac::Engine& e2, const HcClassSet& set) {
-      e2.memo_read(cb->next, sac::fn<&block_min_next>(pg, std::min(mn, set.min)));
+  /// The smallest and the largest initial class, from the blocks' sets, in a walk of the
+  /// blocks. A block that changes the least or the greatest so far re-runs this walk up to
+  /// the next block beyond it, a step per block with no question asked. Threaded through
+  /// the first-class steps instead, a new least class re-ran every one after it; threaded
+  /// through each class's walk of the blocks ("a block before holds a class above j"), a
+  /// change of the first block above j re-ran that class's walk up to the next.
+  static void block_bounds(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, int mn, int mx) {
+    e.read(cb->classes, [cb, pg, mn, mx](sac::Engine& e2, const HcClassSet& set) {
+      e2.memo_read(cb->next, sac::fn<&block_bounds_next>(pg, std::min(mn, set.min), std::max(mx, set.max)));
     });
   }
 
-  static void block_min_next(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, int mn) {
-    if (!cb) return e.write(pg->start->min_class, mn);
-    block_min(e, cb, pg, mn);
+  static void block_bounds_next(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, int mn, int mx) {
+    if (cb) return block_bounds(e, cb, pg, mn, mx);
+    e.write(pg->start->min_class, mn);
+    e.write(pg->start->max_class, mx);
   }
 
   /// Class j: its initial entries from the blocks that hold some, then its rounds.
@@ -378,12 +382,12 @@ struct HpuCellsProgram {
     HcClass* csn = e.alloc<HcClass>(cs->j + 1, cs->j + 1);
     HcBlock* b = e.alloc<HcBlock>(std::tuple{cs->j, HV{nullptr}});
     e.write(b->init_tail, &cs->init);
-    e.memo(sac::fn<&class_block>(pg->start->blocks, pg, cs, b, false));
+    e.memo(sac::fn<&class_block>(pg->start->blocks, pg, cs, b));
     e.memo(sac::fn<&round>(pg, cs, csn, &cs->init, &csn->cont));
   }
 
   /// Class j in block cb: its members appended at b's tail, which the next block's copy
-  /// continues. `more`: a block before held a class above j.
+  /// continues.
   /// The tail is a modifiable, not an argument: with it in the key, a vertex that joined or
   /// left the class gave every step after it a new key up to the next member, thousands of
   /// steps at the class holding most vertices. Through the tail's versions it re-runs the
@@ -391,19 +395,17 @@ struct HpuCellsProgram {
   /// a tail's versions, which the runtime walks from the newest to read or write at a time:
   /// one tail for the whole class was as exact, and several times slower (bench/RESULTS.md,
   /// "Class lists by block").
-  static void class_block(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b, bool more) {
-    e.read(cb->classes, [cb, pg, cs, b, more](sac::Engine& e2, const HcClassSet& set) {
+  static void class_block(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
+    e.read(cb->classes, [cb, pg, cs, b](sac::Engine& e2, const HcClassSet& set) {
       if (set.has(cs->j)) e2.memo_read(cb->head[static_cast<unsigned>(cs->j) & 63], sac::fn<&class_member>(pg, cs, b));
       HcBlock* nb = e2.alloc<HcBlock>(std::tuple{cs->j, cb->first->v});
       e2.read(b->init_tail, [nb](sac::Engine& e3, sac::Mod<HcEntry*>* qd) { e3.write(nb->init_tail, qd); });
-      e2.memo_read(cb->next, sac::fn<&class_block_next>(pg, cs, nb, more || set.max > cs->j));
+      e2.memo_read(cb->next, sac::fn<&class_block_next>(pg, cs, nb));
     });
   }
 
-  static void class_block_next(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b,
-                               bool more) {
-    if (cb) return class_block(e, cb, pg, cs, b, more);
-    e.write(cs->more, more);
+  static void class_block_next(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
+    if (cb) return class_block(e, cb, pg, cs, b);
     // Q_j = its initial entries ++ the continuations of class j − 1 (terminated by now).
     e.read(b->init_tail, [cs](sac::Engine& e2, sac::Mod<HcEntry*>* qd) {
       e2.read(cs->cont, [qd](sac::Engine& e3, HcEntry* h) { e3.write(*qd, h); });
@@ -450,8 +452,8 @@ struct HpuCellsProgram {
   /// The next class when anything is left: continuations, or initial vertices above j.
   static void class_end(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcClass* csn) {
     e.read(csn->cont, [pg, cs, csn](sac::Engine& e2, HcEntry* c) {
-      e2.read(cs->more, [pg, csn, c](sac::Engine& e3, bool more) {
-        if (c || more) e3.memo(sac::fn<&class_start>(pg, csn));
+      e2.read(pg->start->max_class, [pg, cs, csn, c](sac::Engine& e3, int max) {
+        if (c || cs->j < max) e3.memo(sac::fn<&class_start>(pg, csn));
       });
     });
   }
