@@ -210,11 +210,12 @@ struct HpuCellsProgram {
   using Questions = CellQuestions<CellView, HV, Coords>;
 
   HpuCellsProgram(sac::Engine& e, CellDirectory& d, sac::Mod<HpuInputNode*>& in,
-                  const std::array<const CellVertex*, 4>& box_corners, double min_angle_deg, HpuMeshFeed& f)
-      : dir(&d), input(&in), corners(box_corners), feed(&f), view(e, d),
+                  const std::array<const CellVertex*, 4>& box_corners, double min_angle_deg, HpuMeshFeed& f,
+                  SteinerVertices& sv)
+      : dir(&d), input(&in), corners(box_corners), feed(&f), steiner(&sv), view(e, d),
         q(d.box(), min_angle_deg, view, Coords{}, nullptr, stats) {}
   HpuCellsProgram(sac::Engine& e, HpuCellsState& st, double min_angle_deg)
-      : HpuCellsProgram(e, st.cells, st.inputs.head(), st.corner_vertices(), min_angle_deg, st.feed) {}
+      : HpuCellsProgram(e, st.cells, st.inputs.head(), st.corner_vertices(), min_angle_deg, st.feed, st.steiner) {}
   HpuCellsProgram(const HpuCellsProgram&) = delete;
   HpuCellsProgram& operator=(const HpuCellsProgram&) = delete;
 
@@ -222,6 +223,7 @@ struct HpuCellsProgram {
   sac::Mod<HpuInputNode*>* input;
   std::array<const CellVertex*, 4> corners;
   HpuMeshFeed* feed;
+  SteinerVertices* steiner;
   HcStart* start = nullptr;
   CellView view;  // the running step's (steps run one at a time)
   CellQuestionStats stats;
@@ -580,6 +582,13 @@ struct HpuCellsProgram {
     return c;
   }
 
+  /// The Steiner vertex at p: one object per point for as long as the trace holds it
+  /// (steiner_vertices.hpp), so a try that re-runs elsewhere in the trace hands the steps
+  /// that read it the vertex they saw.
+  static const CellVertex* steiner_at(sac::Engine& e, HpuCellsProgram* pg, const Point<2>& p) {
+    return e.alloc<SteinerRef>(std::pair{p[0], p[1]}, pg->steiner, p)->v;
+  }
+
   /// Box edges to split, in order.
   struct Splits {
     std::array<std::array<HV, 2>, 4> s{};
@@ -610,7 +619,7 @@ struct HpuCellsProgram {
           break;
         }
         case CellDecision<HV>::Insert: {
-          const CellVertex* x = e.alloc<CellVertex>(std::pair{d.at[0], d.at[1]}, d.at);
+          const CellVertex* x = steiner_at(e, pg, d.at);
           run_step(e, InsertStep<AfterOffCenter>{pg, x, c.cs->j, AfterOffCenter{c}});
           break;
         }
@@ -628,7 +637,7 @@ struct HpuCellsProgram {
   static void split_next(sac::Engine& e, const Ctx& c, const Splits& sp, std::uint32_t i) {
     if (i == sp.n) return run_step(e, TryStep{c});
     const Point<2> mid = side_midpoint(sp.s[i][0]->p, sp.s[i][1]->p);
-    const CellVertex* m = e.alloc<CellVertex>(std::pair{mid[0], mid[1]}, mid);
+    const CellVertex* m = steiner_at(e, c.pg, mid);
     run_step(e, InsertStep<AfterSplit>{c.pg, m, c.cs->j, AfterSplit{c, sp, i}});
   }
 

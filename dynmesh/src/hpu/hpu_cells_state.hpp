@@ -3,7 +3,8 @@
 //
 // Purpose: one owner for the input list (HpuInputs: the inputs and their side midpoints in
 // insertion order), the cell store (CellDirectory, and InputCells: the box's corners and the
-// list's vertices as the store's base values) and the change feed (HpuMeshFeed). DynamicMesh,
+// list's vertices as the store's base values), the Steiner vertices (SteinerVertices) and
+// the change feed (HpuMeshFeed). DynamicMesh,
 // the program's tests and its benchmark all hold one, declared before their engine so that it
 // outlives the trace that refers to it, and the program after the engine; the owner calls
 // feed.close() before its engine goes (the blocks the engine destroys then log nothing).
@@ -27,6 +28,7 @@
 #include "hpu/cell_store.hpp"
 #include "hpu/hpu_inputs.hpp"
 #include "hpu/hpu_mesh_feed.hpp"
+#include "hpu/steiner_vertices.hpp"
 
 namespace dynmesh::detail {
 
@@ -51,17 +53,25 @@ struct HpuCellsState {
   /// The edits' plan (validated by the caller's rules; changes nothing), then its commit.
   HpuInputs::Plan plan(std::span<const Edit<2>> edits) const { return inputs.plan(edits); }
   void commit(sac::Engine& e, const HpuInputs::Plan& plan) { inputs.commit(e, plan); }
-  /// After the propagation that follows a commit: frees the list nodes that left.
-  void release(sac::Engine& e) { inputs.release(e); }
+  /// After the propagation that follows a commit: frees the list nodes that left, and the
+  /// Steiner vertices no trace record holds any more.
+  void release(sac::Engine& e) {
+    inputs.release(e);
+    steiner.collect();
+  }
 
-  std::size_t bytes() const noexcept { return inputs.bytes() + feed.bytes() + cells.bytes() + input_cells.bytes(); }
+  std::size_t bytes() const noexcept {
+    return inputs.bytes() + feed.bytes() + cells.bytes() + input_cells.bytes() + steiner.bytes();
+  }
   void check_invariants(std::span<const Point<2>> present) const {
     feed.check_invariants();
     inputs.check_invariants(present);
     input_cells.check_invariants();
+    steiner.check_invariants();
   }
 
   HpuMeshFeed feed;
+  SteinerVertices steiner;  // the off-centers and side midpoints, one object per point
   HpuInputs inputs;
   CellDirectory cells;
   InputCells input_cells;
