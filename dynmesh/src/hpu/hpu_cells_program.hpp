@@ -19,7 +19,8 @@
 //      step, memoized apart from the list: its loose pairs into the entry's own list, and its
 //      continuation into the entry's `cont`, which the list step links into Q_{j+1}),
 //      then process the pairs in collection order (each try a step: not loose, split box
-//      edges, or insert the off-center; an insertion is a step that writes the store's leaf);
+//      edges, or insert the off-center; an insertion is a step that writes the store's leaf;
+//      a Steiner vertex is the pool's object at its point, steiner_vertices.hpp);
 //      births (off-centers and side midpoints) form the next round;
 //   4. the final mesh: a pass over the store's newest leaves; a memoized step per vertex of
 //      a leaf finds the triangles whose (x, y)-smallest corner it is, from its star, and
