@@ -3,8 +3,8 @@
 // points near and on the box sides, grids) and after every update of a dynamic run, its
 // triangles equal the static twin HpuMesh's on the current points at 20.7°, 25° and 30°;
 // the change feed replays; the engine's, the feed's, the input list's and the store's
-// invariants hold, and the store's newest cells are the static bucket tree of the mesh's
-// vertices; the per-update trace distance is printed against the from-scratch trace, and
+// invariants hold, the store's newest cells are the static bucket tree of the mesh's
+// vertices, and the Steiner pool holds exactly the mesh's Steiner vertices; the per-update trace distance is printed against the from-scratch trace, and
 // stays within budgets on curves and spirals; the collects and tries an update re-runs stay
 // within budgets on uniform points.
 #include "hpu/hpu_cells_program.hpp"
@@ -88,6 +88,9 @@ class HpuHarness {
       return static_cast<std::uint32_t>(std::lower_bound(pts.begin(), pts.end(), v->p) - pts.begin());
     };
     EXPECT_EQ(state_.cells.leaves(index_of), tree.leaves()) << "the store's newest cells are not the vertices' bucket tree";
+    // The Steiner pool holds exactly the mesh's Steiner vertices (every vertex but the
+    // corners and the input list's) once a propagation's released ones are collected.
+    EXPECT_EQ(state_.steiner.size() + 4 + state_.inputs.size(), vs.size()) << "the Steiner pool's live vertices";
   }
   const sac::Stats& stats() const { return engine_.stats(); }
   std::size_t record_bytes() const { return engine_.record_bytes(); }
