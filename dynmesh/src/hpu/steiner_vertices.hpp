@@ -13,8 +13,9 @@
 // references is freed only by collect(), which the mutator calls after a propagation, so a
 // vertex released and made again within one propagation is the same object.
 // Invariants (check_invariants): the table maps each point to the vertex at it; a vertex's
-// references are what acquire() gave minus what release() took; every idle vertex (no
-// references, not yet collected) is in the idle list once.
+// references are what acquire() gave minus what release() took, never below zero; every idle
+// vertex (no references, not yet collected) is in the idle list (twice when it was released,
+// acquired and released again since the last collect()).
 // Complexity: acquire/release O(1) expected (open addressing on the point's bits);
 // collect O(idle).
 // Paper: Acar & Hudson, Section 4: keyed allocation, here with the key's identity kept for
@@ -57,7 +58,7 @@ class SteinerVertices {
   /// One reference fewer to v; with none left it waits for collect().
   void release(const CellVertex* v) noexcept {
     Slot& x = slot_of(v);
-    if (--x.refs == 0) idle_.push_back(index_of(x));
+    if (--x.refs == 0) idle_.push_back(x.self);
   }
 
   /// Frees the vertices left without references (after a propagation: no trace record
@@ -81,6 +82,8 @@ class SteinerVertices {
   }
 
   void check_invariants() const {
+    std::vector<bool> listed(slots_.size(), false);
+    for (const std::uint32_t s : idle_) listed[s] = true;
     std::size_t in_table = 0;
     for (std::size_t i = 0; i < table_.size(); ++i) {
       if (table_[i] == kEmpty) continue;
@@ -89,16 +92,19 @@ class SteinerVertices {
       if (x.free) throw InvariantError("dynmesh: SteinerVertices: a freed vertex in the table");
       if (find(x.v.p) != i) throw InvariantError("dynmesh: SteinerVertices: a vertex not where its point hashes");
       if (x.refs < 0) throw InvariantError("dynmesh: SteinerVertices: released more often than acquired");
+      if (x.refs == 0 && !listed[table_[i]])
+        throw InvariantError("dynmesh: SteinerVertices: a vertex without references that collect() would miss");
     }
     if (in_table != live_) throw InvariantError("dynmesh: SteinerVertices: the live count disagrees with the table");
   }
 
  private:
   struct Slot {
-    explicit Slot(const Point<2>& p) : v(p) {}
+    Slot(const Point<2>& p, std::uint32_t i) : v(p), self(i) {}
     CellVertex v;
     std::int32_t refs = 0;
     bool free = false;
+    std::uint32_t self;  // its index in slots_
     std::uint32_t next_free = 0;
   };
   static constexpr std::uint32_t kEmpty = 0xffffffffu;
@@ -151,18 +157,14 @@ class SteinerVertices {
       x.free = false;
       return s;
     }
-    slots_.emplace_back(p);
-    return static_cast<std::uint32_t>(slots_.size() - 1);
+    const auto s = static_cast<std::uint32_t>(slots_.size());
+    slots_.emplace_back(p, s);
+    return s;
   }
   // A CellVertex is the first member of its Slot (standard layout), so its address is the
   // slot's.
   Slot& slot_of(const CellVertex* v) noexcept {
     return *reinterpret_cast<Slot*>(const_cast<CellVertex*>(v));
-  }
-  std::uint32_t index_of(const Slot& x) const noexcept {
-    // The deque gives no index from an address; the slot keeps none either, so find it
-    // by its point (it is in the table while it has references or is idle).
-    return table_[find(x.v.p)];
   }
 
   std::deque<Slot> slots_;           // stable addresses
