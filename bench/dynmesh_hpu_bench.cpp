@@ -3,7 +3,11 @@
 //
 // Method: unif1e4 and unif1e5 are python_uniform(n, 1) (CPython's random.Random(1)), in
 // FORMATS.md's default box, the inputs on which Triangle 1.6 (-pq) and CGAL 5.5 Mesh_2 were
-// measured (their figures below are the issue's, measured on this kind of machine). Each
+// measured (their figures below are the issue's, measured on this kind of machine). With
+// --dist D the inputs are generate(D, n, 1) instead (spiral, curves, ...: data along curves,
+// where a mesher's point location and cavities meet long thin triangles), in the box
+// derive_box gives them, at 20.7 and 30 degrees; no earlier peer figures exist for them, so
+// vs_Tri needs Triangle in the build and vs_CGAL is empty. Each
 // mesh is built `--reps` times (median time), checked against the contract (Delaunay, every
 // angle >= the bound, tiling, inputs present: checked = 1), and reported with its size, its
 // ratio to the peers' sizes, and its angle histogram (10-degree bins, every angle of every
@@ -19,6 +23,8 @@
 //   triangle_seconds,twin_over_triangle,triangle_vertices
 #include <algorithm>
 #include <climits>
+#include <cmath>
+#include <limits>
 #include <cstdint>
 #include <cstdio>
 #include <optional>
@@ -64,7 +70,12 @@ int main(int argc, char** argv) {
   std::vector<std::size_t> ns{10000, 100000};
   int reps = 3;
   bool csv = false, histogram = false;
-  app.add_option("--n", ns, "input sizes (python_uniform(n, 1))")->delimiter(',');
+  std::string dist_name;
+  app.add_option("--n", ns, "input sizes (python_uniform(n, 1), or generate(--dist, n, 1))")->delimiter(',');
+  app.add_option("--dist", dist_name, "a distribution instead of the issue's uniform inputs (e.g. spiral, curves)")
+      ->check([](const std::string& s) {
+        return parse_distribution(s) ? std::string{} : "unknown distribution '" + s + "'";
+      });
   app.add_option("--reps", reps, "builds per mesh (median time)")->check(CLI::Range(1, 100));
   app.add_flag("--csv", csv, "CSV instead of a table");
   app.add_flag("--histogram", histogram, "print each mesh's angle histogram");
@@ -86,15 +97,25 @@ int main(int argc, char** argv) {
         "input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,entries_per_vertex,checked,"
         "triangle_seconds,twin_over_triangle,triangle_vertices\n");
   else
-    std::printf("%-9s %6s %9s %9s %9s %8s %8s %9s %6s %8s %7s %9s %8s %9s\n", "input", "angle", "seconds", "vertices",
+    std::printf("%-11s %6s %9s %9s %9s %8s %8s %9s %6s %8s %7s %9s %8s %9s\n", "input", "angle", "seconds", "vertices",
                 "triangles", "vs_Tri", "vs_CGAL", "min_angle", "rounds", "entries", "checked", "tri_s", "twin/Tri",
                 "tri_V");
   bool all_ok = true;
+  const std::optional<Distribution> dist =
+      dist_name.empty() ? std::nullopt : parse_distribution(dist_name);
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   for (const std::size_t n : ns) {
-    const auto pts = python_uniform(n, 1);
+    const auto pts = dist ? generate<2>(*dist, n, 1) : python_uniform(n, 1);
     const Box<2> box = derive_box<2>(pts);
-    for (const Peer& peer : kPeers) {
-      if (peer.n != n) continue;
+    // The inputs with their peers' figures, or the distribution's at both angles
+    // without them.
+    std::vector<Peer> peers;
+    if (dist)
+      peers = {{n, 20.7, kNaN, kNaN}, {n, 30.0, kNaN, kNaN}};
+    else
+      for (const Peer& peer : kPeers)
+        if (peer.n == n) peers.push_back(peer);
+    for (const Peer& peer : peers) {
       std::vector<double> times, tri_times;
       std::vector<Triangle> tris;
       HpuStats stats;
@@ -117,9 +138,13 @@ int main(int argc, char** argv) {
       const MeshReport report =
           check_mesh(mesh, box, pts, MeshCheckOptions{.min_angle_deg = peer.angle, .delaunay = true});
       all_ok = all_ok && report.ok();
-      const std::string input = "unif1e" + std::to_string(n == 10000 ? 4 : n == 100000 ? 5 : 0);
+      char input_buf[64];
+      if (dist)
+        std::snprintf(input_buf, sizeof input_buf, "%s%zu", dist_name.c_str(), n);
+      else
+        std::snprintf(input_buf, sizeof input_buf, "unif1e%d", n == 10000 ? 4 : n == 100000 ? 5 : 0);
+      const std::string input = input_buf;
       const double tri_vertices = bench::kHaveTriangle ? double(tri_size.vertices) : peer.triangle_vertices;
-      const double vt = double(mesh.num_vertices()) / tri_vertices;
       const double tri_s = bench::median(tri_times);
       char tri_cols[96] = ",,,";  // CSV's empty fields without Triangle
       if (bench::kHaveTriangle)
@@ -127,16 +152,25 @@ int main(int argc, char** argv) {
                       bench::median(times) / tri_s, tri_size.vertices);
       else if (!csv)
         std::snprintf(tri_cols, sizeof tri_cols, " %9s %8s %9s", "-", "-", "-");
-      const double vc = double(mesh.num_vertices()) / peer.cgal_vertices;
+      // A ratio to a peer figure this input has none of: empty in CSV, "-" in the table.
+      const auto ratio = [&](double peer_vertices) {
+        char buf[32];
+        if (std::isnan(double(mesh.num_vertices()) / peer_vertices))
+          std::snprintf(buf, sizeof buf, "%s", csv ? "" : "-");
+        else
+          std::snprintf(buf, sizeof buf, "%.3f", double(mesh.num_vertices()) / peer_vertices);
+        return std::string(buf);
+      };
+      const std::string vt = ratio(tri_vertices), vc = ratio(peer.cgal_vertices);
       const double per_vertex = double(stats.entries) / double(mesh.num_vertices());  // queue entries
       if (csv)
-        std::printf("%s,%.1f,%.4f,%zu,%zu,%.4f,%.4f,%.3f,%zu,%.3f,%d%s\n", input.c_str(), peer.angle,
-                    bench::median(times), mesh.num_vertices(), mesh.num_triangles(), vt, vc, report.min_angle_deg,
-                    stats.rounds, per_vertex, report.ok() ? 1 : 0, tri_cols);
+        std::printf("%s,%.1f,%.4f,%zu,%zu,%s,%s,%.3f,%zu,%.3f,%d%s\n", input.c_str(), peer.angle,
+                    bench::median(times), mesh.num_vertices(), mesh.num_triangles(), vt.c_str(), vc.c_str(),
+                    report.min_angle_deg, stats.rounds, per_vertex, report.ok() ? 1 : 0, tri_cols);
       else
-        std::printf("%-9s %6.1f %9.4f %9zu %9zu %8.3f %8.3f %9.3f %6zu %8.3f %7d%s\n", input.c_str(), peer.angle,
-                    bench::median(times), mesh.num_vertices(), mesh.num_triangles(), vt, vc, report.min_angle_deg,
-                    stats.rounds, per_vertex, report.ok() ? 1 : 0, tri_cols);
+        std::printf("%-11s %6.1f %9.4f %9zu %9zu %8s %8s %9.3f %6zu %8.3f %7d%s\n", input.c_str(), peer.angle,
+                    bench::median(times), mesh.num_vertices(), mesh.num_triangles(), vt.c_str(), vc.c_str(),
+                    report.min_angle_deg, stats.rounds, per_vertex, report.ok() ? 1 : 0, tri_cols);
       if (histogram) {
         const MeshStats ms = mesh_stats(mesh);
         std::printf("  angle histogram (%s, %.1f deg):", input.c_str(), peer.angle);
