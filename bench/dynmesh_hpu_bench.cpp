@@ -72,9 +72,12 @@ int main(int argc, char** argv) {
   bool csv = false, histogram = false;
   std::string dist_name;
   app.add_option("--n", ns, "input sizes (python_uniform(n, 1), or generate(--dist, n, 1))")->delimiter(',');
-  app.add_option("--dist", dist_name, "a distribution instead of the issue's uniform inputs (e.g. spiral, curves)")
+  app.add_option("--dist", dist_name, "a distribution instead of unif1e4 and unif1e5 (e.g. spiral, curves)")
       ->check([](const std::string& s) {
-        return parse_distribution(s) ? std::string{} : "unknown distribution '" + s + "'";
+        if (parse_distribution(s)) return std::string{};
+        std::string msg = "unknown distribution '";
+        msg.append(s).append("'");
+        return msg;
       });
   app.add_option("--reps", reps, "builds per mesh (median time)")->check(CLI::Range(1, 100));
   app.add_flag("--csv", csv, "CSV instead of a table");
@@ -107,7 +110,7 @@ int main(int argc, char** argv) {
   for (const std::size_t n : ns) {
     const auto pts = dist ? generate<2>(*dist, n, 1) : python_uniform(n, 1);
     const Box<2> box = derive_box<2>(pts);
-    // The inputs with their peers' figures, or the distribution's at both angles
+    // unif1e4 and unif1e5 with their peers' figures, or the distribution's at both angles
     // without them.
     std::vector<Peer> peers;
     if (dist)

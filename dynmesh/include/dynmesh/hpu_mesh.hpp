@@ -67,8 +67,9 @@
 //
 // Invariants: check_invariants(): the triangulation's own invariants (Delaunay, tiling) and
 // the mesh contract through check_mesh (every angle ≥ θ, every input a vertex).
-// Complexity: O(n lg n + m) expected for m output vertices (walks from nearby triangles,
-// cavities of expected O(1) size, O(1) entries per vertex, stars of O(1) size).
+// Complexity: O(n lg n + m) expected for m output vertices (the inputs triangulated in BRIO
+// order, so that cavities are of expected O(1) size whatever the input, points along curves
+// included; walks from nearby triangles; O(1) entries per vertex, stars of O(1) size).
 // Paper: Acar & Hudson, Figure 5 and Appendix A (DynHPU); Har-Peled & Üngör, "A
 // time-optimal Delaunay refinement algorithm in two dimensions" (2005); Üngör,
 // "Off-centers" (2004); Ruppert (1995) and Shewchuk's Triangle for segments.
