@@ -79,6 +79,15 @@ int main(int argc, char** argv) {
     return std::string(structure) + " about " + human_bytes(cost.bytes_per_point) + ", " +
            human_bytes(cost.check_bytes_per_point) + " more " + check;
   };
+  // The hpu meshes' costs rise with the angle bound (memory_guard.hpp: the costliest inputs,
+  // points along curves, at 20.7 and 30 degrees).
+  auto hpu_cost_text = [](const char* structure, const MemoryCost& low, const MemoryCost& high, const char* check) {
+    std::string text(structure);
+    text.append(" about ").append(human_bytes(low.bytes_per_point)).append(" at --min-angle 20.7 to ");
+    text.append(human_bytes(high.bytes_per_point)).append(" at 30, ").append(human_bytes(low.check_bytes_per_point));
+    text.append(" to ").append(human_bytes(high.check_bytes_per_point)).append(" more ").append(check);
+    return text;
+  };
   // A radius in pixels: positive, and no larger than the drawing.
   const CLI::Validator radius_px = CLI::Range(0.01, 1000.0);
   const CLI::Validator any_count = whole_number(0, std::numeric_limits<std::size_t>::max());
@@ -166,8 +175,9 @@ int main(int argc, char** argv) {
       "               [--min-angle DEG] [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F]\n"
       "               [--msh F] [--svg F [--svg-point-radius PX] [--svg-max-points N]] [--check]\n"
       "               [--stats] [--force]\n\n" +
-      memory_note(cost_text("hpu mesh with --edits (self-adjusting)", kHpuDynamicCost, "with --check") + "; " +
-                  cost_text("hpu mesh without --edits", kHpuMeshCost, "with --check") + "; " +
+      memory_note(hpu_cost_text("hpu mesh with --edits (self-adjusting)", kHpuDynamicCostLow, kHpuDynamicCostHigh,
+                                "with --check") + "; " +
+                  hpu_cost_text("hpu mesh without --edits", kHpuMeshCostLow, kHpuMeshCostHigh, "with --check") + "; " +
                   cost_text("quadtree mesh", kQuadtreeMeshCost, "with --check")));
 
   StabilityOptions s;
@@ -238,7 +248,7 @@ int main(int argc, char** argv) {
       memory_note(cost_text("quadtree (2D)", kQuadtree2dCost, "for the final check") + "; " +
                   cost_text("octree (3D)", kOctree3dCost, "for the final check") + "; " +
                   cost_text("quadtree mesh", kQuadtreeMeshCost, "for the final check") + "; " +
-                  cost_text("hpu mesh", kHpuDynamicCost, "for the final check") +
+                  hpu_cost_text("hpu mesh", kHpuDynamicCostLow, kHpuDynamicCostHigh, "for the final check") +
                   "; the structure holds at most N + U/2 points (--dist), or the points of POINTS and the '+' "
                   "lines of FILE (--points)"));
 

@@ -61,18 +61,49 @@ inline constexpr MemoryCost kOctree3dCost{20'500, 5'600};
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o          7,050,276 KiB: 72,112 B/point
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o --check  8,130,208 KiB: +11,057 B/point
 inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};
-// The hpu mesh (HpuMesh, no trace) on unif1e5 (python3 random.Random(1)), at its largest,
-// 30 degrees (20.7 degrees: 62,984 KiB, 589 B/point; --check +252 B/point):
-//   /usr/bin/time -v dynmesh mesh unif1e5.txt -o o --min-angle 30          101,860 KiB: 987 B/point
-//   /usr/bin/time -v dynmesh mesh unif1e5.txt -o o --min-angle 30 --check  147,524 KiB: +468 B/point
-inline constexpr MemoryCost kHpuMeshCost{1'300, 650};
-// The self-adjusting hpu mesh (DynamicMesh, Postprocess::Hpu: the program on cells and its
-// trace; --edits selects it), on unif1e5, at its largest, 30 degrees (20.7 degrees: 939,524
-// KiB, 9,549 B/point; --check +2,820 B/point). (The triangulation-based program before issue
-// 20: 71,487 B/point at 30 degrees, and 80,000 here.)
-//   /usr/bin/time -v dynmesh mesh unif1e5.txt --min-angle 30 --edits e10.txt -o o          1,448,392 KiB: 14,760 B/point
-//   /usr/bin/time -v dynmesh mesh unif1e5.txt --min-angle 30 --edits e10.txt -o o --check  1,959,208 KiB: +5,230 B/point
-inline constexpr MemoryCost kHpuDynamicCost{19'500, 7'000};
+// The hpu meshes cost more per point as the angle bound rises (more Steiner points), and
+// far more on points along curves than on uniform ones: the mesh grades away from each dense
+// curve, so collinear and spiral points make 2 to 2.5 times the vertices (and trace) per
+// point. Counting lines cannot tell the inputs apart, and an estimate below the peak lets a
+// run be killed minutes in, so the guard takes the costliest input measured, at 20.7 and at
+// 30 degrees, interpolated linearly in the angle between them (the 20.7-degree figure below
+// it: smaller bounds make smaller meshes), with 25% added (hpu_mesh_cost, hpu_dynamic_cost).
+// Measured at n = 10^5 with generate(D, n, 1) (the static tests' generators, written with
+// %.17g), less the program itself, as above; uniform points (unif1e5, python3
+// random.Random(1)) for comparison. --check's own cost is the largest measured on any input.
+//   The hpu mesh (HpuMesh, no trace), `dynmesh mesh P.txt -o o --min-angle A [--check]`:
+//     20.7 degrees: spiral 106,580 KiB (1,091 B/point; --check +442), collinear 99,676 KiB
+//       (1,021), unif1e5 62,984 KiB (589; +252)
+//     30 degrees: collinear 200,584 KiB (2,054; --check +817), spiral 176,644 KiB (1,809;
+//       +746), curves 166,920 KiB (1,709; +685), unif1e5 101,860 KiB (987; +468)
+//   The self-adjusting hpu mesh (DynamicMesh, Postprocess::Hpu: the program on cells and its
+//   trace; --edits selects it), `dynmesh mesh P.txt --edits E -o o --min-angle A [--check]`
+//   with 10 edits:
+//     20.7 degrees: spiral 1,931,980 KiB (19,784 B/point; --check +5,231), collinear
+//       1,813,640 KiB (18,572), unif1e5 939,524 KiB (9,549; +2,820)
+//     30 degrees: collinear 3,518,984 KiB (36,034; --check +0), spiral 3,276,996 KiB (33,556;
+//       +9,923), unif1e5 1,448,392 KiB (14,760; +5,230)
+//   (The triangulation-based program before issue 20: 71,487 B/point at 30 degrees on
+//   unif1e5.) So a uniform input is estimated at 2.5 to 3 times its peak: --force runs it.
+inline constexpr double kHpuCostAngleLow = 20.7, kHpuCostAngleHigh = 30.0;
+inline constexpr MemoryCost kHpuMeshCostLow{1'400, 600}, kHpuMeshCostHigh{2'600, 1'050};
+inline constexpr MemoryCost kHpuDynamicCostLow{25'000, 6'500}, kHpuDynamicCostHigh{45'000, 12'500};
+
+/// low at angle ≤ kHpuCostAngleLow, high at kHpuCostAngleHigh, linear in between.
+inline MemoryCost hpu_cost_at(const MemoryCost& low, const MemoryCost& high, double angle_deg) {
+  double t = (angle_deg - kHpuCostAngleLow) / (kHpuCostAngleHigh - kHpuCostAngleLow);
+  t = !(t > 0) ? 0 : t > 1 ? 1 : t;  // (a NaN angle, refused later anyway, as the lowest)
+  const auto mix = [t](std::uint64_t a, std::uint64_t b) {
+    return static_cast<std::uint64_t>(static_cast<double>(a) + t * (static_cast<double>(b) - static_cast<double>(a)));
+  };
+  return {mix(low.bytes_per_point, high.bytes_per_point), mix(low.check_bytes_per_point, high.check_bytes_per_point)};
+}
+/// The hpu mesh without --edits (HpuMesh) at this angle bound.
+inline MemoryCost hpu_mesh_cost(double angle_deg) { return hpu_cost_at(kHpuMeshCostLow, kHpuMeshCostHigh, angle_deg); }
+/// The self-adjusting hpu mesh (DynamicMesh) at this angle bound.
+inline MemoryCost hpu_dynamic_cost(double angle_deg) {
+  return hpu_cost_at(kHpuDynamicCostLow, kHpuDynamicCostHigh, angle_deg);
+}
 // The program before any point: 7-8 MB resident, more address space (libraries, a thread stack).
 inline constexpr std::uint64_t kFixedBytes = std::uint64_t{32} << 20;
 

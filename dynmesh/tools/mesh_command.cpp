@@ -105,7 +105,7 @@ int run_hpu_mesh(const MeshCommandOptions& o) {
   if (!o.force) {
     const std::uint64_t points = points_held(o.points, o.edits);
     guard_memory("building the hpu mesh of " + std::to_string(points) + " points" + (o.check ? " with --check" : ""),
-                 estimated_bytes(kHpuMeshCost, points, o.check));
+                 estimated_bytes(hpu_mesh_cost(bound), points, o.check));
   }
   std::optional<Phase> reading(std::in_place, "reading " + o.points);
   const InitialPoints<2> initial = read_initial_points<2>(o.points, o.box, o.skip_duplicates);
@@ -157,7 +157,7 @@ int run_mesh(const MeshCommandOptions& o) {
     const std::uint64_t points = points_held(o.points, o.edits);
     guard_memory("building the " + what + " of " + std::to_string(points) + " points" +
                      (o.check ? " with --check" : ""),
-                 estimated_bytes(hpu ? kHpuDynamicCost : kQuadtreeMeshCost, points, o.check));
+                 estimated_bytes(hpu ? hpu_dynamic_cost(bound) : kQuadtreeMeshCost, points, o.check));
   }
 
   std::optional<Phase> reading(std::in_place, "reading " + o.points);

@@ -298,9 +298,9 @@ int run_stability_points(const StabilityOptions& o, PostprocessChoice choice) {
   if (choice == PostprocessChoice::Quadtree)
     return run_points<2, DynamicMesh>(o, "quadtree mesh", kQuadtreeMeshCost,
                                       MeshOptions{.postprocess = Postprocess::Quadtree});
-  return run_points<2, DynamicMesh>(o, "hpu mesh", kHpuDynamicCost,
-                                    MeshOptions{.postprocess = Postprocess::Hpu,
-                                                .min_angle = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle});
+  const double bound = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle;
+  return run_points<2, DynamicMesh>(o, "hpu mesh", hpu_dynamic_cost(bound),
+                                    MeshOptions{.postprocess = Postprocess::Hpu, .min_angle = bound});
 }
 
 }  // namespace
@@ -326,9 +326,9 @@ int run_stability(const StabilityOptions& o) {
   if (choice == PostprocessChoice::Quadtree)
     return run<2, DynamicMesh>(o, *dist, "quadtree mesh", kQuadtreeMeshCost,
                                MeshOptions{.postprocess = Postprocess::Quadtree});
-  return run<2, DynamicMesh>(o, *dist, "hpu mesh", kHpuDynamicCost,
-                             MeshOptions{.postprocess = Postprocess::Hpu,
-                                         .min_angle = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle});
+  const double bound = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle;
+  return run<2, DynamicMesh>(o, *dist, "hpu mesh", hpu_dynamic_cost(bound),
+                             MeshOptions{.postprocess = Postprocess::Hpu, .min_angle = bound});
 }
 
 }  // namespace dynmesh::tool
