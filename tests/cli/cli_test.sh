@@ -829,6 +829,14 @@ GNUPLOT
         fail "unclear message: $(cat err.txt)"
       expect_error 1 'building the quadtree mesh of 1000 points with --check needs about 133 MiB' \
         limited "$dynmesh" mesh p.txt --postprocess quadtree -o e --check
+      # The hpu mesh's cost per point rises with the angle bound (memory_guard.hpp, costliest
+      # inputs): 25,000 bytes at 20.7 degrees (the default), 45,000 at 30, linear in between.
+      expect_error 1 'building the hpu mesh of 1010 points needs about 56.1 MiB' \
+        limited "$dynmesh" mesh p.txt --edits e.txt -o e
+      expect_error 1 'building the hpu mesh of 1010 points needs about 65.7 MiB' \
+        limited "$dynmesh" mesh p.txt --edits e.txt -o e --min-angle 25.35
+      expect_error 1 'building the hpu mesh of 1010 points needs about 75.3 MiB' \
+        limited "$dynmesh" mesh p.txt --edits e.txt -o e --min-angle 30
       # stability --points counts as they do: the 1000 points and the 10 '+' lines (and its check).
       expect_error 1 'building the quadtree of 1010 points needs about 46.4 MiB' \
         limited "$dynmesh" stability --points p.txt --edits e.txt --csv e.csv
