@@ -68,8 +68,8 @@ inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};
 // run be killed minutes in, so the guard takes the costliest input measured, at 20.7 and at
 // 30 degrees, interpolated linearly in the angle between them (the 20.7-degree figure below
 // it: smaller bounds make smaller meshes), with 25% added (hpu_mesh_cost, hpu_dynamic_cost).
-// Measured at n = 10^5 with generate(D, n, 1) (the static tests' generators, written with
-// %.17g), less the program itself, as above; uniform points (unif1e5, python3
+// Measured at n = 10^5 with generate(D, n, 1) (the generators of `dynmesh stability --dist`,
+// written with %.17g), less the program itself, as above; uniform points (unif1e5, python3
 // random.Random(1)) for comparison. --check's own cost is the largest measured on any input.
 //   The hpu mesh (HpuMesh, no trace), `dynmesh mesh P.txt -o o --min-angle A [--check]`:
 //     20.7 degrees: spiral 106,580 KiB (1,091 B/point; --check +442), collinear 99,676 KiB
