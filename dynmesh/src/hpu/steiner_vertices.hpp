@@ -22,11 +22,13 @@
 // the whole propagation rather than within a window.
 #pragma once
 
-#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <type_traits>
 #include <vector>
+
+#include <sac/hash.hpp>
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
@@ -107,17 +109,15 @@ class SteinerVertices {
     std::uint32_t self;  // its index in slots_
     std::uint32_t next_free = 0;
   };
+  // slot_of() finds a slot from its vertex's address, which standard layout makes the slot's.
+  static_assert(std::is_standard_layout_v<Slot>);
   static constexpr std::uint32_t kEmpty = 0xffffffffu;
   static constexpr std::size_t kFirstTable = 1024;
 
-  // Points are equal as doubles, as the trace's keys compare them (so -0.0 is 0.0; adding
-  // 0.0 makes the bits agree).
+  // Points are equal as doubles, as the trace's keys compare them (so -0.0 is 0.0), and are
+  // hashed as the trace hashes its keys' doubles.
   static std::uint64_t hash(const Point<2>& p) noexcept {
-    std::uint64_t h = std::bit_cast<std::uint64_t>(p[0] + 0.0) * 0x9e3779b97f4a7c15ull;
-    h ^= std::bit_cast<std::uint64_t>(p[1] + 0.0) + 0x7f4a7c159e3779b9ull + (h << 6) + (h >> 2);
-    h ^= h >> 31;
-    h *= 0xbf58476d1ce4e5b9ull;
-    return h ^ (h >> 29);
+    return sac::hash_combine(sac::Hash<double>{}(p[0]), sac::Hash<double>{}(p[1]));
   }
   static bool same(const Point<2>& a, const Point<2>& b) noexcept { return a[0] == b[0] && a[1] == b[1]; }
   /// p's place in the table: its vertex's, or the empty one where it would go.
