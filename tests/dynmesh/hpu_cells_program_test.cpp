@@ -4,8 +4,9 @@
 // triangles equal the static twin HpuMesh's on the current points at 20.7°, 25° and 30°;
 // the change feed replays; the engine's, the feed's, the input list's and the store's
 // invariants hold, the store's newest cells are the static bucket tree of the mesh's
-// vertices, and the Steiner pool holds exactly the mesh's Steiner vertices; the per-update trace distance is printed against the from-scratch trace, and
-// stays within budgets on curves and spirals; the collects and tries an update re-runs stay
+// vertices, and the Steiner pool holds exactly the mesh's Steiner vertices; the per-update
+// trace distance is printed against the from-scratch trace, and stays within budgets on
+// curves and spirals; the collects and tries an update re-runs stay
 // within budgets on uniform points.
 #include "hpu/hpu_cells_program.hpp"
 

@@ -277,16 +277,7 @@ TEST(HpuMesh, WorkIsLinearInTheMeshOnCollinearPointsAndCurves) {
   // triangles per final one on the spiral at n = 10^4 and 9.1 on curves, growing with n (a
   // spiral of 32,000 points took 2.6 s); in BRIO order, 5.0 and 4.5.
   const std::size_t n = kSanitized ? 1000 : 10000;
-  for (const auto dist : {Distribution::Spiral, Distribution::Curves}) {
-    const auto pts = generate<2>(dist, n, 31);
-    const HpuMesh m(derive_box<2>(pts), pts);
-    const double ratio = double(m.stats().triangles_made) / double(m.triangles().size());
-    std::printf("[ %s n=%zu ] %zu triangles made for %zu in the mesh (%.2fx)\n",
-                std::string(distribution_name(dist)).c_str(), n, m.stats().triangles_made, m.triangles().size(),
-                ratio);
-    EXPECT_LT(ratio, 8.0) << distribution_name(dist);
-  }
-  for (const auto dist : {Distribution::Uniform, Distribution::Collinear}) {
+  for (const auto dist : {Distribution::Uniform, Distribution::Collinear, Distribution::Spiral, Distribution::Curves}) {
     const auto pts = generate<2>(dist, n, 31);
     const HpuMesh m(derive_box<2>(pts), pts);
     const double ratio = double(m.stats().triangles_made) / double(m.triangles().size());
@@ -294,7 +285,11 @@ TEST(HpuMesh, WorkIsLinearInTheMeshOnCollinearPointsAndCurves) {
                 std::string(distribution_name(dist)).c_str(), n, m.stats().triangles_made, m.triangles().size(),
                 ratio, m.stats().max_cavity);
     EXPECT_LT(ratio, 8.0) << distribution_name(dist);
-    EXPECT_LT(m.stats().max_cavity, n / 10 + 64) << distribution_name(dist);
+    // A point on a curve may still meet one large cavity (1,234 at the spiral's 10^4): only
+    // the total is bounded there.
+    if (dist == Distribution::Uniform || dist == Distribution::Collinear) {
+      EXPECT_LT(m.stats().max_cavity, n / 10 + 64) << distribution_name(dist);
+    }
   }
 }
 
