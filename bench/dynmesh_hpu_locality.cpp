@@ -10,10 +10,14 @@
 // and insertion give the same figure (the difference is symmetric). Prints one row per
 // (distribution, n): the steps of a run, then the mean, median and largest number of
 // changed steps and the mean changed leaf reads per update. Flat in n is the goal.
+// --reach says where the changed collects and processings lie: their distance from the
+// updated point in units of 2^j, j their size class. The O(lg L/s) bound holds if that
+// distance is bounded, whatever n, so that each class changes O(1) steps of its own size.
 //
 //   dynmesh_hpu_locality [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
-//                        [--seed 1] [--angle 20.7] [--csv]
+//                        [--seed 1] [--angle 20.7] [--csv] [--by-class] [--reach] [--time] [--profile]
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <map>
@@ -40,16 +44,25 @@ struct Diff {
   std::size_t by_kind[4] = {0, 0, 0, 0};  // changed steps: first classes, collects, processes, final
   std::size_t leaves_by_kind[4] = {0, 0, 0, 0};
   std::map<int, std::size_t> by_class;  // changed collects and processings by size class
+  Point<2> update{};                    // the point inserted or deleted
+  std::map<int, std::size_t> reach;     // the same by bin b: |at - update| / 2^cls in [2^(b-1), 2^b), 0: < 1
+  double farthest = 0;                  // the largest |at - update| / 2^cls
   void add(const detail::CellStep& s) {
     ++steps, leaves += s.leaves;
     ++by_kind[s.kind], leaves_by_kind[s.kind] += s.leaves;
-    if (s.kind == detail::CellStep::Collect || s.kind == detail::CellStep::Process) ++by_class[s.cls];
+    if (s.kind == detail::CellStep::Collect || s.kind == detail::CellStep::Process) {
+      ++by_class[s.cls];
+      const double r = std::hypot(s.at[0] - update[0], s.at[1] - update[1]) / std::ldexp(1.0, s.cls);
+      ++reach[r < 1 ? 0 : std::ilogb(r) + 1];
+      farthest = std::max(farthest, r);
+    }
   }
 };
 
 /// The multiset difference of two digest-sorted step logs.
-Diff difference(const std::vector<detail::CellStep>& a, const std::vector<detail::CellStep>& b) {
+Diff difference(const std::vector<detail::CellStep>& a, const std::vector<detail::CellStep>& b, const Point<2>& update) {
   Diff d;
+  d.update = update;
   std::size_t i = 0, j = 0;
   while (i < a.size() || j < b.size()) {
     if (j == b.size() || (i < a.size() && a[i].digest < b[j].digest)) {
@@ -78,7 +91,7 @@ int main(int argc, char** argv) {
   std::size_t updates = 20;
   std::uint64_t seed = 1;
   double angle = 20.7;
-  bool csv = false, profile = false, by_class = false, time = false;
+  bool csv = false, profile = false, by_class = false, reach = false, time = false;
   app.add_option("--dist", dists, "distributions")->delimiter(',');
   app.add_option("--n", sizes, "sizes")->delimiter(',');
   app.add_option("--updates", updates, "updates measured per size");
@@ -87,6 +100,9 @@ int main(int argc, char** argv) {
   app.add_flag("--csv", csv, "CSV output");
   app.add_flag("--time", time, "also time HpuMesh (the twin) and the cell refiner on the same points (one run each)");
   app.add_flag("--by-class", by_class, "also print the changed collects and processings per update by size class");
+  app.add_flag("--reach", reach,
+               "also print the changed collects and processings per update by their distance from the updated point, "
+               "in units of 2^(their size class)");
   app.add_flag("--profile", profile, "also print, per step kind, the leaves one step reads (mean, median, p99, max)");
   CLI11_PARSE(app, argc, argv);
 
@@ -131,11 +147,16 @@ int main(int argc, char** argv) {
       std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
       std::vector<double> changed, reads;
       double kind[4] = {0, 0, 0, 0}, kind_leaves[4] = {0, 0, 0, 0};
-      std::map<int, double> classes;
+      std::map<int, double> classes, reaches;
+      double farthest = 0;
       for (std::size_t u = 0; u < updates; ++u) {
         std::vector<Point<2>> less = pts;
-        less.erase(less.begin() + static_cast<std::ptrdiff_t>(rng() % less.size()));
-        const Diff d = difference(base, run(box, less, angle));
+        const auto gone = static_cast<std::ptrdiff_t>(rng() % less.size());
+        const Point<2> x = less[static_cast<std::size_t>(gone)];
+        less.erase(less.begin() + gone);
+        const Diff d = difference(base, run(box, less, angle), x);
+        for (const auto& [b, count] : d.reach) reaches[b] += static_cast<double>(count) / static_cast<double>(updates);
+        farthest = std::max(farthest, d.farthest);
         changed.push_back(static_cast<double>(d.steps));
         reads.push_back(static_cast<double>(d.leaves));
         for (const auto& [c, count] : d.by_class) classes[c] += static_cast<double>(count) / static_cast<double>(updates);
@@ -163,6 +184,11 @@ int main(int argc, char** argv) {
         std::printf("# %s n=%zu changed collects+processings by class:", name.c_str(), n);
         for (const auto& [c, x] : classes) std::printf(" %d:%.0f", c, x);
         std::printf("\n");
+      }
+      if (reach) {
+        std::printf("# %s n=%zu changed collects+processings by distance / 2^class:", name.c_str(), n);
+        for (const auto& [b, x] : reaches) std::printf(" <%g:%.1f", std::ldexp(1.0, b), x);
+        std::printf("; farthest %.1f\n", farthest);
       }
       std::fflush(stdout);
     }

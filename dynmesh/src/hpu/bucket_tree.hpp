@@ -166,6 +166,7 @@ class BucketTree {
   /// records no dependencies).
   void used_within(const Point<2>& /*c*/, double /*r*/) const noexcept {}
   void used_all() const noexcept {}
+  void used_box(double /*x0*/, double /*y0*/, double /*x1*/, double /*y1*/) const noexcept {}
 
   /// The widening of cells that keeps every vertex of a cell inside it despite the rounding
   /// of point location, for a query of radius r around c.

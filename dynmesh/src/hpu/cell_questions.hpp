@@ -30,7 +30,8 @@
 // search_near(focus, scale, margin, keep, f, radius) (search() for a keep() that accepts no
 // cell beyond radius(), which only shrinks: it may start at focus's leaf),
 // margin_for(c, r) and leaves_read(). After every search() the question says what its answer
-// used of the leaves it read: used_within(c, r) (the vertices within r of c) or used_all().
+// used of the leaves it read: used_within(c, r) (the vertices within r of c), used_box(x0, y0,
+// x1, y1) (those inside that closed box) or used_all().
 // A search_within's answer uses only the vertices within its radius (plus the margins): f
 // rejects every other one without an effect. A step's reads re-run only when what it used
 // changes (cell_view.hpp). Every store answers exactly: a step's view
@@ -655,7 +656,14 @@ class CellQuestions {
             }
             return false;
           });
-      store_->used_all();  // which side vertices count depends on the ones found
+      // The answer is the side's vertices next to x: it changes only if a side vertex
+      // enters or leaves the closed stretch between them. So the scan used that stretch of
+      // the side line, not the leaves' other vertices: a coarse leaf that reaches from the
+      // side deep into the box (a sparse quadrant) changes with vertices far from the side.
+      const double s0 = below != none_ ? P_(below)[along] : lo_[along];
+      const double s1 = above != none_ ? P_(above)[along] : hi_[along];
+      if (along == 0) store_->used_box(s0, across, s1, across);
+      else store_->used_box(across, s0, across, s1);
     };
     scan(-std::numeric_limits<double>::infinity(), false);
     if (holding) {

@@ -66,7 +66,7 @@ class CellRefiner {
     for (const Vid v : first_entry_order(box_, pts_)) {
       step_begin();
       const int c = q_.first_class(v, 0.0);
-      step_end(CellStep::FirstClass, mix(0, pts_[v]), static_cast<std::uint64_t>(c));
+      step_end(CellStep::FirstClass, pts_[v], mix(0, pts_[v]), static_cast<std::uint64_t>(c));
       queues_[c].push_back({v, true});
     }
     run_rounds(queues_, batch_, pairs_, out_.stats.rounds, [&](const Entry& e, std::size_t, int j) { collect(e.v, j, e.birth); },
@@ -87,7 +87,7 @@ class CellRefiner {
         out.push_back(canonical_triangle(pts_[v], pts_[a], pts_[b]));
         answer = mix(mix(answer, pts_[a]), pts_[b]);
       }
-      step_end(CellStep::Final, mix(3, pts_[v]), answer);
+      step_end(CellStep::Final, pts_[v], mix(3, pts_[v]), answer);
     }
     std::sort(out.begin(), out.end());
     out_.questions.leaves_final += out_.questions.leaves_read - before;
@@ -116,14 +116,14 @@ class CellRefiner {
     step_leaf_ids_.clear();
     tree_.watch(&seen_, &vertex_digest, this, &step_leaf_ids_);
   }
-  void step_end(CellStep::Kind kind, std::uint64_t key, std::uint64_t answer, int cls = 0) {
+  void step_end(CellStep::Kind kind, const Point<2>& at, std::uint64_t key, std::uint64_t answer, int cls = 0) {
     if (!log_steps_) return;
     tree_.watch(nullptr, nullptr, nullptr);
     // A step reads a leaf once (a self-adjusting step keeps what it read): distinct leaves.
     std::sort(step_leaf_ids_.begin(), step_leaf_ids_.end());
     const auto distinct = std::unique(step_leaf_ids_.begin(), step_leaf_ids_.end()) - step_leaf_ids_.begin();
     out_.steps.push_back(CellStep{mix(mix(mix(key, kind), answer), seen_), static_cast<std::uint32_t>(distinct), kind,
-                                  static_cast<std::int16_t>(std::clamp(cls, -30000, 30000))});
+                                  static_cast<std::int16_t>(std::clamp(cls, -30000, 30000)), at});
   }
 
   Vid add(const Point<2>& p) {
@@ -147,7 +147,7 @@ class CellRefiner {
     if (go_on) queues_[j + 1].push_back({v, false});
     std::uint64_t answer = go_on;
     for (const auto& [a, b] : local_pairs_) answer = mix(mix(answer, pts_[a]), pts_[b]);
-    step_end(CellStep::Collect, mix(mix(mix(1, pts_[v]), static_cast<std::uint64_t>(j)), birth), answer, j);
+    step_end(CellStep::Collect, pts_[v], mix(mix(mix(1, pts_[v]), static_cast<std::uint64_t>(j)), birth), answer, j);
     out_.questions.leaves_collect += out_.questions.leaves_read - before;
   }
 
@@ -174,7 +174,7 @@ class CellRefiner {
       queues_[j].push_back({rv, true});
       break;
     }
-    step_end(CellStep::Process, mix(mix(mix(2, pts_[p]), pts_[q]), static_cast<std::uint64_t>(j)), answer, j);
+    step_end(CellStep::Process, pts_[p], mix(mix(mix(2, pts_[p]), pts_[q]), static_cast<std::uint64_t>(j)), answer, j);
     out_.questions.leaves_process += out_.questions.leaves_read - before;
   }
 

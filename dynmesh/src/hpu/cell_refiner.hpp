@@ -61,6 +61,7 @@ struct CellStep {
   std::uint32_t leaves;  // distinct leaves read
   Kind kind;
   std::int16_t cls;      // the size class of a collect or a pair's processing; 0 otherwise
+  Point<2> at{};         // the step's vertex (of a pair: its first end)
   friend bool operator<(const CellStep& a, const CellStep& b) noexcept { return a.digest < b.digest; }
 };
 

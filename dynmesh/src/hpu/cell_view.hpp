@@ -329,6 +329,18 @@ class CellView {
     for (CellNode* n : visited_) self->widen(self->mark(n), c, R);
     self->visited_.clear();
   }
+  /// The last search()'s answer used the vertices inside the closed box [x0, x1] × [y0, y1]
+  /// only (of the leaves it met). A degenerate box (a stretch of a box side) is exact: a
+  /// vertex's 256th and the box's come from the same monotone function.
+  void used_box(double x0, double y0, double x1, double y1) const {
+    auto* self = const_cast<CellView*>(this);
+    for (CellNode* n : visited_) {
+      CellMark& x = self->mark(n);
+      x.bx0 = std::min(x.bx0, x0), x.by0 = std::min(x.by0, y0);
+      x.bx1 = std::max(x.bx1, x1), x.by1 = std::max(x.by1, y1);
+    }
+    self->visited_.clear();
+  }
   /// The last search()'s answer may depend on any vertex of the leaves it met.
   void used_all() const {
     auto* self = const_cast<CellView*>(this);
