@@ -225,8 +225,9 @@ struct UseRecordingTree : detail::BucketTree {
 /// stretch between those two only, so that is the use the scan states: a stretch of the
 /// side line. It stated "every vertex of the leaves met", and a sparse quadrant is one leaf
 /// reaching from a side to the box's centre, so a vertex coming or going near the centre
-/// re-ran every try whose projection that leaf covers (on 16,000 collinear points, steps
-/// 0.37 of the box away from the update; bench/RESULTS.md, "A side scan's use").
+/// re-ran every try whose projection that leaf covers (on 16,000 collinear points, steps a
+/// fifth of the box's side from the update; bench/RESULTS.md, "Where an update's changes
+/// lie, and a side scan's use").
 TEST(CellQuestions, ASideScanUsesTheStretchOfTheSideBetweenItsAnswers) {
   const Box<2> box{{0, 0}, 4};
   std::vector<Point<2>> pts{{0, 0}, {4, 0}, {4, 4}, {0, 4}, {2, 0}, {4, 2}, {2, 4}, {0, 2},
