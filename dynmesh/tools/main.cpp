@@ -24,6 +24,7 @@
 #include <cstdio>
 #include <exception>
 #include <limits>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -71,7 +72,9 @@ int main(int argc, char** argv) {
   // The memory guard's rule under each command's synopsis, with the costs per point it uses.
   auto memory_note = [](const std::string& costs) {
     return "Memory: a build whose estimated peak exceeds the memory available (the least of MemAvailable and "
-           "what ulimit -v and ulimit -d leave) stops at once with exit status 1; --force builds anyway. "
+           "what ulimit -v and ulimit -d leave) stops at once with exit status 1; one that fits is held to that "
+           "memory (its data size is capped) and, should it outgrow it, stops with status 1 before writing "
+           "anything; --force builds anyway, without the cap. "
            "Estimated peak per point held: " +
            costs + ".";
   };
@@ -288,6 +291,10 @@ int main(int argc, char** argv) {
       return run_stability(s);
     }
     if (*demo) return run_demo(m);
+  } catch (const std::bad_alloc&) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "dynmesh: %s\n", out_of_memory_message().c_str());
+    return 1;
   } catch (const std::exception& e) {
     std::fflush(stdout);
     std::fprintf(stderr, "dynmesh: %s\n", one_line(e.what()).c_str());

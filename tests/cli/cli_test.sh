@@ -851,6 +851,21 @@ GNUPLOT
         fail "--force did not reach the build: $(tr '\r' '|' <err.txt)"
       ! grep -q 'pass --force' err.txt || fail "--force did not skip the guard: $(cat err.txt)"
       [[ ! -e e.cells && ! -e e.node ]] || fail "a refused run wrote its output file"
+      # The estimate is per point, and points along a line cost more than any constant
+      # foresees (3D: about twice it). The guard lets 20,000 of them go on under 600 MB and
+      # caps the build there; it outgrows the cap and stops with the guard's figures, not a
+      # bare std::bad_alloc (nor, without a ulimit, the OOM killer), and writes nothing.
+      awk 'BEGIN { for (i = 1; i <= 20000; i++) { t = (i * i % 100003) / 100003
+                   printf "%.17g %.17g %.17g\n", t, 0.5 * t + 0.1, 0.25 * t + 0.2 } }' >line3.txt
+      quiet() { env DYNMESH_PROGRESS_DELAY_MS=100000000 "$@"; }
+      limited600() (ulimit -v 600000 && "$@")
+      expect_error 1 'out of memory: building the octree of 20000 points was estimated at about 423 MiB and allowed' \
+        limited600 quiet "$dynmesh" quadtree line3.txt --dim 3 --cells e.cells
+      grep -qF 'points along a line or a curve can need up to twice it; pass --force' err.txt ||
+        fail "no hint: $(cat err.txt)"
+      expect_error 1 'out of memory (std::bad_alloc); the run stopped before writing its outputs' \
+        limited600 quiet "$dynmesh" quadtree line3.txt --dim 3 --cells e.cells --force
+      [[ ! -e e.cells ]] || fail "a build out of memory wrote its output file"
     else
       echo "the program cannot run under ulimit -v $limit_kib (a sanitizer build?): the limit is not tested"
     fi
