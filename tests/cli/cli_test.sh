@@ -869,6 +869,29 @@ GNUPLOT
     else
       echo "the program cannot run under ulimit -v $limit_kib (a sanitizer build?): the limit is not tested"
     fi
+    # The cap itself: while a guarded build waits for its points on a FIFO (the guard counts a
+    # pipe as empty), its data-size limit is finite (VmData plus MemAvailable); with --force
+    # it stays unlimited. Then the points come and the build ends as usual.
+    if [[ $(ulimit -d) == unlimited ]]; then
+      mkfifo pts.fifo
+      for force in "" --force; do
+        "$dynmesh" quadtree pts.fifo --cells f.cells $force >out.txt 2>err.txt &
+        pid=$!
+        data_limit=unlimited
+        for _ in $(seq 50); do
+          sleep 0.1
+          data_limit=$(awk '/^Max data size/ { print $4 }' "/proc/$pid/limits")
+          [[ $data_limit != unlimited || -n $force ]] && break
+        done
+        printf '1 2\n3 5\n8 13\n' >pts.fifo
+        wait "$pid" || fail "the build on the FIFO failed: $(cat err.txt)"
+        if [[ -z $force ]]; then
+          [[ $data_limit =~ ^[0-9]+$ ]] || fail "a guarded build's data size is not capped: $data_limit"
+        else
+          [[ $data_limit == unlimited ]] || fail "--force capped the data size: $data_limit"
+        fi
+      done
+    fi
     # MemAvailable: no machine has the 14 TiB of 10^9 points; refused before generating any.
     expect_error 1 'building the quadtree of 1000000000 points needs about 13.6 TiB, but only ' \
       "$dynmesh" stability --dim 2 --dist uniform --n 1000000000 --updates 0 --csv e.csv
