@@ -284,6 +284,11 @@ int run_points(const StabilityOptions& o, const char* what, const MemoryCost& co
   return finish<d>(o, structure, what, mesh_options, m, rows);
 }
 
+// The hpu mesh at --min-angle, or at the default bound.
+MeshOptions hpu_mesh_options(const StabilityOptions& o) {
+  return MeshOptions{.postprocess = Postprocess::Hpu, .min_angle = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle};
+}
+
 // --points: the dimension is --dim's, else a .node header's, else 2 (as `dynmesh quadtree`).
 int run_stability_points(const StabilityOptions& o, PostprocessChoice choice) {
   int dim = o.dim;
@@ -298,9 +303,8 @@ int run_stability_points(const StabilityOptions& o, PostprocessChoice choice) {
   if (choice == PostprocessChoice::Quadtree)
     return run_points<2, DynamicMesh>(o, "quadtree mesh", kQuadtreeMeshCost,
                                       MeshOptions{.postprocess = Postprocess::Quadtree});
-  const double bound = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle;
-  return run_points<2, DynamicMesh>(o, "hpu mesh", hpu_dynamic_cost(bound),
-                                    MeshOptions{.postprocess = Postprocess::Hpu, .min_angle = bound});
+  const MeshOptions hpu = hpu_mesh_options(o);
+  return run_points<2, DynamicMesh>(o, "hpu mesh", hpu_dynamic_cost(hpu.min_angle), hpu);
 }
 
 }  // namespace
@@ -326,9 +330,8 @@ int run_stability(const StabilityOptions& o) {
   if (choice == PostprocessChoice::Quadtree)
     return run<2, DynamicMesh>(o, *dist, "quadtree mesh", kQuadtreeMeshCost,
                                MeshOptions{.postprocess = Postprocess::Quadtree});
-  const double bound = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle;
-  return run<2, DynamicMesh>(o, *dist, "hpu mesh", hpu_dynamic_cost(bound),
-                             MeshOptions{.postprocess = Postprocess::Hpu, .min_angle = bound});
+  const MeshOptions hpu = hpu_mesh_options(o);
+  return run<2, DynamicMesh>(o, *dist, "hpu mesh", hpu_dynamic_cost(hpu.min_angle), hpu);
 }
 
 }  // namespace dynmesh::tool

@@ -334,11 +334,7 @@ class CellView {
   /// vertex's 256th and the box's come from the same monotone function.
   void used_box(double x0, double y0, double x1, double y1) const {
     auto* self = const_cast<CellView*>(this);
-    for (CellNode* n : visited_) {
-      CellMark& x = self->mark(n);
-      x.bx0 = std::min(x.bx0, x0), x.by0 = std::min(x.by0, y0);
-      x.bx1 = std::max(x.bx1, x1), x.by1 = std::max(x.by1, y1);
-    }
+    for (CellNode* n : visited_) widen(self->mark(n), x0, y0, x1, y1);
     self->visited_.clear();
   }
   /// The last search()'s answer may depend on any vertex of the leaves it met.
@@ -569,8 +565,12 @@ class CellView {
 
   /// x's box of used vertices grows by the box around the disc (c, R).
   static void widen(CellMark& x, const Point<2>& c, double R) noexcept {
-    x.bx0 = std::min(x.bx0, c[0] - R), x.by0 = std::min(x.by0, c[1] - R);
-    x.bx1 = std::max(x.bx1, c[0] + R), x.by1 = std::max(x.by1, c[1] + R);
+    widen(x, c[0] - R, c[1] - R, c[0] + R, c[1] + R);
+  }
+  /// x's box of used vertices grows by the box [x0, x1] × [y0, y1].
+  static void widen(CellMark& x, double x0, double y0, double x1, double y1) noexcept {
+    x.bx0 = std::min(x.bx0, x0), x.by0 = std::min(x.by0, y0);
+    x.bx1 = std::max(x.bx1, x1), x.by1 = std::max(x.by1, y1);
   }
 
   /// Where a search of the box [focus ± R] starts: the cells of the finest level as wide as
