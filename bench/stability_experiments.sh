@@ -17,11 +17,21 @@
 # the deepest a mesh of derived-box coordinates resolves (mesh_resolution_level).
 #
 # Usage: bash bench/stability_experiments.sh [--quick] [--postprocess quadtree|hpu]
-#        (after `bash dev.sh run`, which builds)
+# It first brings build/release's `dynmesh` up to date with the sources (the Release build
+# of `bash dev.sh run`), so the figures are those of the tree checked out. DYNMESH=PATH runs
+# that binary instead, as it is. Either way the binary and its age go to stderr.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
-BIN=${DYNMESH:-build/release/bin/dynmesh}
+if [[ -n ${DYNMESH:-} ]]; then
+  BIN=$DYNMESH
+else
+  BIN=build/release/bin/dynmesh
+  cmake -S "$ROOT" -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
+  cmake --build build/release --target dynmesh_cli > /dev/null
+fi
+[[ -x $BIN ]] || { echo "$0: no dynmesh binary at $BIN" >&2; exit 2; }
+echo "$0: measuring $BIN, built $(date -r "$BIN" '+%F %T')" >&2
 DATA=docs/data
 FIG=docs/figures
 mkdir -p "$DATA" "$FIG"
