@@ -120,6 +120,22 @@ TEST(HpuDelaunay, CocircularGridAndPointsOnTheSides) {
   }
 }
 
+/// triangles() sorts through the vertices' ranks; it must give the canonical triangles in
+/// Triangle's own order, on cocircular grids with points on the sides and on random points.
+TEST(HpuDelaunay, TrianglesAreTheCanonicalTrianglesSorted) {
+  std::mt19937_64 rng(13);
+  for (const int random : {0, 1, 50, 2000}) {
+    const Delaunay dt = grid_and_random(rng, random);
+    std::vector<Triangle> expected;
+    for (Delaunay::Tid t = 0; t < dt.num_slots(); ++t) {
+      const auto& T = dt.tri(t);
+      if (T.alive) expected.push_back(canonical_triangle(dt.point(T.v[0]), dt.point(T.v[1]), dt.point(T.v[2])));
+    }
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(dt.triangles(), expected) << random << " random points";
+  }
+}
+
 /// star() and left_of() against the triangle list: the neighbours of each vertex, in
 /// counter-clockwise order, and the triangle on the left of each directed edge.
 TEST(HpuDelaunay, StarsAndLeftTrianglesMatchTheTriangles) {
