@@ -82,11 +82,14 @@ inline int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, con
                            (std::fabs(adxbdy) + std::fabs(bdxady)) * clift;
   // No range test, as orient2d: an underflow's error (at most 2^-1075 a product) is
   // multiplied by at most a lift or a degree-2 difference, each below 2M² for M the largest
-  // difference, so they add up to less than 30·2^-1075·(M² + 1); (M² + 1)·2^-1065 is far
+  // difference, so they add up to less than 30·2^-1075·(M² + 1); (M² + 1)·2^-1000 is far
   // above that. An overflow makes the permanent or the room infinite, or the determinant
-  // NaN, and then neither comparison holds.
+  // NaN, and then neither comparison holds. The room's factor is a normal number: with a
+  // subnormal one (2^-1065, until 2026-11-30) every call multiplied into the subnormal
+  // range, which x86 does in microcode, and that one multiply was 70% of the filter's
+  // time (bench/RESULTS.md, "The in-circle filter's subnormal room").
   const double m = std::max({std::fabs(adx), std::fabs(ady), std::fabs(bdx), std::fabs(bdy), std::fabs(cdx), std::fabs(cdy)});
-  const double bound = detail::kIncircleBound * permanent + (m * m + 1) * 0x1p-1065;
+  const double bound = detail::kIncircleBound * permanent + (m * m + 1) * detail::kUnderflowRoom;
   if (det > bound) return 1;
   if (-det > bound) return -1;
   return detail::incircle_exact(a, b, c, d);
