@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <array>
 #include <climits>
+#include <cfenv>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -643,3 +644,27 @@ TEST(Predicates, PencilMixedMagnitudesAgreeWithTheCircleDefinition) {
 }
 
 }  // namespace
+
+/// The filters' own arithmetic stays in the normal range on meshing input: a subnormal
+/// result costs a microcode assist on x86, and the in-circle filter's room for underflow
+/// once made one on every call (70% of the filter's time; bench/RESULTS.md, "The in-circle
+/// filter's subnormal room"). IEEE 754 raises the underflow flag for an inexact subnormal
+/// result, so a clean flag after many calls says no call computed one.
+TEST(Predicates, FiltersComputeNoSubnormalOnMeshingInput) {
+  constexpr std::uint64_t kSeed = 20261130;
+  SCOPED_TRACE(seed_trace(kSeed));
+  std::mt19937_64 rng(kSeed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  // Coordinates from the unit square to a box of side 2^20, and points about 2^-20 apart.
+  for (const double scale : {1.0, 0x1p20, 0x1p-20}) {
+    SCOPED_TRACE("scale " + std::to_string(scale));
+    std::feclearexcept(FE_ALL_EXCEPT);
+    int sum = 0;
+    for (int i = 0; i < 1000; ++i) {
+      const auto pt = [&] { return Point<2>{1.5 + u(rng) * scale, 0.25 + u(rng) * scale}; };
+      const Point<2> a = pt(), b = pt(), c = pt(), d = pt();
+      sum += dynmesh::orient2d(a, b, c) + dynmesh::incircle(a, b, c, d) + dynmesh::pencil(a, b, u(rng), c);
+    }
+    EXPECT_FALSE(std::fetestexcept(FE_UNDERFLOW)) << "a filter computed a subnormal number (sum " << sum << ")";
+  }
+}
