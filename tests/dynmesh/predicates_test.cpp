@@ -643,7 +643,6 @@ TEST(Predicates, PencilMixedMagnitudesAgreeWithTheCircleDefinition) {
   EXPECT_GT(nonzero, 0u);
 }
 
-}  // namespace
 
 /// The filters' own arithmetic stays in the normal range on meshing input: a subnormal
 /// result costs a microcode assist on x86, and the in-circle filter's room for underflow
@@ -668,3 +667,5 @@ TEST(Predicates, FiltersComputeNoSubnormalOnMeshingInput) {
     EXPECT_FALSE(std::fetestexcept(FE_UNDERFLOW)) << "a filter computed a subnormal number (sum " << sum << ")";
   }
 }
+
+}  // namespace

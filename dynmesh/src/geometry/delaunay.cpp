@@ -318,8 +318,8 @@ std::vector<Triangle> Delaunay::triangles() const {
   // Sorted as std::sort of the canonical triangles would (Triangle's <=>, which is the
   // (x, y) order of v[0], then v[1], then v[2]), but through the vertices' ranks in (x, y)
   // order: the points are distinct, so ranks compare as the corners do. Sorting the 16-byte
-  // vertices once and bucketing the triangles by their smallest corner costs about a third
-  // of sorting the 48-byte triangles.
+  // vertices once and bucketing the triangles by their smallest corner is cheaper than
+  // sorting the 48-byte triangles (bench/RESULTS.md, "The in-circle filter's subnormal room").
   const std::size_t nv = pts_.size();
   std::vector<std::pair<Point<2>, Vid>> by_xy(nv);
   for (Vid v = 0; v < nv; ++v) by_xy[v] = {pts_[v], v};
