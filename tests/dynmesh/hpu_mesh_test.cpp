@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cfenv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -305,6 +306,22 @@ TEST(HpuMesh, WorkIsLinearInTheMeshOnCollinearPointsAndCurves) {
     // the total is bounded there.
     if (dist == Distribution::Uniform || dist == Distribution::Collinear) {
       EXPECT_LT(m.stats().max_cavity, n / 10 + 64) << distribution_name(dist);
+    }
+  }
+}
+
+/// A whole build computes no subnormal number (IEEE 754's underflow flag stays clear): x86
+/// computes one in microcode, and one in the in-circle filter once cost the twin a tenth of
+/// its time (bench/RESULTS.md, "The in-circle filter's subnormal room").
+TEST(HpuMesh, BuildComputesNoSubnormal) {
+  const std::size_t n = kSanitized ? 300 : 2000;
+  for (const auto dist : {Distribution::Uniform, Distribution::Spiral, Distribution::Curves}) {
+    const auto pts = generate<2>(dist, n, 43);
+    for (const double angle : {20.7, 30.0}) {
+      std::feclearexcept(FE_ALL_EXCEPT);
+      const HpuMesh m(derive_box<2>(pts), pts, angle);
+      EXPECT_FALSE(std::fetestexcept(FE_UNDERFLOW))
+          << distribution_name(dist) << " at " << angle << " degrees (" << m.triangles().size() << " triangles)";
     }
   }
 }
