@@ -27,7 +27,9 @@ if [[ -n ${DYNMESH:-} ]]; then
   BIN=$DYNMESH
 else
   BIN=build/release/bin/dynmesh
-  cmake -S "$ROOT" -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
+  # Configured as dev.sh does when there is no build yet; an existing one keeps its generator.
+  [[ -f build/release/CMakeCache.txt ]] ||
+    cmake -S "$ROOT" -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
   cmake --build build/release --target dynmesh_cli > /dev/null
 fi
 [[ -x $BIN ]] || { echo "$0: no dynmesh binary at $BIN" >&2; exit 2; }
