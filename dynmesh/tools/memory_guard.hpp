@@ -206,8 +206,9 @@ inline std::optional<GuardedBuild>& guarded_build() {
 
 namespace detail {
 
-// Lowers the soft RLIMIT_DATA to the current VmData plus `bytes` (saturating; never above the
-// hard limit, never raised). False when VmData or the limit cannot be read or set.
+// Lowers the soft RLIMIT_DATA to the current VmData plus `bytes` (saturating; never raised, so
+// never above the hard limit, which bounds the soft one). False when VmData or the limit
+// cannot be read or set.
 inline bool cap_data_size(std::uint64_t bytes) {
   const std::optional<std::uint64_t> in_use = proc_kb("/proc/self/status", "VmData");
   struct ::rlimit limit;
@@ -218,7 +219,6 @@ inline bool cap_data_size(std::uint64_t bytes) {
   if (limit.rlim_cur != RLIM_INFINITY && static_cast<std::uint64_t>(limit.rlim_cur) <= cap) return true;
   if (cap >= static_cast<std::uint64_t>(RLIM_INFINITY)) return true;
   limit.rlim_cur = static_cast<rlim_t>(cap);
-  if (limit.rlim_max != RLIM_INFINITY && limit.rlim_max < limit.rlim_cur) limit.rlim_cur = limit.rlim_max;
   return ::setrlimit(RLIMIT_DATA, &limit) == 0;
 }
 
