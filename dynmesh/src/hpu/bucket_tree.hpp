@@ -50,7 +50,10 @@ class BucketTree {
   static constexpr std::size_t kCapacity = 8;
   static constexpr int kMaxLevel = 52;
 
-  explicit BucketTree(const Box<2>& box) : box_(box), scale_(box.scale()) { nodes_.emplace_back(); }
+  explicit BucketTree(const Box<2>& box) : box_(box), scale_(box.scale()) {
+    nodes_.emplace_back();
+    for (int l = 0; l <= kMaxLevel; ++l) width_[static_cast<std::size_t>(l)] = std::ldexp(box_.side, -l);
+  }
 
   /// The squared distance from c to the box [x0, x1] × [y0, y1] (0 inside): what every
   /// search's keep() test of a cell against a disc needs.
@@ -260,7 +263,7 @@ class BucketTree {
                    Keep& keep, F& f, bool& stop) const {
     const Node& N = nodes_[n];
     if (N.count == 0 || stop) return;
-    const double w = std::ldexp(box_.side, -level);
+    const double w = width_[static_cast<std::size_t>(level)];
     const double x0 = box_.origin[0] + grid_double(ix) * w - margin, x1 = x0 + w + 2 * margin;
     const double y0 = box_.origin[1] + grid_double(iy) * w - margin, y1 = y0 + w + 2 * margin;
     if (!keep(x0, y0, x1, y1)) return;
@@ -283,7 +286,12 @@ class BucketTree {
       const double cy = box_.origin[1] + (grid_double(2 * iy + (k >> 1)) + 0.5) * 0.5 * w;
       order[k] = {(cx - focus[0]) * (cx - focus[0]) + (cy - focus[1]) * (cy - focus[1]), k};
     }
-    std::sort(order.begin(), order.end());
+    // The order std::sort gives (the keys are distinct), by a five-exchange network: the
+    // sort's call was a tenth of the refiner's time.
+    const auto exchange = [&](unsigned a, unsigned b) {
+      if (order[b] < order[a]) std::swap(order[a], order[b]);
+    };
+    exchange(0, 1), exchange(2, 3), exchange(0, 2), exchange(1, 3), exchange(1, 2);
     for (const auto& [d2, k] : order) {
       if (stop) return;
       search_node(N.child + k, level + 1, 2 * ix + (k & 1), 2 * iy + (k >> 1), focus, margin, keep, f, stop);
@@ -319,6 +327,7 @@ class BucketTree {
 
   Box<2> box_;
   double scale_;
+  std::array<double, kMaxLevel + 1> width_{};  // the side of a cell at each level
   std::vector<Node> nodes_;
   std::size_t size_ = 0;
   mutable std::size_t leaves_read_ = 0;
