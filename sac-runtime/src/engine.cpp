@@ -251,7 +251,7 @@ void Engine::move_readers_after(ModBase& m, VersionBase* older, VersionBase* v, 
   if (!kept.empty()) fold_unordered(older);
   if (moved.empty() && first == stop) return;
   // v had no readers: they are the run merged with the unordered readers moved.
-  *link_merged(&v->readers, first != stop ? first : nullptr) = nullptr;
+  link_merged(&v->readers, first != stop ? first : nullptr, nullptr);
   if (same) return;
   for (ReaderLink* x = v->readers; x; x = x->rnext) note_change(x, m, older, v, true);
 }
@@ -293,13 +293,13 @@ void Engine::fold_unordered(VersionBase* older) {
   xs.clear();
 }
 
-ReaderLink** Engine::link_merged(ReaderLink** at, ReaderLink* run) {
+void Engine::link_merged(ReaderLink** at, ReaderLink* run, ReaderLink* tail) {
   std::vector<ReaderLink*>& xs = order_scratch_;
   sort_newest_first(xs);
   std::size_t i = 0;
-  while (run || i < xs.size()) {
+  while (i < xs.size()) {
     ReaderLink* x;
-    if (!run || (i < xs.size() && order_.less(&owner_of(run)->start, &owner_of(xs[i])->start))) {
+    if (!run || order_.less(&owner_of(run)->start, &owner_of(xs[i])->start)) {
       x = xs[i++];
     } else {
       x = run;
@@ -309,9 +309,18 @@ ReaderLink** Engine::link_merged(ReaderLink** at, ReaderLink* run) {
     *at = x;
     at = &x->rnext;
     x->unordered = 0;
+    ++stats_.readers_relinked;
   }
   xs.clear();
-  return at;
+  if (run) {  // what is left of the run is in order and linked: it goes in whole
+    run->rpprev = at;
+    *at = run;
+    if (!tail) return;  // the run ends in null already
+    for (; run->rnext; run = run->rnext) ++stats_.readers_relinked;
+    at = &run->rnext;
+  }
+  *at = tail;
+  if (tail) tail->rpprev = at;
 }
 
 bool Engine::move_readers_between(ModBase& m, VersionBase* older, VersionBase* v, VersionBase* newer, bool same) {
@@ -865,17 +874,24 @@ void Engine::undo(Stamp* s) {
           // no readers yet: then v's ordered list becomes older's whole, with no reader
           // touched but the first (none more when the value is the same).
           ReaderLink* rest = older->readers;
-          if (!v->unordered_readers && !rest) {
-            older->readers = v->readers;
-            older->readers->rpprev = &older->readers;
+          if (!rest && !older->unordered_readers) {
+            // Both lists go over whole: those that re-execution attached stay unordered (a
+            // cell that the steps of every class read has a thousand readers, and merging
+            // them relinked every one: bench/RESULTS.md, "Clusters far below the box's
+            // scale").
+            for (ReaderLink** l : {&v->readers, &v->unordered_readers}) {
+              ReaderLink** to = l == &v->readers ? &older->readers : &older->unordered_readers;
+              if ((*to = *l)) (*to)->rpprev = to;
+            }
+            if (!same)
+              for (ReaderLink* l : {older->readers, older->unordered_readers})
+                for (ReaderLink* r = l; r; r = r->rnext) note_change(r, *m, v, seen, seen != nullptr);
           } else {
             for (ReaderLink* r = v->unordered_readers; r; r = r->rnext) order_scratch_.push_back(r);
-            ReaderLink** end = link_merged(&older->readers, v->readers);
-            *end = rest;
-            if (rest) rest->rpprev = end;
+            link_merged(&older->readers, v->readers, rest);
+            if (!same)
+              for (ReaderLink* r = older->readers; r != rest; r = r->rnext) note_change(r, *m, v, seen, seen != nullptr);
           }
-          if (!same)
-            for (ReaderLink* r = older->readers; r != rest; r = r->rnext) note_change(r, *m, v, seen, seen != nullptr);
         } else {
           for (ReaderLink* l : {v->readers, v->unordered_readers})
             for (ReaderLink* r = l; r;) {

@@ -431,6 +431,42 @@ TEST(HpuCellsProgram, UpdatesNearTheSidesAt30Degrees) {
               static_cast<unsigned long long>(scratch), mean / double(std::max<std::size_t>(1, distance.size())));
 }
 
+/// Updates inside a cluster of radius 10^-11 in the unit box, and of points far from it, at
+/// 20.7° and 30°: size classes from the box's down to 10^-14, and cells near the cluster
+/// read by the steps of all of them (the case where an undone version's readers, merged
+/// into order, made updates 1.5 times slower: bench/RESULTS.md, "Clusters far below the
+/// box's scale").
+TEST(HpuCellsProgram, UpdatesInAClusterFarBelowTheBoxScale) {
+  const std::uint64_t seed = 131;
+  SCOPED_TRACE(seed_note(seed));
+  const Box<2> box{{0, 0}, 1};
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.001, 0.999), turn(0.0, 6.283185307179586);
+  std::set<Point<2>> used;
+  const auto fresh = [&] {
+    for (;;) {
+      Point<2> p{u(rng), u(rng)};
+      if (rng() % 8 != 0) {  // mostly in the cluster, uniform over its disc
+        const double r = 1e-11 * std::sqrt(u(rng)), t = turn(rng);
+        p = {0.3 + r * std::cos(t), 0.7 + r * std::sin(t)};
+      }
+      if (used.insert(p).second) return p;
+    }
+  };
+  std::vector<Point<2>> pts;
+  for (int i = 0; i < (kSanitized ? 40 : 150); ++i) pts.push_back(fresh());
+  for (const double angle : {kHpuDefaultMinAngle, 30.0}) {
+    SCOPED_TRACE("angle " + std::to_string(angle));
+    std::uint64_t scratch = 0;
+    const auto distance = run_updates(box, pts, fresh, angle, kSanitized ? 6 : 24, rng, scratch);
+    double mean = 0;
+    for (auto x : distance) mean += double(x);
+    std::printf("[ HpuCells ] cluster of radius 1e-11, %.1f°: from scratch %llu events; per update trace distance "
+                "mean %.1f\n",
+                angle, static_cast<unsigned long long>(scratch), mean / double(std::max<std::size_t>(1, distance.size())));
+  }
+}
+
 }  // namespace
 
 namespace {

@@ -2153,6 +2153,65 @@ TEST(EngineReaderOrder, AnUndoneVersionsReadersMoveOntoTheWriteThatReplacesIt) {
   EXPECT_GT(new_value, 5);
 }
 
+TEST(EngineReaderOrder, AnUndoneVersionsUnorderedReadersMoveWithoutARelinkOfTheOthers) {
+  // A read of sel writes m, and 2,000 reads follow, each of pick[i] around a read of m. A
+  // change of pick[i] re-executes that inner read of m, which hangs on m's version among
+  // its unordered readers. A change of sel then re-executes the write: the old version is
+  // undone onto the new one, which has no readers yet, and both of its lists move over
+  // whole. Merging them into order relinked all 2,000 (a cell read by the steps of every
+  // class: bench/RESULTS.md, "Clusters far below the box's scale"). Outputs, re-runs and
+  // the checker are tested after every change (seed printed).
+  constexpr int kReaders = 2000;
+  Mod<int> sel, m;
+  auto pick = std::make_unique<Mod<int>[]>(kReaders);
+  auto outs = std::make_unique<Mod<int>[]>(kReaders);
+  std::vector<int> vpick(kReaders, 0);
+  Engine e;
+  int vsel = 0, reruns = 0;
+  e.set(sel, vsel);
+  for (int i = 0; i < kReaders; ++i) e.set(pick[i], 0);
+  e.run([&](Engine& en) {
+    en.read(sel, [&m](Engine& x, int s) { x.write(m, s / 3); });
+    for (int i = 0; i < kReaders; ++i)
+      en.read(pick[i], [&m, &reruns, o = &outs[i]](Engine& x, int p) {
+        x.read(m, [&reruns, o, p](Engine& y, int v) {
+          ++reruns;
+          y.write(*o, 10 * v + p);
+        });
+      });
+  });
+  std::mt19937 rng(20261201);
+  std::printf("seed 20261201\n");
+  int whole_moves = 0;
+  for (int t = 0; t < 40; ++t) {
+    // Re-execute a few of the inner reads: they hang on m's version unordered.
+    for (int k = 0; k < 5; ++k) {
+      const int i = static_cast<int>(rng() % kReaders);
+      e.set(pick[i], ++vpick[i] % 7);
+    }
+    e.propagate();
+    e.check_invariants();
+    const int before = vsel;
+    e.set(sel, vsel = static_cast<int>(rng() % 12));
+    const std::uint64_t relinked0 = e.stats().readers_relinked;
+    reruns = 0;
+    e.propagate();
+    const bool rewritten = vsel != before;  // the read of sel re-ran and wrote m again
+    if (vsel / 3 == before / 3) {
+      EXPECT_EQ(reruns, 0) << "change " << t;
+    } else {
+      EXPECT_EQ(reruns, kReaders) << "change " << t;
+    }
+    if (rewritten) {
+      ++whole_moves;
+      EXPECT_LE(e.stats().readers_relinked - relinked0, std::uint64_t{5}) << "change " << t;
+    }
+    for (int i = 0; i < kReaders; ++i) ASSERT_EQ(outs[i].get(), 10 * (vsel / 3) + vpick[i] % 7) << "change " << t;
+    e.check_invariants();
+  }
+  EXPECT_GT(whole_moves, 10);
+}
+
 TEST(EngineDifferential, MapWithMemoReadAndKeyedCells) {
   for (std::uint64_t seed : {1u, 2u, 3u}) differential<MapProgram>(seed, 120 / kScale, 200 / kScale);
 }

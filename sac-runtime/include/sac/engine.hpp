@@ -421,10 +421,10 @@ class Engine {
   /// Sorts xs newest first by their reads' start times.
   void sort_newest_first(std::vector<detail::ReaderLink*>& xs) const;
   /// Links `run` (a null-ended chain of readers, newest first) and the readers in
-  /// order_scratch_ into one chain, newest first and all ordered, from *at on; empties
-  /// order_scratch_ and returns the last reader's rnext slot (or `at`), for the caller to
-  /// link what follows.
-  detail::ReaderLink** link_merged(detail::ReaderLink** at, detail::ReaderLink* run);
+  /// order_scratch_ into one chain, newest first and all ordered, from *at on, followed by
+  /// `tail` (a chain, or null); empties order_scratch_. O(order_scratch_ + the run up to the
+  /// last of those), plus the run's length when tail is not null.
+  void link_merged(detail::ReaderLink** at, detail::ReaderLink* run, detail::ReaderLink* tail);
   /// Hangs r, a read at its start's time, on v: at the head of v's ordered readers when it
   /// is at the trace's end (every from-scratch read) or v has none, else on v's unordered
   /// readers. Testing r against the head's time instead costs a cache miss per read that

@@ -36,6 +36,10 @@ struct Stats {
   /// version's unordered readers, its ordered ones up to the first before the write, and
   /// those the fold of the unordered ones into order walked (Engine::link_write).
   std::uint64_t readers_tested = 0;
+  /// Readers passed one by one (relinked in time order, or walked to a run's end) when a
+  /// version's readers moved onto another: an undone version's onto the version before it,
+  /// or the readers after a re-executed write onto it. A list that moves whole costs none.
+  std::uint64_t readers_relinked = 0;
   std::uint64_t propagations = 0;
   std::uint64_t live_events = 0;
   /// Trace distance (created + undone) of the last propagate().
@@ -49,7 +53,8 @@ struct Stats {
               << " memo_misses=" << s.memo_misses << " memo_far=" << s.memo_far << " alloc_reuses=" << s.alloc_reuses
               << " queue_pushes=" << s.queue_pushes << " queue_pops=" << s.queue_pops
               << " queue_removes=" << s.queue_removes << " unaffected=" << s.reads_unaffected
-              << " followed=" << s.reads_followed << " readers_tested=" << s.readers_tested << " live_events=" << s.live_events
+              << " followed=" << s.reads_followed << " readers_tested=" << s.readers_tested
+              << " readers_relinked=" << s.readers_relinked << " live_events=" << s.live_events
               << " last_trace_distance=" << s.last_trace_distance;
   }
 };
