@@ -15,16 +15,19 @@
 // the engine's counters (sac::Stats) after each series; --search-stats what the steps'
 // searches asked and read, per input point from scratch and per update: left searches and
 // leaves read (counters the program keeps anyway: counting more inside the view's leaf loop
-// cost 2% of an update's instructions, bench/RESULTS.md).
+// cost 2% of an update's instructions, bench/RESULTS.md). --points FILE measures a point
+// file instead (its one row is named after the file, n is its size; --box sets the box,
+// else it is derived from the points), with the same delete-insert updates.
 //
 //   dynmesh_hpu_steps [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
 //                     [--seed 1] [--angle 20.7] [--verify] [--tail K] [--breakdown] [--engine-stats]
-//                     [--search-stats]
+//                     [--search-stats] [--points FILE [--box o1 o2 L]]
 #include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
@@ -38,6 +41,7 @@
 #include "dynmesh/distributions.hpp"
 #include "dynmesh/edit.hpp"
 #include "dynmesh/hpu_mesh.hpp"
+#include "dynmesh/io.hpp"
 #include "hpu/hpu_cells_program.hpp"
 #include "hpu/hpu_cells_state.hpp"
 
@@ -87,6 +91,10 @@ int main(int argc, char** argv) {
   bool engine_stats = false;
   bool search_stats = false;
   std::size_t tail = 0;
+  std::string points_file;
+  std::vector<double> box_args;
+  app.add_option("--points", points_file, "measure this point file instead of the distributions");
+  app.add_option("--box", box_args, "with --points: the box, origin and side (default: derived)")->expected(3);
   app.add_option("--dist", dists, "distributions, comma-separated")->delimiter(',');
   app.add_option("--n", sizes, "sizes, comma-separated")->delimiter(',');
   app.add_option("--updates", updates, "delete-insert pairs measured");
@@ -103,16 +111,27 @@ int main(int argc, char** argv) {
   std::printf("%-8s %7s | %9s %8s %31s %6s %6s | %8s %8s %8s %31s %7s\n", "dist", "n", "events", "B/pt",
               "steps/pt (fc co try ins fin)", "rnd/st", "cl/rnd", "dist", "median", "us", "re-run (fc co try ins fin)",
               "rounds");
+  std::vector<Point<2>> file_points;
+  if (!points_file.empty()) {
+    try {
+      file_points = read_points_file<2>(points_file).points;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "dynmesh_hpu_steps: %s\n", e.what());
+      return 2;
+    }
+    const std::size_t slash = points_file.find_last_of('/');
+    dists = {points_file.substr(slash == std::string::npos ? 0 : slash + 1)};
+    sizes = {file_points.size()};
+  }
   for (const std::string& dname : dists) {
-    const auto parsed = parse_distribution(dname);
-    if (!parsed) {
+    const auto parsed = points_file.empty() ? parse_distribution(dname) : std::optional<Distribution>{};
+    if (points_file.empty() && !parsed) {
       std::fprintf(stderr, "dynmesh_hpu_steps: unknown distribution %s\n", dname.c_str());
       return 2;
     }
-    const Distribution dist = *parsed;
     for (const std::size_t n : sizes) {
-      std::vector<Point<2>> pts = generate<2>(dist, n, seed);
-      const Box<2> box = derive_box<2>(pts);
+      std::vector<Point<2>> pts = points_file.empty() ? generate<2>(*parsed, n, seed) : file_points;
+      const Box<2> box = box_args.empty() ? derive_box<2>(pts) : Box<2>{{box_args[0], box_args[1]}, box_args[2]};
       Run run(box, pts, angle);
       const sac::Stats& st = run.engine.stats();
       const double scratch_events = static_cast<double>(st.events_created);

@@ -172,10 +172,13 @@ class BucketTree {
   void used_box(double /*x0*/, double /*y0*/, double /*x1*/, double /*y1*/) const noexcept {}
 
   /// The widening of cells that keeps every vertex of a cell inside it despite the rounding
-  /// of point location, for a query of radius r around c.
+  /// of point location, for a query of radius r around c. position() is off by less than
+  /// 2^-51·(|x| + |origin|) in coordinates (the difference, the scale and their product
+  /// each round once); the absolute term is at least 16 times that (it was 2^-40: see
+  /// cellq::ulp_room), and the relative one covers the vertices' distance from c.
   double margin_for(const Point<2>& c, double r) const noexcept {
     const double mag = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(box_.origin[0]), std::abs(box_.origin[1])});
-    return r * 0x1p-30 + (mag + box_.side) * 0x1p-40;
+    return r * 0x1p-30 + (mag + box_.side) * 0x1p-46;
   }
 
   std::size_t size() const noexcept { return size_; }

@@ -84,9 +84,12 @@ namespace cellq {
 inline constexpr double kSlack = 0x1p-20;
 
 /// An absolute allowance for the rounding of coordinates near p: computed centres and
-/// differences are off by a few ulps of the coordinates, which can be large against a small
-/// question's radius.
-inline double ulp_room(const Point<2>& p) noexcept { return std::max(std::abs(p[0]), std::abs(p[1])) * 0x1p-40; }
+/// differences are off by a few ulps of the coordinates (2^-52 of them each), which can be
+/// large against a small question's radius. 2^-46 is 64 such ulps. It was 2^-40, which in
+/// a cluster of radius 10^-11 in the unit box widened every question by several vertex
+/// spacings: a search read thousands of leaves (bench/RESULTS.md, "Clusters far below the
+/// box's scale").
+inline double ulp_room(const Point<2>& p) noexcept { return std::max(std::abs(p[0]), std::abs(p[1])) * 0x1p-46; }
 
 /// |(dx, dy)| for radii and thresholds that carry a slack: within two ulps of std::hypot at
 /// a fraction of its cost (a tenth of the program's time went to hypot); hypot itself where
