@@ -93,8 +93,10 @@ int main(int argc, char** argv) {
   std::size_t tail = 0;
   std::string points_file;
   std::vector<double> box_args;
-  app.add_option("--points", points_file, "measure this point file instead of the distributions");
-  app.add_option("--box", box_args, "with --points: the box, origin and side (default: derived)")->expected(3);
+  auto* points_opt = app.add_option("--points", points_file, "measure this point file instead of the distributions");
+  app.add_option("--box", box_args, "with --points: the box, origin and side (default: derived)")
+      ->expected(3)
+      ->needs(points_opt);
   app.add_option("--dist", dists, "distributions, comma-separated")->delimiter(',');
   app.add_option("--n", sizes, "sizes, comma-separated")->delimiter(',');
   app.add_option("--updates", updates, "delete-insert pairs measured");

@@ -879,10 +879,9 @@ void Engine::undo(Stamp* s) {
             // cell that the steps of every class read has a thousand readers, and merging
             // them relinked every one: bench/RESULTS.md, "Clusters far below the box's
             // scale").
-            for (ReaderLink** l : {&v->readers, &v->unordered_readers}) {
-              ReaderLink** to = l == &v->readers ? &older->readers : &older->unordered_readers;
-              if ((*to = *l)) (*to)->rpprev = to;
-            }
+            if ((older->readers = v->readers)) older->readers->rpprev = &older->readers;
+            if ((older->unordered_readers = v->unordered_readers))
+              older->unordered_readers->rpprev = &older->unordered_readers;
             if (!same)
               for (ReaderLink* l : {older->readers, older->unordered_readers})
                 for (ReaderLink* r = l; r; r = r->rnext) note_change(r, *m, v, seen, seen != nullptr);
