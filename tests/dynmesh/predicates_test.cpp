@@ -27,8 +27,8 @@
 
 #include <algorithm>
 #include <array>
-#include <climits>
 #include <cfenv>
+#include <climits>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -642,7 +642,6 @@ TEST(Predicates, PencilMixedMagnitudesAgreeWithTheCircleDefinition) {
   EXPECT_GT(zeros, 0u);
   EXPECT_GT(nonzero, 0u);
 }
-
 
 /// The filters' own arithmetic stays in the normal range on meshing input: a subnormal
 /// result costs a microcode assist on x86, and the in-circle filter's room for underflow
