@@ -35,6 +35,7 @@
 #include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
+#include "dynmesh/predicates.hpp"
 #include "hpu/bucket_tree.hpp"
 #include "hpu/cell_store.hpp"
 #include "hpu/hpu_geometry.hpp"
@@ -464,6 +465,60 @@ TEST(HpuCellsProgram, UpdatesInAClusterFarBelowTheBoxScale) {
     std::printf("[ HpuCells ] cluster of radius 1e-11, %.1f°: from scratch %llu events; per update trace distance "
                 "mean %.1f\n",
                 angle, static_cast<unsigned long long>(scratch), mean / double(std::max<std::size_t>(1, distance.size())));
+  }
+}
+
+/// Far from the unit scale the predicates' inline filters overflow (or underflow), and every
+/// call went to exact arithmetic: 2,811 to 111,268 calls below, against 3 to 18 in the unit
+/// box, and a fuzzed box of side 3·10^291 took 0.63 s for 3 points. The exact stage now
+/// rescales such calls by a power of two and filters them again. The meshes at 30° are not
+/// the unit box's scaled (a Steiner vertex moves by an ulp, and the program asks other
+/// questions), so the bound is on the order of the calls, not their number.
+TEST(HpuCellsProgram, FarFromTheUnitScaleThePredicatesStayFiltered) {
+  const std::uint64_t seed = 137;
+  SCOPED_TRACE(seed_note(seed));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Point<2>> unit;
+  for (int i = 0; i < 30; ++i) unit.push_back({u(rng), u(rng)});
+  unit.push_back({0.5, 0.0});  // on a side, and collinear with the corners
+  for (const double angle : {kHpuDefaultMinAngle, 30.0}) {
+    SCOPED_TRACE("angle " + std::to_string(angle));
+    struct Count {
+      std::uint64_t twin, program;
+      std::vector<Triangle> mesh;
+    };
+    const auto count = [&](int e) {
+      const auto at = [e](const Point<2>& p) { return Point<2>{std::ldexp(p[0], e), std::ldexp(p[1], e)}; };
+      std::vector<Point<2>> pts;
+      for (const Point<2>& p : unit) pts.push_back(at(p));
+      const Box<2> box{{0, 0}, std::ldexp(1.0, e)};
+      Count c{};
+      std::uint64_t before = detail::exact_stage_calls();
+      const HpuMesh twin(box, pts, angle);
+      c.twin = detail::exact_stage_calls() - before;
+      before = detail::exact_stage_calls();
+      const HpuHarness program(box, pts, angle);
+      c.program = detail::exact_stage_calls() - before;
+      c.mesh = program.triangles();
+      EXPECT_TRUE(same_triangles(c.mesh, twin.triangles())) << "scale 2^" << e;
+      // Back to the unit box, exactly (the scale is a power of two and nothing is subnormal).
+      for (Triangle& t : c.mesh)
+        for (Point<2>& v : t.v) v = {std::ldexp(v[0], -e), std::ldexp(v[1], -e)};
+      return c;
+    };
+    const Count base = count(0);
+    for (const int e : {968, -960}) {
+      const Count far = count(e);
+      std::printf("[ HpuCells ] %.1f°, scale 2^%d: exact-stage calls twin %llu, program %llu (unit box %llu, %llu)\n", angle,
+                  e, static_cast<unsigned long long>(far.twin), static_cast<unsigned long long>(far.program),
+                  static_cast<unsigned long long>(base.twin), static_cast<unsigned long long>(base.program));
+      EXPECT_LE(far.twin, 8 * base.twin + 64) << "scale 2^" << e;
+      EXPECT_LE(far.program, 8 * base.program + 64) << "scale 2^" << e;
+      if (angle == kHpuDefaultMinAngle) {
+        EXPECT_EQ(far.mesh, base.mesh) << "scale 2^" << e;
+      }
+    }
   }
 }
 

@@ -248,6 +248,33 @@ TEST(MeshIo, StatsOfTheGrid) {
   EXPECT_EQ(s.angle_histogram, histogram);
 }
 
+/// The statistics of the grid scaled by a power of two are the grid's, scaled: a box of
+/// side 3·10^291 once reported every edge and area as infinite (squares that overflowed),
+/// and a tiny one would report 0.
+TEST(MeshIo, StatsAtExtremeScales) {
+  const Mesh unit = grid(4);
+  const MeshStats base = mesh_stats(unit);
+  for (const int e : {600, 960, -600, -960}) {
+    SCOPED_TRACE("scale 2^" + std::to_string(e));
+    std::vector<Triangle> ts;
+    for (std::size_t t = 0; t < unit.num_triangles(); ++t) {
+      Triangle tri = unit.triangle(t);
+      for (Point<2>& v : tri.v) v = {std::ldexp(v[0], e), std::ldexp(v[1], e)};
+      ts.push_back(tri);
+    }
+    const MeshStats s = mesh_stats(make_mesh(ts));
+    EXPECT_EQ(s.shortest_edge, std::ldexp(base.shortest_edge, e));
+    EXPECT_EQ(s.longest_edge, std::ldexp(base.longest_edge, e));
+    // An area of 2^1919 is beyond the doubles, and one of 2^-1921 below them.
+    const double area = std::abs(e) < 512 ? std::ldexp(0.5, 2 * e) : (e > 0 ? HUGE_VAL : 0.0);
+    EXPECT_EQ(s.smallest_area, area);
+    EXPECT_EQ(s.largest_area, area);
+    EXPECT_EQ(s.min_angle_deg, base.min_angle_deg);
+    EXPECT_EQ(s.max_angle_deg, base.max_angle_deg);
+    EXPECT_EQ(s.angle_histogram, base.angle_histogram);
+  }
+}
+
 TEST(MeshIo, StatsReport) {
   const std::string report = format_stats(mesh_stats(grid(4)));
   EXPECT_EQ(report,

@@ -643,6 +643,62 @@ TEST(Predicates, PencilMixedMagnitudesAgreeWithTheCircleDefinition) {
   EXPECT_GT(nonzero, 0u);
 }
 
+/// Far from the unit scale the inline filters overflow (or underflow) and cannot decide; the
+/// exact stage then rescales the call by a power of two and filters it again. Random cases
+/// scaled by 2^±960 must agree with GMP and reach exact arithmetic exactly as often as the
+/// same cases unscaled (the signs and the filters' decisions are scale-free); before the
+/// rescale, every scaled in-circle call and most others did.
+TEST(Predicates, FarFromTheUnitScaleTheFiltersStillDecide) {
+  constexpr std::uint64_t kSeed = 20261206;
+  SCOPED_TRACE(seed_trace(kSeed));
+  RandomPoints gen(kSeed);
+  std::mt19937_64 rng(kSeed);
+  std::array<std::vector<OrientCase>, 3> orient;
+  std::array<std::vector<IncircleCase>, 3> circle;
+  std::array<std::uint64_t, 3> pencil_exact{};
+  constexpr std::array<int, 3> kScales{0, 960, -960};
+  const auto at = [](const Point<2>& p, int e) { return Point<2>{std::ldexp(p[0], e), std::ldexp(p[1], e)}; };
+  const auto exact_scale = [&](const Point<2>& p) {
+    return at(at(p, 960), -960) == p && at(at(p, -960), 960) == p;  // nothing rounded
+  };
+  for (std::size_t i = 0; i < kRandomCases / 20; ++i) {
+    const int mix = gen.next_mix();
+    gen.recenter();
+    const Point<2> a = gen.point(mix), b = gen.point(mix), c = gen.point(mix), d = gen.point(mix);
+    if (!(exact_scale(a) && exact_scale(b) && exact_scale(c) && exact_scale(d))) continue;
+    const double h = 0.5 / std::tan(20.7 * std::numbers::pi / 180) * (rng() % 2 ? 1 : -1);
+    for (std::size_t s = 0; s < kScales.size(); ++s) {
+      const int e = kScales[s];
+      orient[s].push_back({at(a, e), at(b, e), at(c, e)});
+      circle[s].push_back({at(a, e), at(b, e), at(c, e), at(d, e)});
+      const std::uint64_t before = dynmesh::detail::exact_stage_calls();
+      ASSERT_EQ(dynmesh::pencil(at(a, e), at(b, e), h, at(c, e)), pencil_reference(a, b, h, c)) << "scale 2^" << e;
+      pencil_exact[s] += dynmesh::detail::exact_stage_calls() - before;
+    }
+  }
+  std::array<std::uint64_t, 3> orient_exact{}, circle_exact{};
+  for (std::size_t s = 0; s < kScales.size(); ++s) {
+    SCOPED_TRACE("scale 2^" + std::to_string(kScales[s]));
+    std::uint64_t before = dynmesh::detail::exact_stage_calls();
+    const Tally o = check(orient[s]);
+    orient_exact[s] = dynmesh::detail::exact_stage_calls() - before;
+    EXPECT_AGREES(o);
+    before = dynmesh::detail::exact_stage_calls();
+    const Tally c = check(circle[s]);
+    circle_exact[s] = dynmesh::detail::exact_stage_calls() - before;
+    EXPECT_AGREES(c);
+  }
+  std::printf("[ Predicates ] %zu cases: exact-stage calls orient2d %llu, incircle %llu, pencil %llu at the unit scale\n",
+              orient[0].size(), static_cast<unsigned long long>(orient_exact[0]),
+              static_cast<unsigned long long>(circle_exact[0]), static_cast<unsigned long long>(pencil_exact[0]));
+  EXPECT_GT(orient_exact[0] + circle_exact[0], 0u);  // the degenerate cases of the mixes reach it
+  for (std::size_t s = 1; s < kScales.size(); ++s) {
+    EXPECT_EQ(orient_exact[s], orient_exact[0]) << "orient2d at 2^" << kScales[s];
+    EXPECT_EQ(circle_exact[s], circle_exact[0]) << "incircle at 2^" << kScales[s];
+    EXPECT_EQ(pencil_exact[s], pencil_exact[0]) << "pencil at 2^" << kScales[s];
+  }
+}
+
 /// The filters' own arithmetic stays in the normal range on meshing input: a subnormal
 /// result costs a microcode assist on x86, and the in-circle filter's room for underflow
 /// once made one on every call (70% of the filter's time; bench/RESULTS.md, "The in-circle

@@ -8,7 +8,9 @@
 // ccwerrboundA and iccerrboundA) plus a small absolute term for the products that underflow
 // (an overflow leaves the comparison undecided); otherwise it asks CGAL's
 // Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
-// interval filter with an exact fallback. CGAL's headers are confined to src/geometry/predicates.cpp.
+// interval filter with an exact fallback. Before that, a call whose coordinates are so large
+// (or small) that the filter's products overflow (or underflow) is rescaled by a power of
+// two, exactly, and filtered again. CGAL's headers are confined to src/geometry/predicates.cpp.
 // The inline stage decides nearly all calls on meshing input and saves the call and CGAL's
 // own filter setup (the predicates were a third of the hpu mesh's build time).
 //
@@ -21,6 +23,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "dynmesh/point.hpp"
 
@@ -31,6 +34,9 @@ namespace detail {
 int orient2d_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept;
 int incircle_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept;
 int pencil_exact(const Point<2>& p, const Point<2>& q, double h, const Point<2>& x) noexcept;
+/// How many calls on this thread reached exact arithmetic (CGAL's kernel or GMP rationals)
+/// in orient2d, incircle and pencil: for tests and experiments that check the filters decide.
+std::uint64_t exact_stage_calls() noexcept;
 /// Shewchuk's bounds, ε = 2^−53: the error of the double evaluations below is at most
 /// bound × permanent when no intermediate value overflows or underflows.
 inline constexpr double kEpsilon = 0x1p-53;

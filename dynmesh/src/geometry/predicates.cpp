@@ -8,7 +8,7 @@
 // Invariants: the returned int is the sign of the exact determinant of the double inputs
 // (−1, 0 or +1); CGAL's Sign enum already uses exactly these values.
 // Complexity: O(1); the exact fallback costs microseconds but runs only on (nearly)
-// degenerate input.
+// degenerate input, once the rescaling below has settled the calls whose filters overflowed.
 // Paper: Shewchuk (1997) for the determinants and their sign conventions; Brönnimann,
 // Burnikel, Pion, "Interval arithmetic yields efficient dynamic filters for computational
 // geometry" (1998) for the filter CGAL implements.
@@ -16,6 +16,10 @@
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 
 namespace dynmesh {
 
@@ -26,14 +30,68 @@ using KPoint = Kernel::Point_2;
 
 KPoint to_kernel(const Point<2>& p) noexcept { return KPoint(p[0], p[1]); }
 
+thread_local std::uint64_t exact_evaluations = 0;
+
+/// Coordinates beyond these magnitudes are rescaled before the exact stage. Above 2^200 the
+/// in-circle filter's degree-4 products can overflow (at 2^254), and the others' too further
+/// up; below 2^-200 the products underflow past the filters' absolute room. Either way a
+/// common power-of-two scale brings the calls back into the range the filters decide.
+constexpr double kRescaleAbove = 0x1p200;
+constexpr double kRescaleBelow = 0x1p-200;
+
+/// Rescales the points in place by the power of two that brings their largest coordinate
+/// magnitude into [1/2, 1) (subnormal ones as near as a factor 2^1000 takes them), when that
+/// magnitude is outside [2^-200, 2^200] and every coordinate scales exactly; returns whether
+/// it did. A common positive scale leaves each sign unchanged: orient2d, encroachment and the
+/// pencil's determinant are homogeneous of degree 2 in the coordinates, incircle of degree 4,
+/// and the pencil's h is a ratio. So a call whose inline filter overflowed (a fuzzed input
+/// near 10^291 sent every call to GMP) is decided by the filters again.
+template <std::size_t N>
+bool rescale(std::array<Point<2>, N>& pts) noexcept {
+  double m = 0;
+  for (const auto& p : pts) m = std::max({m, std::fabs(p[0]), std::fabs(p[1])});
+  if (!(m > kRescaleAbove || (m < kRescaleBelow && m > 0))) return false;
+  int e = 0;
+  std::frexp(m, &e);
+  // 2^−e, though never above 2^1000 (a finite double): for m down to 2^−1074 the result's
+  // largest coordinate is then at least 2^−74, so no call rescales twice.
+  const double s = std::ldexp(1.0, std::min(-e, 1000));
+  std::array<Point<2>, N> scaled;
+  for (std::size_t i = 0; i < N; ++i)
+    for (int k = 0; k < 2; ++k) {
+      // Products and quotients by a power of two are exact unless they round into the
+      // subnormal range, which the way back detects.
+      scaled[i][k] = pts[i][k] * s;
+      if (scaled[i][k] / s != pts[i][k]) return false;
+    }
+  pts = scaled;
+  return true;
+}
+
 }  // namespace
 
+std::uint64_t detail::exact_stage_calls() noexcept { return exact_evaluations; }
+
 int detail::orient2d_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept {
+  // The rescaled points are within [2^-200, 2^200], so the call below cannot come back here
+  // through another rescale: it decides in its filter or reaches CGAL.
+  if (std::array pts{a, b, c}; rescale(pts)) return orient2d(pts[0], pts[1], pts[2]);
+  // A difference of doubles is zero exactly when they are equal, and is otherwise rounded
+  // to a value of the same sign. So when one factor of a product is an exact zero (a
+  // repeated point, points on one axis-parallel line: the filter's bound is then its
+  // absolute room alone), the sign is the other product's, from the factors' signs.
+  const double acx = a[0] - c[0], bcy = b[1] - c[1], acy = a[1] - c[1], bcx = b[0] - c[0];
+  const auto sgn = [](double v) { return (v > 0) - (v < 0); };
+  if (acx == 0 || bcy == 0) return -sgn(acy) * sgn(bcx);
+  if (acy == 0 || bcx == 0) return sgn(acx) * sgn(bcy);
+  ++exact_evaluations;
   // CGAL::LEFT_TURN == POSITIVE == +1: c left of the directed line ab, i.e. a, b, c ccw.
   return static_cast<int>(Kernel::Orientation_2()(to_kernel(a), to_kernel(b), to_kernel(c)));
 }
 
 int detail::incircle_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept {
+  if (std::array pts{a, b, c, d}; rescale(pts)) return incircle(pts[0], pts[1], pts[2], pts[3]);
+  ++exact_evaluations;
   // ON_POSITIVE_SIDE == +1 of the circle oriented by a, b, c: the inside when a, b, c are ccw.
   // CGAL evaluates the full lifted determinant, so collinear a, b, c get its sign, as promised.
   return static_cast<int>(Kernel::Side_of_oriented_circle_2()(to_kernel(a), to_kernel(b),
@@ -41,6 +99,8 @@ int detail::incircle_exact(const Point<2>& a, const Point<2>& b, const Point<2>&
 }
 
 int detail::pencil_exact(const Point<2>& p, const Point<2>& q, double h, const Point<2>& x) noexcept {
+  if (std::array pts{p, q, x}; rescale(pts)) return pencil(pts[0], pts[1], h, pts[2]);
+  ++exact_evaluations;
   using Q = CGAL::Exact_rational;
   const Q px(p[0]), py(p[1]), qx(q[0]), qy(q[1]), xx(x[0]), xy(x[1]), hh(h);
   const Q det = (xx - px) * (xx - qx) + (xy - py) * (xy - qy) - 2 * hh * ((qx - px) * (xy - py) - (qy - py) * (xx - px));
@@ -48,6 +108,9 @@ int detail::pencil_exact(const Point<2>& p, const Point<2>& q, double h, const P
 }
 
 bool encroaches(const Point<2>& a, const Point<2>& b, const Point<2>& x) noexcept {
+  // CGAL's filter overflows as the inline ones do; its exact stage is not counted, since it
+  // cannot be told apart from the filter's success from here.
+  if (std::array pts{a, b, x}; rescale(pts)) return encroaches(pts[0], pts[1], pts[2]);
   // The angle at x of a, x, b is obtuse exactly when x is strictly inside the diametral circle.
   return Kernel::Angle_2()(to_kernel(a), to_kernel(x), to_kernel(b)) == CGAL::OBTUSE;
 }

@@ -417,14 +417,23 @@ MeshStats mesh_stats(const Mesh& mesh) {
   for (std::size_t t = 0; t < mesh.num_triangles(); ++t) {
     const Triangle tri = mesh.triangle(t);
     const auto& [a, b, c] = tri.v;
-    const double area = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])) / 2;
+    // In a frame scaled by a power of two (exact), so that the products neither overflow in
+    // a box near 1e300 nor underflow in one near 1e-300: the area is infinite or 0 only when
+    // it is beyond the doubles' range itself.
+    double ux = b[0] - a[0], uy = b[1] - a[1], vx = c[0] - a[0], vy = c[1] - a[1];
+    int e = 0;
+    if (const double m = std::max({std::abs(ux), std::abs(uy), std::abs(vx), std::abs(vy)}); m > 0 && std::isfinite(m)) {
+      e = std::ilogb(m);
+      ux = std::ldexp(ux, -e), uy = std::ldexp(uy, -e), vx = std::ldexp(vx, -e), vy = std::ldexp(vy, -e);
+    }
+    const double area = std::ldexp((ux * vy - uy * vx) / 2, 2 * e);
     stats.smallest_area = std::min(stats.smallest_area, area);
     stats.largest_area = std::max(stats.largest_area, area);
     for (int k = 0; k < 3; ++k) {
       const Point<2>& p = tri.v[k];
       const Point<2>& q = tri.v[(k + 1) % 3];
       const Point<2>& r = tri.v[(k + 2) % 3];
-      const double edge = std::sqrt((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]));
+      const double edge = std::hypot(q[0] - p[0], q[1] - p[1]);  // no overflow or underflow
       stats.shortest_edge = std::min(stats.shortest_edge, edge);
       stats.longest_edge = std::max(stats.longest_edge, edge);
       const double angle = corner_angle_deg(p, q, r);
