@@ -18,8 +18,10 @@
 #include <CGAL/Exact_rational.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 namespace dynmesh {
 
@@ -46,23 +48,31 @@ constexpr double kRescaleBelow = 0x1p-200;
 /// pencil's determinant are homogeneous of degree 2 in the coordinates, incircle of degree 4,
 /// and the pencil's h is a ratio. So a call whose inline filter overflowed (a fuzzed input
 /// near 10^291 sent every call to GMP) is decided by the filters again.
+/// ⌊log2 x⌋ + 1 for finite x > 0 (std::frexp's exponent), without the libm call.
+int frexp_exponent(double x) noexcept {
+  const auto bits = std::bit_cast<std::uint64_t>(x);
+  const int field = static_cast<int>(bits >> 52);  // the sign bit is clear
+  if (field != 0) return field - 1022;
+  return -1021 - std::countl_zero(bits & ((std::uint64_t{1} << 52) - 1)) + 11;  // subnormal
+}
+
 template <std::size_t N>
 bool rescale(std::array<Point<2>, N>& pts) noexcept {
   double m = 0;
   for (const auto& p : pts) m = std::max({m, std::fabs(p[0]), std::fabs(p[1])});
   if (!(m > kRescaleAbove || (m < kRescaleBelow && m > 0))) return false;
-  int e = 0;
-  std::frexp(m, &e);
-  // 2^−e, though never above 2^1000 (a finite double): for m down to 2^−1074 the result's
-  // largest coordinate is then at least 2^−74, so no call rescales twice.
-  const double s = std::ldexp(1.0, std::min(-e, 1000));
+  // 2^−e, though never above 2^1000: for m down to 2^−1074 the result's largest coordinate
+  // is then at least 2^−74, so no call rescales twice. From the bits when 2^−e is normal.
+  const int k = std::min(-frexp_exponent(m), 1000);
+  const double s = k >= -1022 ? std::bit_cast<double>(static_cast<std::uint64_t>(k + 1023) << 52) : std::ldexp(1.0, k);
   std::array<Point<2>, N> scaled;
   for (std::size_t i = 0; i < N; ++i)
-    for (int k = 0; k < 2; ++k) {
-      // Products and quotients by a power of two are exact unless they round into the
-      // subnormal range, which the way back detects.
-      scaled[i][k] = pts[i][k] * s;
-      if (scaled[i][k] / s != pts[i][k]) return false;
+    for (int c = 0; c < 2; ++c) {
+      // A product by a power of two is exact unless it rounds into the subnormal range,
+      // which only a scale below 1 can do, and which the way back then detects.
+      const double x = pts[i][c], y = x * s;
+      if (s < 1 && std::fabs(y) < std::numeric_limits<double>::min() && y / s != x) return false;
+      scaled[i][c] = y;
     }
   pts = scaled;
   return true;
