@@ -471,9 +471,10 @@ TEST(HpuCellsProgram, UpdatesInAClusterFarBelowTheBoxScale) {
 /// Far from the unit scale the predicates' inline filters overflow (or underflow), and every
 /// call went to exact arithmetic: 2,811 to 111,268 calls below, against 3 to 18 in the unit
 /// box, and a fuzzed box of side 3·10^291 took 0.63 s for 3 points. The exact stage now
-/// rescales such calls by a power of two and filters them again. The meshes at 30° are not
-/// the unit box's scaled (a Steiner vertex moves by an ulp, and the program asks other
-/// questions), so the bound is on the order of the calls, not their number.
+/// rescales such calls by a power of two and filters them again. A scaled input is not the
+/// same input: the BRIO rounds of the insertion order hash the coordinates' bits, so the
+/// refinement may run in another order (here the mesh at 30° differs, and the program asks
+/// other questions). So the bound is on the order of the calls, not their number.
 TEST(HpuCellsProgram, FarFromTheUnitScaleThePredicatesStayFiltered) {
   const std::uint64_t seed = 137;
   SCOPED_TRACE(seed_note(seed));
