@@ -41,6 +41,14 @@ thread_local std::uint64_t exact_evaluations = 0;
 constexpr double kRescaleAbove = 0x1p200;
 constexpr double kRescaleBelow = 0x1p-200;
 
+/// ⌊log2 x⌋ + 1 for finite x > 0 (std::frexp's exponent), without the libm call.
+int frexp_exponent(double x) noexcept {
+  const auto bits = std::bit_cast<std::uint64_t>(x);  // the sign bit is clear
+  const int field = static_cast<int>(bits >> 52);
+  if (field != 0) return field - 1022;
+  return -1010 - std::countl_zero(bits);  // subnormal: x = bits · 2^-1074
+}
+
 /// Rescales the points in place by the power of two that brings their largest coordinate
 /// magnitude into [1/2, 1) (subnormal ones as near as a factor 2^1000 takes them), when that
 /// magnitude is outside [2^-200, 2^200] and every coordinate scales exactly; returns whether
@@ -48,14 +56,6 @@ constexpr double kRescaleBelow = 0x1p-200;
 /// pencil's determinant are homogeneous of degree 2 in the coordinates, incircle of degree 4,
 /// and the pencil's h is a ratio. So a call whose inline filter overflowed (a fuzzed input
 /// near 10^291 sent every call to GMP) is decided by the filters again.
-/// ⌊log2 x⌋ + 1 for finite x > 0 (std::frexp's exponent), without the libm call.
-int frexp_exponent(double x) noexcept {
-  const auto bits = std::bit_cast<std::uint64_t>(x);
-  const int field = static_cast<int>(bits >> 52);  // the sign bit is clear
-  if (field != 0) return field - 1022;
-  return -1021 - std::countl_zero(bits & ((std::uint64_t{1} << 52) - 1)) + 11;  // subnormal
-}
-
 template <std::size_t N>
 bool rescale(std::array<Point<2>, N>& pts) noexcept {
   double m = 0;
@@ -83,8 +83,8 @@ bool rescale(std::array<Point<2>, N>& pts) noexcept {
 std::uint64_t detail::exact_stage_calls() noexcept { return exact_evaluations; }
 
 int detail::orient2d_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept {
-  // The rescaled points are within [2^-200, 2^200], so the call below cannot come back here
-  // through another rescale: it decides in its filter or reaches CGAL.
+  // The rescaled points' largest coordinate is in [2^-74, 1), so the call below cannot come
+  // back here through another rescale: it decides in its filter or reaches CGAL.
   if (std::array pts{a, b, c}; rescale(pts)) return orient2d(pts[0], pts[1], pts[2]);
   // A difference of doubles is zero exactly when they are equal, and is otherwise rounded
   // to a value of the same sign. So when one factor of a product is an exact zero (a
