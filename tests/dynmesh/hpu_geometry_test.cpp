@@ -1,6 +1,7 @@
-// Tests of hpu/hpu_geometry.hpp's exact power-of-two helpers against libm, and of the
-// formulas that use them against the same formulas written with std::ldexp and std::ilogb
-// (their form before the helpers): the twin and the program must keep every bit.
+// Tests of hpu/hpu_geometry.hpp's formulas that compute in frames scaled by a power of two
+// (geometry/powers_of_two.hpp, tested in powers_of_two_test.cpp) against the same formulas
+// written with std::ldexp and std::ilogb (their form before the helpers): the twin and the
+// program must keep every bit.
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -15,50 +16,6 @@ namespace dynmesh::detail {
 namespace {
 
 constexpr std::uint64_t kSeed = 20261128;
-
-double random_bits(std::mt19937_64& rng) { return std::bit_cast<double>(rng()); }
-
-/// A finite non-zero double of any exponent, subnormals included.
-double random_finite(std::mt19937_64& rng) {
-  for (;;) {
-    const double x = random_bits(rng);
-    if (std::isfinite(x) && x != 0) return x;
-  }
-}
-
-TEST(HpuGeometry, ExponentOfIsIlogbEverywhere) {
-  std::mt19937_64 rng(kSeed);
-  SCOPED_TRACE("seed " + std::to_string(kSeed));
-  for (int i = 0; i < 1'000'000; ++i) {
-    const double x = random_bits(rng);
-    if (std::isnan(x)) continue;
-    ASSERT_EQ(exponent_of(x), std::ilogb(x)) << x;
-  }
-  for (const double x : {0.0, -0.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::denorm_min(),
-                         std::numeric_limits<double>::min(), std::numeric_limits<double>::max(), 1.0, 0x1.fffffffffffffp-1023,
-                         -0x1p-1070})
-    EXPECT_EQ(exponent_of(x), std::ilogb(x)) << x;
-  EXPECT_EQ(exponent_of(std::numeric_limits<double>::quiet_NaN()), std::ilogb(std::numeric_limits<double>::quiet_NaN()));
-}
-
-TEST(HpuGeometry, Pow2IsLdexpOfOneAndSaturatesAsIt) {
-  for (int e = -1300; e <= 1300; ++e) ASSERT_EQ(pow2(e), std::ldexp(1.0, e)) << e;
-}
-
-TEST(HpuGeometry, ScaleDownByIsLdexpWithinTheFrame) {
-  std::mt19937_64 rng(kSeed + 1);
-  SCOPED_TRACE("seed " + std::to_string(kSeed + 1));
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  for (int i = 0; i < 1'000'000; ++i) {
-    const double m = std::abs(random_finite(rng));
-    const int e = exponent_of(m);
-    // x of any size up to m: a fraction of m, or m's bits with fewer exponent.
-    double x = i % 2 ? m * u(rng) : std::ldexp(m, -static_cast<int>(rng() % 1200));
-    if (i % 3 == 0) x = -x;
-    ASSERT_EQ(scale_down_by(x, e), std::ldexp(x, -e)) << x << " in the frame of " << m;
-    ASSERT_EQ(scale_down_by(m, e), std::ldexp(m, -e)) << m;
-  }
-}
 
 // The formulas in their form before the helpers, as the oracle.
 int edge_class_ldexp(const Point<2>& a, const Point<2>& b) {

@@ -14,11 +14,12 @@
 // geometry" (1998) for the filter CGAL implements.
 #include "dynmesh/predicates.hpp"
 
+#include "geometry/powers_of_two.hpp"
+
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Exact_rational.h>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -41,14 +42,6 @@ thread_local std::uint64_t exact_evaluations = 0;
 constexpr double kRescaleAbove = 0x1p200;
 constexpr double kRescaleBelow = 0x1p-200;
 
-/// ⌊log2 x⌋ + 1 for finite x > 0 (std::frexp's exponent), without the libm call.
-int frexp_exponent(double x) noexcept {
-  const auto bits = std::bit_cast<std::uint64_t>(x);  // the sign bit is clear
-  const int field = static_cast<int>(bits >> 52);
-  if (field != 0) return field - 1022;
-  return -1010 - std::countl_zero(bits);  // subnormal: x = bits · 2^-1074
-}
-
 /// Rescales the points in place by the power of two that brings their largest coordinate
 /// magnitude into [1/2, 1) (subnormal ones as near as a factor 2^1000 takes them), when that
 /// magnitude is outside [2^-200, 2^200] and every coordinate scales exactly; returns whether
@@ -61,10 +54,9 @@ bool rescale(std::array<Point<2>, N>& pts) noexcept {
   double m = 0;
   for (const auto& p : pts) m = std::max({m, std::fabs(p[0]), std::fabs(p[1])});
   if (!(m > kRescaleAbove || (m < kRescaleBelow && m > 0))) return false;
-  // 2^−e, though never above 2^1000: for m down to 2^−1074 the result's largest coordinate
-  // is then at least 2^−74, so no call rescales twice. From the bits when 2^−e is normal.
-  const int k = std::min(-frexp_exponent(m), 1000);
-  const double s = k >= -1022 ? std::bit_cast<double>(static_cast<std::uint64_t>(k + 1023) << 52) : std::ldexp(1.0, k);
+  // 2^−(⌊log2 m⌋ + 1), though never above 2^1000: for m down to 2^−1074 the result's
+  // largest coordinate is then at least 2^−74, so no call rescales twice.
+  const double s = detail::pow2(std::min(-detail::exponent_of(m) - 1, 1000));
   std::array<Point<2>, N> scaled;
   for (std::size_t i = 0; i < N; ++i)
     for (int c = 0; c < 2; ++c) {
@@ -87,9 +79,10 @@ int detail::orient2d_exact(const Point<2>& a, const Point<2>& b, const Point<2>&
   // back here through another rescale: it decides in its filter or reaches CGAL.
   if (std::array pts{a, b, c}; rescale(pts)) return orient2d(pts[0], pts[1], pts[2]);
   // A difference of doubles is zero exactly when they are equal, and is otherwise rounded
-  // to a value of the same sign. So when one factor of a product is an exact zero (a
-  // repeated point, points on one axis-parallel line: the filter's bound is then its
-  // absolute room alone), the sign is the other product's, from the factors' signs.
+  // to a value of the same sign. So when one factor of a product is an exact zero, the sign
+  // is the other product's, from the factors' signs. The filter fails on such calls when
+  // both products are zero (a repeated point, points on one axis-parallel line), where its
+  // bound is its absolute room alone.
   const double acx = a[0] - c[0], bcy = b[1] - c[1], acy = a[1] - c[1], bcx = b[0] - c[0];
   const auto sgn = [](double v) { return (v > 0) - (v < 0); };
   if (acx == 0 || bcy == 0) return -sgn(acy) * sgn(bcx);

@@ -36,6 +36,7 @@
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
 #include "dynmesh/predicates.hpp"
+#include "geometry/powers_of_two.hpp"
 #include "geometry/z_order.hpp"
 
 namespace dynmesh::detail {
@@ -77,34 +78,6 @@ inline double apex_height(double min_angle_deg) noexcept {
 /// than the checker's rounding.
 inline double leaf_height(double min_angle_deg) noexcept {
   return kLeafMargin * 0.5 / std::tan(min_angle_deg * (std::numbers::pi / 180.0));
-}
-
-/// std::ilogb(x) without the libm call, for finite non-zero x (subnormals included); std::ilogb
-/// itself otherwise. The twin and the program call it for every edge they classify.
-inline int exponent_of(double x) noexcept {
-  const std::uint64_t bits = std::bit_cast<std::uint64_t>(x);
-  const int field = static_cast<int>((bits >> 52) & 0x7ff);
-  const std::uint64_t mantissa = bits & ((std::uint64_t{1} << 52) - 1);
-  if (field == 0x7ff || (field == 0 && mantissa == 0)) return std::ilogb(x);  // inf, NaN, ±0
-  if (field == 0) return -1011 - std::countl_zero(mantissa);                  // subnormal
-  return field - 1023;
-}
-
-/// 2^e, exactly, for e in [-1074, 1023] (subnormal below -1022); 0 below and +inf above, as
-/// std::ldexp(1.0, e) saturates.
-inline double pow2(int e) noexcept {
-  if (e > 1023) return std::numeric_limits<double>::infinity();
-  if (e < -1074) return 0.0;
-  if (e >= -1022) return std::bit_cast<double>(static_cast<std::uint64_t>(e + 1023) << 52);
-  return std::bit_cast<double>(std::uint64_t{1} << (e + 1074));
-}
-
-/// std::ldexp(x, -exponent_of(m)) for |x| ≤ m, m finite and non-zero: x in the frame where m
-/// lies in [1, 2). Scaling up is exact, and scaling down rounds once, as ldexp does; only a
-/// subnormal m needs two factors (both scale up, so both are exact).
-inline double scale_down_by(double x, int e) noexcept {
-  if (e >= -1023) return x * pow2(-e);
-  return (x * pow2(1023)) * pow2(-e - 1023);
 }
 
 /// The size class of an edge of squared length `squared`: ⌊log2 |pq|⌋.
