@@ -1,7 +1,6 @@
 // Tests of sac/chunk_cache.hpp: a destroyed engine's chunks go to the cache only up to its
 // bound, lowering the bound or trimming unmaps them, and with the bound at 0 the resident
-// set shrinks by the trace when the engine dies. The prefaulting worker holds the next
-// chunk of a growing pool, the pool takes it, a dying pool gives it back, and off means off.
+// set shrinks by the trace when the engine dies.
 #include <gtest/gtest.h>
 
 #include <cstddef>
@@ -11,34 +10,19 @@
 #include <vector>
 
 #include "sac/chunk_cache.hpp"
-#include "sac/detail/pool.hpp"
 #include "sac/sac.hpp"
 
 namespace {
 
-/// Restores the process-wide bound and prefaulting when a test ends.
+/// Restores the process-wide bound when a test ends.
 class ChunkCache : public ::testing::Test {
  protected:
-  void SetUp() override {
-    saved_ = sac::chunk_cache_limit();
-    prefault_ = sac::chunk_prefault();
-  }
-  void TearDown() override {
-    sac::set_chunk_cache_limit(saved_);
-    sac::set_chunk_prefault(prefault_);
-  }
+  void SetUp() override { saved_ = sac::chunk_cache_limit(); }
+  void TearDown() override { sac::set_chunk_cache_limit(saved_); }
 
  private:
   std::size_t saved_ = 0;
-  bool prefault_ = true;
 };
-
-using Pool = sac::detail::Pool;
-
-/// Carves blocks from `pool` until it has reserved more than `bytes`.
-void grow(Pool& pool, std::size_t bytes) {
-  while (pool.reserved_bytes() <= bytes) pool.allocate(Pool::kMaxSmall);
-}
 
 /// An engine holding a trace of n reads (tens of MiB: several huge chunks).
 struct BigTrace {
@@ -96,61 +80,6 @@ TEST_F(ChunkCache, ABoundOfZeroGivesTheMemoryBack) {
     EXPECT_GT(before - std::min(before, after), trace / 2)
         << "resident " << before << " -> " << after << " bytes, trace " << trace;
   }
-}
-
-TEST_F(ChunkCache, ThePrefaulterHoldsTheNextChunkAndThePoolTakesIt) {
-  sac::set_chunk_prefault(true);
-  sac::trim_chunk_cache();
-  Pool pool;
-  grow(pool, Pool::kMaxChunk / 2);  // the chunks have grown to the largest size: one is asked for
-  sac::wait_chunk_prefault();
-  const std::size_t ahead = sac::chunk_prefault_bytes();
-  ASSERT_EQ(ahead, Pool::kMaxChunk) << "no chunk was faulted in ahead";
-  const std::size_t served = sac::chunk_prefaults_served();
-  const std::size_t reserved = pool.reserved_bytes();
-  grow(pool, reserved);  // the pool's next chunk is the one held ahead
-  EXPECT_EQ(pool.reserved_bytes(), reserved + ahead);
-  EXPECT_EQ(sac::chunk_prefaults_served(), served + 1);
-  sac::wait_chunk_prefault();
-  EXPECT_EQ(sac::chunk_prefault_bytes(), Pool::kMaxChunk);  // and the next
-}
-
-TEST_F(ChunkCache, ADyingPoolGivesTheChunkHeldAheadBack) {
-  sac::set_chunk_prefault(true);
-  sac::set_chunk_cache_limit(0);
-  {
-    Pool pool;
-    grow(pool, Pool::kMaxChunk / 2);
-    sac::wait_chunk_prefault();
-    EXPECT_GT(sac::chunk_prefault_bytes(), 0u);
-  }
-  EXPECT_EQ(sac::chunk_prefault_bytes(), 0u);  // unmapped: the cache's bound is 0
-  EXPECT_EQ(sac::chunk_cache_bytes(), 0u);
-  // With room in the cache, it goes there instead, already faulted in.
-  sac::set_chunk_cache_limit(std::size_t{1} << 30);
-  sac::trim_chunk_cache();
-  std::size_t ahead = 0;
-  {
-    Pool pool;
-    grow(pool, Pool::kMaxChunk / 2);
-    sac::wait_chunk_prefault();
-    ahead = sac::chunk_prefault_bytes();
-  }
-  EXPECT_EQ(sac::chunk_prefault_bytes(), 0u);
-  EXPECT_GE(sac::chunk_cache_bytes(), ahead);
-  sac::trim_chunk_cache();
-  EXPECT_EQ(sac::chunk_cache_bytes(), 0u);
-}
-
-TEST_F(ChunkCache, WithPrefaultingOffNoChunkIsHeldAhead) {
-  sac::set_chunk_prefault(false);
-  EXPECT_FALSE(sac::chunk_prefault());
-  const std::size_t served = sac::chunk_prefaults_served();
-  Pool pool;
-  grow(pool, Pool::kMaxChunk);
-  sac::wait_chunk_prefault();
-  EXPECT_EQ(sac::chunk_prefault_bytes(), 0u);
-  EXPECT_EQ(sac::chunk_prefaults_served(), served);
 }
 
 }  // namespace
