@@ -10,6 +10,7 @@
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/predicates.hpp"
+#include "geometry/powers_of_two.hpp"
 #include "geometry/z_order.hpp"
 
 namespace dynmesh {
@@ -372,10 +373,7 @@ double corner_angle_deg(const Point<2>& at, const Point<2>& p, const Point<2>& q
   double ux = p[0] - at[0], uy = p[1] - at[1], vx = q[0] - at[0], vy = q[1] - at[1];
   // Scaled by a power of two (exact, and the angle does not change) so that the products
   // neither overflow in a box of side near 1e308 nor underflow to 0 in one near 1e-300.
-  if (const double m = std::max({std::abs(ux), std::abs(uy), std::abs(vx), std::abs(vy)}); m > 0 && std::isfinite(m)) {
-    const int e = std::ilogb(m);
-    ux = std::ldexp(ux, -e), uy = std::ldexp(uy, -e), vx = std::ldexp(vx, -e), vy = std::ldexp(vy, -e);
-  }
+  detail::to_unit_frame(ux, uy, vx, vy);
   const double cross = ux * vy - uy * vx, dot = ux * vx + uy * vy;
   return std::atan2(std::abs(cross), dot) * (180.0 / std::numbers::pi);
 }

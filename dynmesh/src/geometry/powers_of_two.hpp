@@ -7,11 +7,13 @@
 // for an exponent for every edge they classify; these are a few bit operations, inline.
 // Invariants: exponent_of(x) == std::ilogb(x) for every double; pow2(e) == std::ldexp(1.0, e)
 // for every int; scale_down_by(x, exponent_of(m)) == std::ldexp(x, -exponent_of(m)) for
-// |x| <= m, m finite and non-zero (tests/dynmesh/powers_of_two_test.cpp).
+// |x| <= m, m finite and non-zero; to_unit_frame scales as std::ldexp does
+// (tests/dynmesh/powers_of_two_test.cpp).
 // Complexity: O(1).
 // Paper: IEEE 754 binary64's layout.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -45,6 +47,18 @@ inline double pow2(int e) noexcept {
 inline double scale_down_by(double x, int e) noexcept {
   if (e >= -1023) return x * pow2(-e);
   return (x * pow2(1023)) * pow2(-e - 1023);
+}
+
+/// A vector pair (ux, uy), (vx, vy) in the frame where its largest coordinate lies in [1, 2):
+/// scaled by 2^-e in place, e returned (0, and nothing scaled, when all are zero or one is
+/// not finite). A corner's angle is the same in that frame, and its products neither
+/// overflow nor underflow (the quality report's and the mesh checker's frame).
+inline int to_unit_frame(double& ux, double& uy, double& vx, double& vy) noexcept {
+  const double m = std::max({std::abs(ux), std::abs(uy), std::abs(vx), std::abs(vy)});
+  if (!(m > 0) || !std::isfinite(m)) return 0;
+  const int e = exponent_of(m);
+  ux = scale_down_by(ux, e), uy = scale_down_by(uy, e), vx = scale_down_by(vx, e), vy = scale_down_by(vy, e);
+  return e;
 }
 
 }  // namespace dynmesh::detail

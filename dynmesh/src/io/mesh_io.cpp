@@ -12,6 +12,7 @@
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh_check.hpp"
+#include "geometry/powers_of_two.hpp"
 
 namespace dynmesh {
 namespace {
@@ -421,11 +422,7 @@ MeshStats mesh_stats(const Mesh& mesh) {
     // a box near 1e300 nor underflow in one near 1e-300: the area is infinite or 0 only when
     // it is beyond the doubles' range itself.
     double ux = b[0] - a[0], uy = b[1] - a[1], vx = c[0] - a[0], vy = c[1] - a[1];
-    int e = 0;
-    if (const double m = std::max({std::abs(ux), std::abs(uy), std::abs(vx), std::abs(vy)}); m > 0 && std::isfinite(m)) {
-      e = std::ilogb(m);
-      ux = std::ldexp(ux, -e), uy = std::ldexp(uy, -e), vx = std::ldexp(vx, -e), vy = std::ldexp(vy, -e);
-    }
+    const int e = detail::to_unit_frame(ux, uy, vx, vy);
     const double area = std::ldexp((ux * vy - uy * vx) / 2, 2 * e);
     stats.smallest_area = std::min(stats.smallest_area, area);
     stats.largest_area = std::max(stats.largest_area, area);
