@@ -79,7 +79,8 @@ TEST(PowersOfTwo, ToUnitFrameIsLdexpByTheLargestExponent) {
     const double big = std::max({std::abs(w[0]), std::abs(w[1]), std::abs(w[2]), std::abs(w[3])});
     ASSERT_TRUE(big >= 1.0 && big < 2.0) << big;
   }
-  // All zero, or one not finite: nothing is scaled.
+  // All zero, or the largest magnitude infinite (or a NaN where std::max keeps it): nothing
+  // is scaled.
   for (const double bad : {0.0, std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
     double a = bad, b = 3.0e300, c = -2.0e-300, d = 0.0;
     if (bad == 0.0) b = c = 0.0;

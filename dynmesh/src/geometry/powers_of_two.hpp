@@ -50,8 +50,9 @@ inline double scale_down_by(double x, int e) noexcept {
 }
 
 /// A vector pair (ux, uy), (vx, vy) in the frame where its largest coordinate lies in [1, 2):
-/// scaled by 2^-e in place, e returned (0, and nothing scaled, when all are zero or one is
-/// not finite). A corner's angle is the same in that frame, and its products neither
+/// scaled by 2^-e in place, e returned; 0, and nothing scaled, when the largest magnitude
+/// (by std::max, as the callers had it) is not a positive finite number (all zero, an
+/// infinity). A corner's angle is the same in that frame, and its products neither
 /// overflow nor underflow (the quality report's and the mesh checker's frame).
 inline int to_unit_frame(double& ux, double& uy, double& vx, double& vy) noexcept {
   const double m = std::max({std::abs(ux), std::abs(uy), std::abs(vx), std::abs(vy)});
