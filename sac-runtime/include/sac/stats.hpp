@@ -17,6 +17,8 @@ struct Stats {
   std::uint64_t events_created = 0;
   std::uint64_t events_undone = 0;
   std::uint64_t reads_reexecuted = 0;
+  /// Lookups of memo(), memo_near() and memo_read() calls during change propagation (none
+  /// from scratch) that reused an old call or read, and those that ran anew.
   std::uint64_t memo_hits = 0;
   std::uint64_t memo_misses = 0;
   /// memo_near calls whose equal old call lay too far ahead (counted in memo_misses too).
