@@ -207,8 +207,8 @@ int main(int argc, char** argv) {
         const double pn = static_cast<double>(n);
         std::printf("  searches, per point from scratch: left searches %.1f, leaves read %.1f\n",
                     static_cast<double>(asks0) / pn, static_cast<double>(leaves0) / pn);
-        std::printf("  searches, per update: left searches %.0f (recalled %.0f), leaves read %.0f\n", asks1 / m,
-                    static_cast<double>(run.program.view.left_recalls()) / m, static_cast<double>(leaves1) / m);
+        std::printf("  searches, per update: left searches %.0f, leaves read %.0f\n", asks1 / m,
+                    static_cast<double>(leaves1) / m);
         std::fflush(stdout);
       }
       if (verify) {

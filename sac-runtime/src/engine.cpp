@@ -690,7 +690,6 @@ void Engine::rerun(ReadNode* r, const ModBase* mp) {
 void Engine::propagate() {
   require_mutator("propagate");
   in_computation_ = true;
-  ++computations_;
   window_end_ = nullptr;
   const std::uint64_t created0 = stats_.events_created;
   const std::uint64_t undone0 = stats_.events_undone;

@@ -7,8 +7,7 @@
 // vertices, and the Steiner pool holds exactly the mesh's Steiner vertices; the per-update
 // trace distance is printed against the from-scratch trace, and stays within budgets on
 // curves and spirals; the collects and tries an update re-runs stay
-// within budgets on uniform points; left searches recalled within a propagation keep every
-// update exact.
+// within budgets on uniform points.
 #include "hpu/hpu_cells_program.hpp"
 
 #include <gtest/gtest.h>
@@ -99,7 +98,6 @@ class HpuHarness {
   std::size_t record_bytes() const { return engine_.record_bytes(); }
   const detail::CellQuestionStats& questions() const { return program_.stats; }
   const detail::HcStepCounts& steps() const { return program_.steps; }
-  std::uint64_t left_recalls() const { return program_.view.left_recalls(); }
   /// For the checker's negative test.
   detail::HpuMeshFeed& feed() { return state_.feed; }
 
@@ -327,45 +325,6 @@ TEST(HpuCellsProgram, AnUpdateOnCurvesStaysWithinAFixedBudget) {
       EXPECT_LT(most, kMost);
       EXPECT_TRUE(same_triangles(h.triangles(), HpuMesh(box, pts, kHpuDefaultMinAngle).triangles()));
     }
-  }
-}
-
-/// Within a propagation the view recalls left searches asked before on the same cells
-/// (CellView::left_recall): on a spiral, where a vertex stays in the queue through many
-/// classes, a large share of an update's searches is recalled (415 of 1,115 at n = 4,000:
-/// bench/RESULTS.md), and the meshes stay the twin's after every update, at 20.7° and 30°.
-/// SAC_DEBUG_CHECKS builds (the sanitizer job) search again at every recall and compare.
-TEST(HpuCellsProgram, RecalledLeftSearchesKeepEveryUpdateExact) {
-  const std::uint64_t seed = 20261206;
-  SCOPED_TRACE(seed_note(seed));
-  const std::size_t n = kSanitized ? 300 : 1500;
-  const int pairs = kSanitized ? 3 : 8;
-  for (const double angle : {kHpuDefaultMinAngle, 30.0}) {
-    SCOPED_TRACE("angle " + std::to_string(angle));
-    std::vector<Point<2>> pts = generate<2>(Distribution::Spiral, n, seed);
-    const Box<2> box = derive_box<2>(pts);
-    HpuHarness h(box, pts, angle);
-    EXPECT_EQ(h.left_recalls(), 0u) << "the initial run recalls nothing";
-    std::mt19937_64 rng(seed);
-    std::uint64_t asks = 0;
-    for (int k = 0; k < pairs; ++k) {
-      const std::size_t i = rng() % pts.size();
-      const Point<2> x = pts[i];
-      for (int op = 0; op < 2; ++op) {
-        if (op == 0) pts.erase(pts.begin() + static_cast<std::ptrdiff_t>(i));
-        else pts.push_back(x);
-        const std::size_t asks0 = h.questions().neighbour_asks;
-        h.set_points(pts);
-        asks += h.questions().neighbour_asks - asks0;
-        h.check();
-        ASSERT_TRUE(same_triangles(h.triangles(), HpuMesh(box, pts, angle).triangles())) << "update " << k << "." << op;
-      }
-    }
-    std::printf("[ HpuCells ] spiral n = %zu, angle %.1f: %llu left searches in %d propagations, %llu recalled\n", n,
-                angle, static_cast<unsigned long long>(asks), 2 * pairs,
-                static_cast<unsigned long long>(h.left_recalls()));
-    // Measured: about a third (the figure above); a recall that never fires would fail here.
-    EXPECT_GT(h.left_recalls(), asks / 10);
   }
 }
 

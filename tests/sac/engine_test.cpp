@@ -358,30 +358,6 @@ std::vector<long> random_values(std::mt19937_64& rng, int n) {
 
 // ================================================================ versioned reads
 
-// computation_serial() tells a program's caches which computation they were filled in: it
-// counts run() and every propagate() as they begin, and the body sees the new value.
-TEST(EngineComputations, SerialCountsRunAndPropagationsAsTheyBegin) {
-  Engine e;
-  Mod<int> in, out;
-  std::vector<std::uint64_t> seen;
-  e.set(in, 1);
-  EXPECT_EQ(e.computation_serial(), 0u);
-  e.run([&](Engine& en) {
-    en.read(in, body([&seen, po = &out](Engine& x, int v) {
-      seen.push_back(x.computation_serial());
-      x.write(*po, v);
-    }));
-  });
-  EXPECT_EQ(e.computation_serial(), 1u);
-  e.propagate();  // nothing changed: still a computation
-  EXPECT_EQ(e.computation_serial(), 2u);
-  e.set(in, 2);
-  e.propagate();
-  EXPECT_EQ(e.computation_serial(), 3u);
-  EXPECT_EQ(seen, (std::vector<std::uint64_t>{1, 3}));
-  EXPECT_EQ(out.get(), 2);
-}
-
 TEST(EngineVersions, EachReadSeesTheLatestVersionBeforeIt) {
   Engine e;
   Mod<int> in, m, o1, o2, o3;

@@ -31,10 +31,7 @@
 // cell beyond radius(), which only shrinks: it may start at focus's leaf),
 // margin_for(c, r) and leaves_read(). After every search() the question says what its answer
 // used of the leaves it read: used_within(c, r) (the vertices within r of c), used_box(x0, y0,
-// x1, y1) (those inside that closed box) or used_all(). A store may also remember left
-// searches: left_recall(p, q, h_max, t) gives an answer it kept, else left_begin() precedes
-// the search and left_keep(p, q, h_found, t, c, r) or left_drop() ends it (CellView's, within
-// one propagation).
+// x1, y1) (those inside that closed box) or used_all().
 // A search_within's answer uses only the vertices within its radius (plus the margins): f
 // rejects every other one without an effect. A step's reads re-run only when what it used
 // changes (cell_view.hpp). Every store answers exactly: a step's view
@@ -292,30 +289,10 @@ class CellQuestions {
   /// whose circle through p and q lies lowest in the pencil of circles through p and q,
   /// searched among the circles centred at most h_max·|pq| along J(q − p) from pq's
   /// midpoint, smallest first. none() when none lies that low (or the left is outside the
-  /// box). A store that remembers answers (CellView::left_recall) may give one it found
-  /// before on the same cells; SAC_DEBUG_CHECKS builds search again and compare.
+  /// box).
   V left_search(V p, V q, double h_max) const {
     ++stats_.neighbour_asks;
     if (outside_left(p, q)) return none_;  // a box edge seen from outside: no triangle there
-    if constexpr (kRecalls) {
-      V t = none_;
-      if (store_->left_recall(p, q, h_max, t)) {
-#ifdef SAC_DEBUG_CHECKS
-        if (search_left(p, q, h_max) != t)
-          throw InvariantError("dynmesh: a recalled left search and the search disagree");
-#endif
-        return t;
-      }
-      store_->left_begin();
-    }
-    return search_left(p, q, h_max);
-  }
-
- private:
-  static constexpr bool kRecalls = requires(const Store* s, V v, double h) { s->left_recall(v, v, h, v); };
-
-  /// left_search() by the probes.
-  V search_left(V p, V q, double h_max) const {
     const Point<2>&a = P_(p), &b = P_(q);
     const double dx = b[0] - a[0], dy = b[1] - a[1];
     const double len = cellq::length(dx, dy);
@@ -331,7 +308,7 @@ class CellQuestions {
     };
     V best = none_;
     Point<2> pc, bc{};
-    double pr, br = 0, h_found = 0;
+    double pr, br = 0;
     for (double h = std::min(kFirstHeight, h_max);; h = std::min(2 * h, h_max)) {
       disc(h, pc, pr);
       // Within the probe, a cell is read only while it can hold a vertex below the best
@@ -367,26 +344,17 @@ class CellQuestions {
             }
             return false;
           });
-      if (best != none_ || h >= h_max) {
-        h_found = h;
-        break;
-      }
+      if (best != none_ || h >= h_max) break;
     }
     // On the left of pq the discs grow with the height, so the answer used the vertices in
     // the best circle's disc (the last probe's when it found none): a vertex beyond it is
     // higher in the pencil, or on the right. So a first probe wider than the answer needs
     // costs no dependency.
-    if constexpr (kRecalls) {
-      if (best != none_) store_->left_keep(p, q, h_found, best, bc, br);
-      else store_->left_drop();
-    }
     if (best != none_) store_->used_within(bc, br);
     else store_->used_within(pc, pr);
     stats_.leaves_read += store_->leaves_read() - before;
     return best;
   }
-
- public:
 
   /// v's star, counter-clockwise (a cycle for an interior vertex, from one box side to the
   /// other for a vertex on the boundary), walked from a sure neighbour by left searches, into

@@ -280,103 +280,6 @@ class CellView {
   std::span<CellNode* const> pending() const noexcept { return pending_; }
   std::size_t leaves_read() const noexcept { return leaves_read_; }
 
-  // ---------------------------------------------------------------- left searches recalled
-
-  /// A left search's answer (cell_questions.hpp) recalled within one computation of the
-  /// engine: the steps an update re-runs ask again what the steps before them in the same
-  /// propagation asked (a vertex's collects in successive classes and its final step walk
-  /// the same star), mostly of cells no write changed in between. An answer is remembered
-  /// with the cells its search touched, a copy of their values, the probe height that found
-  /// it and the disc its answer used. It is recalled only if every one of those cells holds
-  /// the same value now (kind and vertices), and only for a cap at least that height: the
-  /// search would then probe the same circles up to that one, and its answer, the lowest
-  /// circle on the left, lies within them (a lower vertex would lie inside that disc, in a
-  /// cell compared). The recall touches those cells and widens the leaves by the disc, as
-  /// the search would have (its dependencies are those of the answer: a superset of the
-  /// leaves that meet the disc). Vertices are compared by identity, which is safe while
-  /// nothing is freed: within one computation (Engine::computation_serial; the hpu Steiner
-  /// vertices are collected between propagations). The initial run does not recall: its
-  /// repeats come a round later, far beyond a table of this size.
-  /// Returns whether it recalled, and the answer in t.
-  bool left_recall(V p, V q, double h_max, V& t) const {
-    return e_->computation_serial() > 1 && const_cast<CellView*>(this)->recall_left(p, q, h_max, t);
-  }
-  [[gnu::noinline]] bool recall_left(V p, V q, double h_max, V& t) {
-    if (left_memo_.empty()) return false;
-    LeftMemo& m = left_memo_[left_slot(p, q)];
-    if (m.serial != e_->computation_serial() || m.p != p || m.q != q || !(h_max >= m.h_found)) return false;
-    for (std::uint8_t i = 0; i < m.n; ++i) {
-      const CellMark& x = resolve(m.cells[i].node);
-      const CellState& was = m.cells[i].state;
-      // A split cell that a read below it made known has no value in its mark (settle()).
-      if (was.kind == CellState::Split ? x.tag != Tag::Split : !x.state || !same_inside(*x.state, was, m.c, m.R)) return false;
-    }
-    for (std::uint8_t i = 0; i < m.n; ++i) {
-      CellNode* n = m.cells[i].node;
-      CellMark& x = mark(n);
-      touch(n, x);
-      if (x.tag == Tag::Leaf) widen(x, m.c, m.R);
-    }
-    ++left_recalls_;
-    t = m.t;
-    return true;
-  }
-  /// Do leaves a and b (a leaf's vertices are sorted) hold the same vertices inside the box
-  /// of the disc (c, R)? The answer used no other (the reads' projections rest on the same).
-  static bool same_inside(const CellState& a, const CellState& b, const Point<2>& c, double R) noexcept {
-    if (a.kind != CellState::Leaf) return false;
-    const double x0 = c[0] - R, x1 = c[0] + R, y0 = c[1] - R, y1 = c[1] + R;
-    const auto in = [&](const CellVertex* w) {
-      return w->p[0] >= x0 && w->p[0] <= x1 && w->p[1] >= y0 && w->p[1] <= y1;
-    };
-    std::size_t i = 0, j = 0;
-    for (;;) {
-      while (i < a.count && !in(a.items[i])) ++i;
-      while (j < b.count && !in(b.items[j])) ++j;
-      if (i == a.count || j == b.count) return i == a.count && j == b.count;
-      if (a.items[i++] != b.items[j++]) return false;
-    }
-  }
-  /// A left search begins: the split cells it prunes whole are recorded for left_keep().
-  void left_begin() const { const_cast<CellView*>(this)->begin_left(); }
-  void begin_left() {
-    left_splits_.clear();
-    left_recording_ = e_->computation_serial() > 1;
-  }
-  /// Its answer t (not none), found by the probe at height h_found, used the vertices within
-  /// r of c: remembered with the cells the search touched (the leaves it met, not yet given
-  /// their use, and the split cells it pruned), unless there are more than kLeftCells. Call
-  /// it before used_within(c, r).
-  void left_keep(V p, V q, double h_found, V t, const Point<2>& c, double r) const {
-    if (left_recording_) const_cast<CellView*>(this)->keep_left(p, q, h_found, t, c, r);
-  }
-  [[gnu::noinline]] void keep_left(V p, V q, double h_found, V t, const Point<2>& c, double r) {
-    left_recording_ = false;
-    if (left_memo_.empty()) left_memo_.resize(kLeftSlots);  // views that only run from scratch need none
-    LeftMemo& m = left_memo_[left_slot(p, q)];
-    m.serial = 0;
-    m.n = 0;
-    for (const auto* list : {&visited_, &left_splits_})
-      for (CellNode* n : *list) {  // a leaf two probes met is in visited_ twice
-        bool seen = false;
-        for (std::uint8_t i = 0; i < m.n && !seen; ++i) seen = m.cells[i].node == n;
-        if (seen) continue;
-        if (m.n == kLeftCells) return;  // left invalid
-        const CellMark& x = mark(n);
-        if (x.tag == Tag::Split) m.cells[m.n++] = {n, CellState::split()};
-        else if (x.tag == Tag::Leaf && x.state) m.cells[m.n++] = {n, *x.state};
-        else return;
-      }
-    m.serial = e_->computation_serial();
-    m.p = p, m.q = q, m.t = t;
-    m.h_found = h_found;
-    m.c = c;
-    m.R = r * (1 + 0x1p-20) + cellq::ulp_room(c);  // as used_within()
-  }
-  /// A left search that found nothing: nothing to remember.
-  void left_drop() const noexcept { const_cast<CellView*>(this)->left_recording_ = false; }
-  std::uint64_t left_recalls() const noexcept { return left_recalls_; }
-
   /// What the steps' reads cost so far: rounds issued (read_many events) and cells in them.
   struct Counts {
     std::uint64_t rounds = 0, cells = 0;
@@ -497,7 +400,7 @@ class CellView {
   /// n's mark, its state looked up now if the view does not know it: a peek, which records
   /// nothing (the runtime's guess for a prefetch); a search that uses the cell makes it
   /// pending, and the step reads it before it acts.
-  [[gnu::always_inline]] CellMark& resolve(CellNode* n) {
+  CellMark& resolve(CellNode* n) {
     CellMark& x = mark(n);
     if (x.tag == Tag::Unknown) {
       x.state = e_->peek(n->state);
@@ -754,10 +657,7 @@ class CellView {
           if (!ch) throw InvariantError("dynmesh: CellView: a split cell without its children's nodes");
           search_node(ch, focus, margin, keep, f, stop);
         }
-        if (leaves_read_ == before) {
-          touch(n, x);
-          if (left_recording_) left_splits_.push_back(n);
-        }
+        if (leaves_read_ == before) touch(n, x);
         return;
       }
       case Tag::Absent:
@@ -802,34 +702,6 @@ class CellView {
   std::array<StartMemo, kStartMemo> start_memo_{};
   std::size_t leaves_read_ = 0;
   Counts counts_;
-  // left_recall()'s table, direct-mapped by (p, q); an entry is valid in its computation.
-  static constexpr std::size_t kLeftCells = 12;
-  static constexpr std::size_t kLeftSlots = 4096;
-  struct LeftCell {
-    CellNode* node;
-    CellState state;
-  };
-  struct LeftMemo {
-    std::uint64_t serial = 0;
-    V p = nullptr, q = nullptr, t = nullptr;
-    double h_found = 0;
-    Point<2> c{};
-    double R = 0;
-    std::uint8_t n = 0;
-    std::array<LeftCell, kLeftCells> cells;
-  };
-  // By the points, not the addresses: which searches share a slot, hence which recall, and
-  // so the trace, must not depend on where the vertices were allocated.
-  static std::size_t left_slot(V p, V q) noexcept {
-    std::uint64_t h = 0;
-    for (const double x : {p->p[0], p->p[1], q->p[0], q->p[1]})
-      h = (h ^ std::bit_cast<std::uint64_t>(x)) * 0x9E3779B97F4A7C15ull;
-    return static_cast<std::size_t>(h >> 52) & (kLeftSlots - 1);
-  }
-  std::vector<LeftMemo> left_memo_;
-  std::vector<CellNode*> left_splits_;
-  bool left_recording_ = false;
-  std::uint64_t left_recalls_ = 0;
   // The run the view was last filled for, when it failed (see reset()).
   const void* owner_ = nullptr;     // a round, by its closure
   std::uint32_t owner_serial_ = 0;  // or the step's first run, by its serial

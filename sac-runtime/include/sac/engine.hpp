@@ -283,11 +283,6 @@ class Engine {
   /// O(live events + base versions).
   MemoryBreakdown memory_breakdown() const;
   bool in_computation() const { return in_computation_; }
-  /// How many run() and propagate() calls have begun. Within one computation no mutator
-  /// change happens and nothing the program allocated is freed (undone allocations wait for
-  /// the end of propagate()), so a program may cache what it derived from the values it saw,
-  /// and drop the cache when this changes. O(1).
-  std::uint64_t computation_serial() const noexcept { return computations_; }
   bool poisoned() const { return poisoned_; }
   const OrderList& order() const { return order_; }
 
@@ -585,7 +580,6 @@ class Engine {
   Stamp* window_end_ = nullptr;   // end of the re-execution window; null when running fresh
   Stamp* tail_ = nullptr;         // last stamp of the last run()
   bool in_computation_ = false;
-  std::uint64_t computations_ = 0;  // computation_serial()
   bool poisoned_ = false;
   Stats stats_;
   std::size_t input_bytes_ = 0;
@@ -635,7 +629,6 @@ template <class F>
 void Engine::run(F&& f) {
   require_mutator("run");
   in_computation_ = true;
-  ++computations_;
   now_ = tail_;
   window_end_ = nullptr;
   try {
