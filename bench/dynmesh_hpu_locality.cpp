@@ -13,6 +13,12 @@
 // --reach says where the changed collects and processings lie: their distance from the
 // updated point in units of 2^j, j their size class. The O(lg L/s) bound holds if that
 // distance is bounded, whatever n, so that each class changes O(1) steps of its own size.
+// --time also times the twin and the cell refiner on P and prints what the changed steps'
+// geometry costs: the new steps (half the changed, over deletions and insertions) at each
+// one's mean cost per step of a from-scratch run. Changed steps count from above (a step
+// whose cells handed it another vertex re-runs in the program only if it used that
+// vertex), so beside the program's measured update it says how much of that update the
+// rules' own change could explain (bench/RESULTS.md).
 //
 //   dynmesh_hpu_locality [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
 //                        [--seed 1] [--angle 20.7] [--csv] [--by-class] [--reach] [--time] [--profile]
@@ -122,10 +128,11 @@ int main(int argc, char** argv) {
       const auto pts = generate<2>(*dist, n, seed);
       const Box<2> box = derive_box<2>(pts);
       const auto base = run(box, pts, angle);
+      double twin_s = 0, cell_s = 0;
       if (time) {
         std::vector<Triangle> twin_mesh, cell_mesh;
-        const double twin_s = bench::seconds([&] { twin_mesh = HpuMesh(box, pts, angle).triangles(); });
-        const double cell_s = bench::seconds([&] { cell_mesh = detail::cell_refine(box, pts, angle).triangles; });
+        twin_s = bench::seconds([&] { twin_mesh = HpuMesh(box, pts, angle).triangles(); });
+        cell_s = bench::seconds([&] { cell_mesh = detail::cell_refine(box, pts, angle).triangles; });
         std::printf("# %s n=%zu time: twin %.3f s, cell refiner %.3f s (%.1fx), same mesh %d\n", name.c_str(), n, twin_s,
                     cell_s, cell_s / twin_s, static_cast<int>(twin_mesh == cell_mesh));
       }
@@ -184,6 +191,19 @@ int main(int argc, char** argv) {
         std::printf("# %s n=%zu changed collects+processings by class:", name.c_str(), n);
         for (const auto& [c, x] : classes) std::printf(" %d:%.0f", c, x);
         std::printf("\n");
+      }
+      if (time && !base.empty()) {
+        // The new run's steps that the old one lacks (half the changed steps, over deletions
+        // and insertions) at a from-scratch run's cost per step (by steps for the twin; by
+        // leaves read too for the refiner).
+        double base_leaves = 0;
+        for (const auto& st : base) base_leaves += st.leaves;
+        const double steps = static_cast<double>(base.size());
+        std::printf("# %s n=%zu new steps per update: %.1f; at the twin's %.3f us a step %.0f us; at the cell "
+                    "refiner's %.3f us a step %.0f us, by leaves read %.0f us\n",
+                    name.c_str(), n, mean(changed) / 2, 1e6 * twin_s / steps, 1e6 * twin_s / steps * mean(changed) / 2,
+                    1e6 * cell_s / steps, 1e6 * cell_s / steps * mean(changed) / 2,
+                    1e6 * cell_s / base_leaves * mean(reads) / 2);
       }
       if (reach) {
         std::printf("# %s n=%zu changed collects+processings by distance / 2^class:", name.c_str(), n);
