@@ -199,10 +199,10 @@ int main(int argc, char** argv) {
         double base_leaves = 0;
         for (const auto& st : base) base_leaves += st.leaves;
         const double steps = static_cast<double>(base.size());
+        const double new_steps = mean(changed) / 2, twin_us = 1e6 * twin_s / steps, cell_us = 1e6 * cell_s / steps;
         std::printf("# %s n=%zu new steps per update: %.1f; at the twin's %.3f us a step %.0f us; at the cell "
                     "refiner's %.3f us a step %.0f us, by leaves read %.0f us\n",
-                    name.c_str(), n, mean(changed) / 2, 1e6 * twin_s / steps, 1e6 * twin_s / steps * mean(changed) / 2,
-                    1e6 * cell_s / steps, 1e6 * cell_s / steps * mean(changed) / 2,
+                    name.c_str(), n, new_steps, twin_us, twin_us * new_steps, cell_us, cell_us * new_steps,
                     1e6 * cell_s / base_leaves * mean(reads) / 2);
       }
       if (reach) {
