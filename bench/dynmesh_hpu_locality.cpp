@@ -127,14 +127,7 @@ int main(int argc, char** argv) {
     for (const std::size_t n : sizes) {
       const auto pts = generate<2>(*dist, n, seed);
       const Box<2> box = derive_box<2>(pts);
-      dynmesh::detail::skip_counts() = {};
       const auto base = run(box, pts, angle);
-      {
-        const auto& C = dynmesh::detail::skip_counts();
-        std::printf("# skip: collects %zu, no pairs %zu, go on %zu, go on with a whole star %zu: next loose class j+1 %zu, "
-                    "above %zu (classes skipped %zu), none %zu\n",
-                    C[0], C[1], C[2], C[3], C[4], C[5], C[6], C[7]);
-      }
       double twin_s = 0, cell_s = 0;
       if (time) {
         std::vector<Triangle> twin_mesh, cell_mesh;

@@ -78,7 +78,6 @@ struct CellQuestionStats {
   std::size_t leaves_collect = 0, leaves_process = 0, leaves_final = 0;
 };
 
-inline std::array<std::size_t, 8>& skip_counts() { static std::array<std::size_t, 8> c{}; return c; }
 namespace cellq {
 /// Relative slack of the "circumdisc inside the gathered disc" test: far above the rounding
 /// of the circumcentre (a few ulps), far below any gap the tests rely on.
@@ -524,29 +523,6 @@ class CellQuestions {
       if (P_(x[0]) != P_(y[0])) return xy_less(P_(x[0]), P_(y[0]));
       return xy_less(P_(x[1]), P_(y[1]));
     });
-    {
-      // Scratch count (bench/RESULTS.md, "A rule that skips classes, counted"): of the
-      // collects that go on with a whole star, the class of the shortest loose longer edge.
-      auto& C = skip_counts();
-      ++C[0];
-      if (pairs.empty()) ++C[1];
-      if (go_on) ++C[2];
-      if (go_on && whole) {
-        ++C[3];
-        int k = INT_MAX;
-        for (std::size_t i = 0; i < d; ++i) {
-          const V q = star_[i];
-          const int c = edge_class(P_(v), P_(q));
-          if (c <= j) continue;
-          const V* left = i + 1 < d ? &star_[i + 1] : cycle ? &star_[0] : &none_;
-          const V* right = i > 0 ? &star_[i - 1] : cycle ? &star_[d - 1] : &none_;
-          if (loose_pair(v, q, left, right) || loose_pair(q, v, right, left)) k = std::min(k, c);
-        }
-        if (k == j + 1) ++C[4];
-        else if (k != INT_MAX) { ++C[5]; C[6] += static_cast<std::size_t>(k - j - 1); }
-        else ++C[7];
-      }
-    }
     return go_on;
   }
 
