@@ -16,7 +16,7 @@ DEPS=(cmake g++ ninja-build libgtest-dev libgmock-dev libbenchmark-dev libcli11-
       libmpfr-dev libcgal-dev gnuplot gnuplot-nox clang libclang-rt-14-dev pkg-config
       python3 python3-dev python3-pybind11 pybind11-dev python3-numpy python3-pytest python3-meshio
       python3-matplotlib python3-venv python3-pip libopenmpi-dev openmpi-bin
-      gnuplot-doc)
+      gnuplot-doc tetgen)
 
 deps() {
   local missing=() p

@@ -20,6 +20,7 @@
 #include "geometry/delaunay.hpp"  // perturbed_incircle: the twin's tie rule
 #include "hpu/bucket_tree.hpp"
 #include "hpu/hpu_geometry.hpp"
+#include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "io/locate_points.hpp"
 
 namespace dynmesh::detail {

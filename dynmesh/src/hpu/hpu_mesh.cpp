@@ -19,6 +19,7 @@
 #include "dynmesh/mesh_check.hpp"
 #include "dynmesh/predicates.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
+#include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "io/locate_points.hpp"
 #include "geometry/z_order.hpp"
 

@@ -16,21 +16,23 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/detail/cell_table.hpp"
-#include "dynmesh/detail/quadtree_mesh_rules.hpp"
+#include "dynmesh/detail/mesh_grid.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
 
 namespace dynmesh::detail {
 
-inline std::vector<Position<2>> locate_all(const Box<2>& box, std::span<const Point<2>> points) {
+template <std::size_t d>
+std::vector<Position<d>> locate_all(const Box<d>& box, std::type_identity_t<std::span<const Point<d>>> points) {
   validate_box(box);
-  std::vector<Position<2>> qs(points.size());
+  std::vector<Position<d>> qs(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
-    for (unsigned a = 0; a < 2; ++a)
+    for (unsigned a = 0; a < d; ++a)
       if (!std::isfinite(points[i][a]))
         throw InputError(InputError::Kind::NotFinite, "point " + std::to_string(i) + " has a NaN or infinite coordinate")
             .with_points({i});
@@ -81,14 +83,16 @@ inline void check_separated(std::span<const Position<2>> qs) {
 }
 
 /// The mesh's resolution rules (detail/quadtree_mesh_rules.hpp) over a whole point set.
-inline void check_resolution(const MeshGrid& grid, std::span<const Point<2>> points, std::span<const Position<2>> qs) {
-  detail::CellTable<2, std::uint32_t> count;
+template <std::size_t d>
+void check_resolution(const BasicMeshGrid<d>& grid, std::type_identity_t<std::span<const Point<d>>> points,
+                      std::type_identity_t<std::span<const Position<d>>> qs) {
+  detail::CellTable<d, std::uint32_t> count;
   for (const auto& q : qs) ++*count.try_emplace(cell_of(q, std::max(grid.level_limit, 0)), 0u).first;
   for (std::size_t i = 0; i < qs.size(); ++i) {
-    const CellId<2> own = cell_of(qs[i], std::max(grid.level_limit, 0));
+    const CellId<d> own = cell_of(qs[i], std::max(grid.level_limit, 0));
     detail::check_mesh_resolution(
         grid, qs[i], points[i],
-        [&](const CellId<2>& c) {
+        [&](const CellId<d>& c) {
           const std::uint32_t* k = count.find(c);
           return k && *k > (c == own ? 1u : 0u);
         },

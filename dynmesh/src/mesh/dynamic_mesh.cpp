@@ -18,36 +18,13 @@
 #include "hpu/hpu_geometry.hpp"
 #include "hpu/hpu_inputs.hpp"
 #include "hpu/hpu_mesh_feed.hpp"
+#include "mesh/mesh_input_rules.hpp"
 #include "quadtree/quadtree_core.hpp"
 #include "quadtree_mesh/quadtree_mesh_program.hpp"
 
 namespace dynmesh {
 namespace detail {
 
-/// Points per cell of the mesh's resolution level, for its input rule.
-using CellCounts = std::unordered_map<CellId<2>, std::int64_t, CellHash>;
-
-/// The mesh's input rules over a batch: the quadtree's validate() calls insert/erase in
-/// batch order; `delta` holds the batch's changes to the counts.
-struct MeshChecks {
-  const MeshGrid& grid;
-  const CellCounts& counts;
-  CellCounts delta{};
-
-  int level() const { return std::max(grid.level_limit, 0); }
-  std::int64_t count(const CellId<2>& c) const {
-    std::int64_t k = 0;
-    if (auto it = counts.find(c); it != counts.end()) k += it->second;
-    if (auto it = delta.find(c); it != delta.end()) k += it->second;
-    return k;
-  }
-  template <class Fail>
-  void insert(const Position<2>& q, const Point<2>& p, Fail&& fail) {
-    check_mesh_resolution(grid, q, p, [&](const CellId<2>& c) { return count(c) > 0; }, fail);
-    ++delta[cell_of(q, level())];
-  }
-  void erase(const Position<2>& q) { --delta[cell_of(q, level())]; }
-};
 
 /// The box, validated before MeshGrid computes with it (its resolution level takes ilogb of
 /// the side, which overflows for 0 or NaN): `log` is built before `core` validates.
@@ -80,7 +57,7 @@ struct MeshState {
 
   MeshOptions options;
   FeedLog log;
-  CellCounts counts;
+  CellCounts<2> counts;
   MeshChange change;
   QuadtreeMeshProgram program{};
   HpuCellsState hpu_state;  // the hpu mesh's input list, cell store and feed outlive the engine
@@ -90,18 +67,10 @@ struct MeshState {
   /// The whole batch against the quadtree's and the mesh's input rules; with hpu, also its
   /// side midpoints (returned as the plan to commit). Changes nothing.
   HpuInputs::Plan validate(std::span<const Edit<2>> edits, const std::string& noun) const {
-    core.validate(edits, noun, MeshChecks{log.grid, counts});
+    core.validate(edits, noun, MeshChecks<2>{log.grid, counts});
     return is_hpu() ? hpu_state.plan(edits) : HpuInputs::Plan{};
   }
-  void count(std::span<const Edit<2>> edits) {
-    const int level = std::max(log.grid.level_limit, 0);
-    for (const Edit<2>& e : edits) {
-      const CellId<2> c = cell_of(*try_locate(core.box, e.point), level);
-      auto& k = counts[c];
-      k += e.op == EditOp::Insert ? 1 : -1;
-      if (k == 0) counts.erase(c);
-    }
-  }
+  void count(std::span<const Edit<2>> edits) { count_edits<2>(log.grid, core.box, edits, counts); }
   std::vector<PointId> update(std::span<const Edit<2>> edits, const HpuInputs::Plan& plan) {
     if (is_hpu()) {
       auto ids = core.update(edits, [&](sac::Engine& e) { hpu_state.commit(e, plan); });
@@ -110,8 +79,6 @@ struct MeshState {
       change = hpu_state.feed.take_change();
       return ids;
     }
-    log.created.clear();
-    log.removed.clear();
     auto ids = core.update(edits);
     count(edits);
     collect_change();
@@ -123,27 +90,7 @@ struct MeshState {
     for (const auto* n = core.first; n; n = n->succ) out.push_back(n->point);
     return out;
   }
-  /// The feed of the update just propagated: the triangles of the blocks it undid, less
-  /// those of the blocks it made (a leaf re-made unchanged is no change).
-  void collect_change() {
-    std::vector<Triangle> added;
-    for (LeafBlock* b : log.created) {
-      if (!b) continue;
-      triangulate_leaf(log.grid, b->shape, added);
-      b->slot = LeafBlock::kOld;
-    }
-    log.created.clear();
-    std::vector<Triangle> removed = std::move(log.removed);
-    log.removed.clear();
-    std::sort(added.begin(), added.end());
-    std::sort(removed.begin(), removed.end());
-    change.removed.clear();
-    change.added.clear();
-    std::set_difference(removed.begin(), removed.end(), added.begin(), added.end(),
-                        std::back_inserter(change.removed));
-    std::set_difference(added.begin(), added.end(), removed.begin(), removed.end(),
-                        std::back_inserter(change.added));
-  }
+  void collect_change() { log.take_change(change); }
 };
 
 /// T* as the quadtree's contract states it, and T''s closure rule (the quadtree mesh only:
@@ -211,8 +158,7 @@ DynamicMesh::DynamicMesh(const Box<2>& box, std::span<const Point<2>> points, Me
     s_->core.build(points, [program](sac::Engine& rt) { detail::QuadtreeMeshProgram::main(rt, program); });
   }
   s_->count(edits);
-  for (detail::LeafBlock* b : s_->log.created) b->slot = detail::LeafBlock::kOld;
-  s_->log.created.clear();
+  s_->log.settle();
 }
 
 DynamicMesh::~DynamicMesh() = default;
@@ -252,23 +198,12 @@ std::vector<std::pair<PointId, Point<2>>> DynamicMesh::points() const { return s
 
 std::vector<Triangle> DynamicMesh::triangles() const {
   if (s_->is_hpu()) return s_->hpu_state.feed.triangles();
-  std::vector<Triangle> out;
-  out.reserve(s_->log.live_count * 2);
-  for (const detail::LeafBlock* b = s_->log.live; b; b = b->next) detail::triangulate_leaf(s_->log.grid, b->shape, out);
-  std::sort(out.begin(), out.end());
-  return out;
+  return s_->log.simplices();
 }
 
 std::size_t DynamicMesh::num_triangles() const noexcept {
   if (s_->is_hpu()) return s_->hpu_state.feed.live_count();
-  std::size_t k = 0;
-  std::vector<Triangle> scratch;
-  for (const detail::LeafBlock* b = s_->log.live; b; b = b->next) {
-    scratch.clear();
-    detail::triangulate_leaf(s_->log.grid, b->shape, scratch);
-    k += scratch.size();
-  }
-  return k;
+  return s_->log.num_simplices();
 }
 
 Mesh DynamicMesh::mesh() const { return make_mesh(triangles()); }

@@ -99,6 +99,7 @@ class Directory {
     // (82% of the 2D defaults at n = 10^5 were never read).
     rt.init_default(s->split);
     rt.init_default(s->pts);
+    if constexpr (d == 3) rt.init_default(s->kids);
     return *s;
   }
   const Slot<d>* find(const CellId<d>& c) const { return table_.find(c); }
@@ -149,11 +150,13 @@ class Directory {
   void sweep(sac::Engine& rt) {
     std::vector<Slot<d>*> dead;
     table_.for_each([&](Slot<d>* s) {
-      if (rt.unused(s->split) && rt.unused(s->pts) && !parent_used(rt, s->id())) dead.push_back(s);
+      if (rt.unused(s->split) && rt.unused(s->pts) && kids_unused(rt, *s) && !parent_used(rt, s->id()))
+        dead.push_back(s);
     });
     for (Slot<d>* s : dead) {
       rt.retire(s->split);
       rt.retire(s->pts);
+      if constexpr (d == 3) rt.retire(s->kids);
       table_.erase(s->id());
       pool_.destroy(s);
     }
@@ -173,7 +176,7 @@ class Directory {
     }
     table_.for_each([&](const Slot<d>* s) {
       const CellId<d> c = s->id();
-      if (!s->split.written() || !s->pts.written())
+      if (!s->split.written() || !s->pts.written() || !kids_written(*s))
         throw InvariantError("dynmesh: directory slot " + to_string(c) + " without its default state");
       if (!tree_split(s->split.get())) return;
       if (c.level >= kMaxLevel) throw InvariantError("dynmesh: a level-52 cell is split");
@@ -187,6 +190,15 @@ class Directory {
   }
 
  private:
+  static bool kids_unused(const sac::Engine& rt, const Slot<d>& s) {
+    if constexpr (d == 3) return rt.unused(s.kids);
+    else return true;
+  }
+  static bool kids_written(const Slot<d>& s) {
+    if constexpr (d == 3) return s.kids.written();
+    else return true;
+  }
+
   /// Whether c's parent may have been split in the trace: then c's slot stays, even unused,
   /// because the parent's partition steps hold a pointer to its `pts` (an empty child's
   /// `pts` is never written, and may never be read).

@@ -65,6 +65,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <stdexcept>
 #include <tuple>
 #include <utility>
@@ -101,6 +102,9 @@ constexpr bool tree_split(std::uint8_t v) noexcept { return (v & 3u) == kTreeSpl
 /// Split in T* or in a postprocess's refinement of it.
 constexpr bool any_split(std::uint8_t v) noexcept { return (v & 3u) != 0; }
 
+/// The 2D slot's stand-in for `kids`.
+struct SlotNoKids {};
+
 /// The directory entry of a cell: its versioned state. Lives outside the trace; found by
 /// CellId, so identities never depend on when or where a run first named the cell.
 template <std::size_t d>
@@ -110,6 +114,10 @@ struct Slot {
   PackedCell<d> key;  // its cell, packed (the directory's index reads it)
   sac::Mod<std::uint8_t> split;  // kTreeSplit once SPLIT ran on the cell (see above)
   sac::Mod<PNode<d>*> pts;       // the cell's points (written by its parent's SPLIT)
+  /// 3D only: the `split` values of a split cell's eight children, a byte each (child w in
+  /// byte w), written by the octree mesh's first walk of T' and read by its second, so that a
+  /// leaf's neighbourhood is 27 reads of its parent's neighbours rather than one per cell.
+  [[no_unique_address]] std::conditional_t<d == 3, sac::Mod<std::uint64_t>, SlotNoKids> kids;
 };
 
 /// A crowded-queue entry's key: its cell, packed, and `two` in a bit the packing leaves free

@@ -43,51 +43,14 @@
 
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/mesh.hpp"
+#include "mesh/block_feed.hpp"
 #include "quadtree/quadtree_core.hpp"
 
 namespace dynmesh::detail {
 
-struct LeafBlock;
-
-/// Live leaf blocks and the change of the running update.
-struct FeedLog {
-  explicit FeedLog(const MeshGrid& g) : grid(g) {}
-  MeshGrid grid;
-  LeafBlock* live = nullptr;           // every live block, doubly linked
-  std::vector<LeafBlock*> created;     // blocks made in this update (null once undone)
-  std::vector<Triangle> removed;       // triangles of the blocks undone in this update
-  std::size_t live_count = 0;
-  bool closing = false;                // the engine is being destroyed: log nothing
-};
-
-struct LeafBlock {
-  LeafBlock(FeedLog* l, const LeafShape& s) : log(l), shape(s) {
-    next = log->live;
-    if (next) next->prev = this;
-    log->live = this;
-    ++log->live_count;
-    slot = log->created.size();
-    log->created.push_back(this);
-  }
-  ~LeafBlock() {
-    if (log->closing) return;
-    if (prev) prev->next = next;
-    else log->live = next;
-    if (next) next->prev = prev;
-    --log->live_count;
-    if (slot != kOld) log->created[slot] = nullptr;  // made and undone in one update
-    else triangulate_leaf(log->grid, shape, log->removed);
-  }
-  LeafBlock(const LeafBlock&) = delete;
-  LeafBlock& operator=(const LeafBlock&) = delete;
-
-  static constexpr std::size_t kOld = ~std::size_t{0};
-  FeedLog* log;
-  LeafShape shape;
-  LeafBlock* prev = nullptr;
-  LeafBlock* next = nullptr;
-  std::size_t slot;  // index in log->created, or kOld
-};
+/// A leaf's triangles, as one block of the feed (mesh/block_feed.hpp).
+using FeedLog = BlockFeed<LeafShape>;
+using LeafBlock = FeedBlock<LeafShape>;
 
 struct QuadtreeMeshProgram {
   using Node = PNode<2>;

@@ -26,15 +26,8 @@
 //     first. Valid means every triangle strictly counter-clockwise (exact orient2d).
 // Bound: no angle below arctan(1/3) = 18.43° (DESIGN.md's enumeration; the checker verifies
 // kQuadtreeMinAngle = 18.4° on every output).
-// Coordinates: the grid vertex g (0..2^52 per axis) is o + g·(L·2^−52) in IEEE double, one
-// multiplication and one addition, so the same vertex always gets the same bits, g = 0 gives
-// o and g = 2^52 gives fl(o + L). Only input points and grid vertices occur.
-// Resolution: grid vertices are exact when the box is dyadic (L a power of two, o a
-// multiple of L·2^−52 with |o| ≤ L). Otherwise they round, and the mesh needs its deepest
-// cells to span many ulps: mesh_resolution_level() is the deepest level R at which the
-// vertices two levels deeper are 2^12 ulps apart, and a point is rejected (Resolution) when
-// another point lies in its level-R neighbourhood or when it lies within one level-R cell
-// of a box side it is not on. Then every leaf of T' has level ≤ R + 1.
+// Coordinates and resolution: detail/mesh_grid.hpp (the grid vertices in double; points the
+// mesh cannot resolve are rejected, so every leaf of T' has level ≤ R + 1).
 // Complexity: every function is O(1).
 // Paper: Bern, Eppstein & Gilbert, "Provably good mesh generation" (1994), the warped
 // quadtree; Acar & Hudson, Section 5.
@@ -48,6 +41,7 @@
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/cell.hpp"
+#include "dynmesh/detail/mesh_grid.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
@@ -59,17 +53,12 @@ namespace dynmesh::detail {
 constexpr unsigned corner_dx(unsigned k) noexcept { return k == 1 || k == 2; }
 constexpr unsigned corner_dy(unsigned k) noexcept { return k >= 2; }
 
-struct MeshGrid {
-  Box<2> box;
-  double unit = 0;     // L·2^−52
-  int level_limit = 0;  // R (see the header comment)
+/// The 2D grid, with the corner names of a square cell.
+struct MeshGrid : BasicMeshGrid<2> {
+  using BasicMeshGrid<2>::BasicMeshGrid;
+  using BasicMeshGrid<2>::vertex;
 
-  explicit MeshGrid(const Box<2>& b) : box(b), unit(b.side * 0x1p-52), level_limit(resolution_level(b)) {}
-
-  double coord(unsigned axis, std::uint64_t g) const noexcept {
-    return box.origin[axis] + static_cast<double>(g) * unit;
-  }
-  Point<2> vertex(std::uint64_t gx, std::uint64_t gy) const noexcept { return {coord(0, gx), coord(1, gy)}; }
+  Point<2> vertex(std::uint64_t gx, std::uint64_t gy) const noexcept { return vertex({gx, gy}); }
   /// Grid coordinate of corner k of cell c on `axis`.
   static std::uint64_t corner_grid(const CellId<2>& c, unsigned k, unsigned axis) noexcept {
     const unsigned off = axis == 0 ? corner_dx(k) : corner_dy(k);
@@ -78,48 +67,7 @@ struct MeshGrid {
   Point<2> corner(const CellId<2>& c, unsigned k) const noexcept {
     return vertex(corner_grid(c, k, 0), corner_grid(c, k, 1));
   }
-  /// Does p lie on the box side where grid coordinate `g` of `axis` is 0 or 2^52?
-  bool on_line(const Point<2>& p, unsigned axis, std::uint64_t g) const noexcept {
-    return p[axis] == coord(axis, g);
-  }
-
-  static int resolution_level(const Box<2>& b) {
-    const double unit = b.side * 0x1p-52;
-    bool exact = std::exp2(std::ilogb(b.side)) == b.side;
-    for (unsigned a = 0; a < 2 && exact; ++a)
-      exact = std::fmod(b.origin[a], unit) == 0.0 && std::fabs(b.origin[a]) <= b.side;
-    if (exact) return kMaxLevel - 2;
-    double m = 0;
-    for (unsigned a = 0; a < 2; ++a)
-      m = std::fmax(m, std::fmax(std::fabs(b.origin[a]), std::fabs(b.origin[a] + b.side)));
-    // L·2^−(R+2) ≥ 2^12·ulp(m), ulp(m) = 2^(ilogb(m) − 52).
-    const int r = std::ilogb(b.side) - std::ilogb(m) + 52 - 12 - 2;
-    return r > kMaxLevel - 2 ? kMaxLevel - 2 : r;
-  }
 };
-
-/// The rejection rules of the header comment for inserting p (located at q). `present(c)`
-/// tells whether another point lies in the level-R cell c; `fail(text)` throws.
-template <class Present, class Fail>
-void check_mesh_resolution(const MeshGrid& grid, const Position<2>& q, const Point<2>& p, Present&& present,
-                           Fail&& fail) {
-  const int r = grid.level_limit;
-  if (r < 2) fail("the domain box is too small for its offset: double coordinates cannot resolve its cells");
-  const CellId<2> c = cell_of(q, r);
-  // `present(cell)`: some other point lies in that level-R cell.
-  bool near = present(c);
-  for_each_neighbour(c, [&](const CellId<2>& nb) { near = near || present(nb); });
-  if (near)
-    fail("another point lies in a neighbouring cell of level " + std::to_string(r) + " (L/2^" + std::to_string(r) +
-         "): spread beyond the resolution of the mesh's double coordinates");
-  const std::uint64_t n = cells_per_axis(r);
-  for (unsigned a = 0; a < 2; ++a) {
-    if (c.index[a] == 0 && !grid.on_line(p, a, 0))
-      fail("the point lies within L/2^" + std::to_string(r) + " of a box side: beyond the resolution of the mesh");
-    if (c.index[a] + 1 == n && !grid.on_line(p, a, kResolution))
-      fail("the point lies within L/2^" + std::to_string(r) + " of a box side: beyond the resolution of the mesh");
-  }
-}
 
 /// Where p goes in T': its leaf c_t and the corner of c_t that moves onto p.
 struct WarpTarget {
@@ -211,6 +159,9 @@ inline bool side_neighbour(const CellId<2>& c, unsigned s, CellId<2>& out) noexc
 
 /// What the triangulation of a leaf depends on.
 struct LeafShape {
+  using Grid = MeshGrid;
+  using Simplex = Triangle;
+
   CellId<2> cell;
   std::uint8_t midpoints = 0;  // bit s: side s has a midpoint (a smaller neighbour there)
   std::int8_t warped = -1;     // the warped corner, or −1
@@ -298,6 +249,11 @@ inline void triangulate_leaf(const MeshGrid& grid, const LeafShape& s, std::vect
   }
   if (best_q < 0) throw InvariantError("dynmesh: no valid triangulation of warped leaf " + to_string(c));
   evaluate(best, true);
+}
+
+/// The triangles of a leaf, for the feed's blocks (mesh/block_feed.hpp).
+inline void emit_simplices(const MeshGrid& grid, const LeafShape& s, std::vector<Triangle>& out) {
+  triangulate_leaf(grid, s, out);
 }
 
 }  // namespace dynmesh::detail

@@ -1,0 +1,266 @@
+// octree_mesh_program.hpp (private) — the octree mesh written as static code on sac-runtime,
+// run after QuadTreeRefine in the same run() (DynamicOctreeMesh).
+//
+// Purpose: the rules of detail/octree_mesh_rules.hpp as a program whose trace is local, so
+// that a point update changes O(lg L/s) of it:
+//
+//   main:        place(each input point); then gather(the root); then emit(the root)
+//   place(p):    descend to p's leaf in T*; p's block target; SPLIT' the parent of each
+//                block cell; mark the block's cells; owner.pts := p
+//   split'(c):   unless c is split: c.split := kRefineSplit; split' each coarser cell
+//                touching c (grading)
+//   gather(c):   c split: read its eight children's split values as one event, write them to
+//                c.kids; gather each split child
+//   emit(c):     read c.kids; emit each split child; if c has a leaf child, read the kids of
+//                c's neighbours (two events) and make the block of c's leaf children's
+//                tetrahedra (the owner's block cone included, with its point read from
+//                owner.pts)
+//
+// Why two walks: a leaf's tetrahedra depend on the split state of its 26 same-size
+// neighbours, all children of its parent's 3x3x3 neighbourhood. Reading those 27 cells' kids
+// (one 64-bit value each) once per split cell costs about a third of what reading each leaf's
+// neighbours would, and the unit of output, a split cell's leaf children, is coarse.
+// How it is made stable and order independent: as the quadtree mesh's program
+// (quadtree_mesh_program.hpp): T' and the marks are later versions of the same `split`
+// modifiables that QuadTreeRefine reads earlier in the trace; p's T* level is found from the
+// T* bit alone; T' is a least closure, a set; each point's work is memoized on its list node;
+// the walks are memoized per cell. The kids are written in the first walk, which precedes the
+// second in the trace, so every read of them sees the final T'. A cell no longer split has no
+// write of its kids left, so they read as zero: no child split.
+// Complexity: from scratch O(Σ_p depth(p) + |T'|) events; per update O(lg L/s) expected.
+// Paper: Acar & Hudson, Section 4 (dynamizing by change propagation) and Section 2.2.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <sac/engine.hpp>
+#include <sac/fn.hpp>
+
+#include "dynmesh/detail/octree_mesh_rules.hpp"
+#include "dynmesh/errors.hpp"
+#include "dynmesh/tet_mesh.hpp"
+#include "mesh/block_feed.hpp"
+#include "quadtree/quadtree_core.hpp"
+
+namespace dynmesh::detail {
+
+/// The tetrahedra of a split cell's leaf children (or of the root, when it is a leaf).
+struct OctreeGroupShape {
+  using Grid = OctreeGrid;
+  using Simplex = Tetrahedron;
+  static constexpr std::uint32_t kNone = ~std::uint32_t{0};  // a child that emits nothing here
+
+  CellId<3> cell;                  // the split cell, or the root leaf
+  std::array<std::uint32_t, 8> masks{kNone, kNone, kNone, kNone, kNone, kNone, kNone, kNone};
+  std::uint64_t block = 0;         // the owner's block mask
+  Point<3> point{};                // the owner's point
+  std::int8_t owner = -1;          // the child that owns a block, or −1
+  std::uint8_t corner = 0;         // the owner's block corner
+  bool root_leaf = false;
+};
+
+inline void emit_simplices(const OctreeGrid& grid, const OctreeGroupShape& s, std::vector<Tetrahedron>& out) {
+  if (s.root_leaf) return tetrahedralize_leaf(grid, s.cell, 0, out);
+  for (unsigned w = 0; w < 8; ++w) {
+    if (static_cast<int>(w) == s.owner)
+      tetrahedralize_block(grid, child(s.cell, w), s.corner, s.point, s.block, out);
+    else if (s.masks[w] != OctreeGroupShape::kNone)
+      tetrahedralize_leaf(grid, child(s.cell, w), s.masks[w], out);
+  }
+}
+
+/// The split value of child w in a kids word.
+constexpr std::uint8_t kid(std::uint64_t kids, unsigned w) noexcept {
+  return static_cast<std::uint8_t>(kids >> (8 * w));
+}
+
+/// The shape of c's leaf children from the kids of c's 3x3x3 neighbourhood (`near`, by
+/// leaf_bit offset; zero outside the box). `point` is the owner's point when there is one.
+inline OctreeGroupShape group_shape(const CellId<3>& c, const std::array<std::uint64_t, 27>& near,
+                                    const Point<3>& point) {
+  // Is the level-(c.level + 1) cell x split? Its parent is c or one of c's neighbours.
+  auto split = [&](const CellId<3>& x) {
+    const CellId<3> p = parent(x);
+    int off[3];
+    for (unsigned a = 0; a < 3; ++a) off[a] = static_cast<int>(p.index[a] - c.index[a]);
+    unsigned w = 0;
+    for (unsigned a = 0; a < 3; ++a) w |= static_cast<unsigned>(x.index[a] & 1u) << a;
+    return any_split(kid(near[leaf_bit(off[0], off[1], off[2])], w));
+  };
+  OctreeGroupShape s;
+  s.cell = c;
+  s.point = point;
+  const std::uint64_t own = near[leaf_bit(0, 0, 0)];
+  for (unsigned w = 0; w < 8; ++w) {
+    const std::uint8_t v = kid(own, w);
+    if (any_split(v)) continue;
+    const CellId<3> x = child(c, w);
+    if (is_block_owner(v)) {
+      s.owner = static_cast<std::int8_t>(w);
+      s.corner = static_cast<std::uint8_t>(block_corner(v));
+      s.block = block_mask(x, s.corner, split);
+    } else if (!is_block_cell(v)) {
+      s.masks[w] = leaf_mask(x, split);
+    }
+  }
+  return s;
+}
+
+using OctreeFeed = BlockFeed<OctreeGroupShape>;
+using OctreeBlock = FeedBlock<OctreeGroupShape>;
+
+struct OctreeMeshProgram {
+  using Node = PNode<3>;
+  using Kids = sac::Mod<std::uint64_t>;
+  Directory<3>* dir;
+  sac::Mod<Node*>* input;
+  OctreeFeed* log;
+
+  Slot<3>& slot(sac::Engine& r, const CellId<3>& c) { return dir->get(r, c); }
+  const OctreeGrid& grid() const { return log->grid; }
+
+  static void main(sac::Engine& r, OctreeMeshProgram* cx) {
+    r.memo_read(*cx->input, sac::fn<&place>(cx));
+    r.memo(sac::fn<&gather_root>(cx));
+    r.memo(sac::fn<&emit_root>(cx));
+  }
+
+  // ------------------------------------------------------------------ the points
+  static void place(sac::Engine& r, Node* n, OctreeMeshProgram* cx) {
+    if (!n) return;
+    r.memo(sac::fn<&descend>(cx, n, 0));
+    r.memo_read(n->next, sac::fn<&place>(cx));
+  }
+
+  /// Reads cell_of(q, l).split; only its T* bit steers (tree_split), which no postprocess
+  /// write changes.
+  static void descend(sac::Engine& r, OctreeMeshProgram* cx, Node* n, int l) {
+    if (l >= kMaxLevel) return settle(r, cx, n, kMaxLevel);
+    r.read(cx->slot(r, cell_of(n->q, l)).split, [cx, n, l](sac::Engine& e, std::uint8_t v) {
+      if (tree_split(v)) descend(e, cx, n, l + 1);
+      else settle(e, cx, n, l);
+    });
+  }
+
+  static void settle(sac::Engine& r, OctreeMeshProgram* cx, Node* n, int tree_level) {
+    const auto* in = static_cast<const InputNode<3>*>(n);
+    const BlockTarget t = block_target(cx->grid(), n->q, in->point, tree_level);
+    for_each_block_cell(t, [&](const CellId<3>& x, std::uint8_t) { split(r, cx, parent(x)); });
+    for_each_block_cell(t, [&](const CellId<3>& x, std::uint8_t mark) {
+      r.read(cx->slot(r, x).split, [cx, x, mark](sac::Engine& e, std::uint8_t v) {
+        // A split value here would break the closure's rule; the checkers report it.
+        if (!any_split(v)) e.write(cx->slot(e, x).split, mark);
+      });
+    });
+    r.write(cx->slot(r, t.owner).pts, n);
+  }
+
+  /// SPLIT' and grading: c and the coarser cells it forces become split.
+  static void split(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c) {
+    r.read(cx->slot(r, c).split, [cx, c](sac::Engine& e, std::uint8_t v) {
+      if (any_split(v)) return;
+      e.write(cx->slot(e, c).split, kRefineSplit);
+      if (c.level > 0) for_each_coarser_touching(c, [&](const CellId<3>& u) { split(e, cx, u); });
+    });
+  }
+
+  // ------------------------------------------------------------------ first walk: the kids
+  static void gather_root(sac::Engine& r, OctreeMeshProgram* cx) {
+    r.read(cx->slot(r, CellId<3>::root()).split, [cx](sac::Engine& e, std::uint8_t v) {
+      if (any_split(v)) e.memo(sac::fn<&gather>(cx, CellId<3>::root()));
+    });
+  }
+
+  static void gather(sac::Engine& r, OctreeMeshProgram* cx, CellId<3> c) {
+    std::array<const sac::Mod<std::uint8_t>*, 8> kids;
+    for (unsigned w = 0; w < 8; ++w) kids[w] = &cx->slot(r, child(c, w)).split;
+    r.read_many(std::span<const sac::Mod<std::uint8_t>* const>(kids), [cx, c](sac::Engine& e, std::span<const std::uint8_t* const> v) {
+      std::uint64_t word = 0;
+      for (unsigned w = 0; w < 8; ++w) word |= std::uint64_t{*v[w]} << (8 * w);
+      e.write(cx->slot(e, c).kids, word);
+      for (unsigned w = 0; w < 8; ++w)
+        if (any_split(*v[w])) e.memo(sac::fn<&gather>(cx, child(c, w)));
+    });
+  }
+
+  // ------------------------------------------------------------------ second walk: the blocks
+  static void emit_root(sac::Engine& r, OctreeMeshProgram* cx) {
+    r.read(cx->slot(r, CellId<3>::root()).split, [cx](sac::Engine& e, std::uint8_t v) {
+      if (any_split(v)) {
+        e.memo(sac::fn<&emit>(cx, CellId<3>::root()));
+      } else {
+        OctreeGroupShape s;
+        s.root_leaf = true;
+        e.make<OctreeBlock>(cx->log, s);
+      }
+    });
+  }
+
+  static void emit(sac::Engine& r, OctreeMeshProgram* cx, CellId<3> c) {
+    r.read(cx->slot(r, c).kids, [cx, c](sac::Engine& e, std::uint64_t own) {
+      bool leaves = false;
+      for (unsigned w = 0; w < 8; ++w) {
+        if (any_split(kid(own, w))) e.memo(sac::fn<&emit>(cx, child(c, w)));
+        else leaves = true;
+      }
+      if (leaves) group(e, cx, c, own);
+    });
+  }
+
+  /// The neighbours of c in the box, in for_each_neighbour's order, with their offsets.
+  struct Near {
+    std::array<const Kids*, 26> mods{};
+    std::array<std::uint8_t, 26> bit{};
+    unsigned n = 0;
+  };
+  static Near near_of(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c) {
+    Near out;
+    for_each_neighbour(c, [&](const CellId<3>& nb) {
+      int off[3];
+      for (unsigned a = 0; a < 3; ++a) off[a] = static_cast<int>(nb.index[a] - c.index[a]);
+      out.bit[out.n] = static_cast<std::uint8_t>(leaf_bit(off[0], off[1], off[2]));
+      out.mods[out.n++] = &cx->slot(r, nb).kids;
+    });
+    return out;
+  }
+  static constexpr unsigned kFirst = 13;  // of at most 26 neighbours: two events of ≤ 16
+
+  static void group(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c, std::uint64_t own) {
+    const Near nb = near_of(r, cx, c);
+    if (nb.n == 0) return finish(r, cx, c, own, nb);  // the root has no neighbours
+    const unsigned first = nb.n < kFirst ? nb.n : kFirst;
+    r.read_many(std::span<const Kids* const>(nb.mods.data(), first),
+                [cx, c, own](sac::Engine& e, std::span<const std::uint64_t* const>) {
+                  const Near nb2 = near_of(e, cx, c);
+                  if (nb2.n <= kFirst) return finish(e, cx, c, own, nb2);
+                  e.read_many(std::span<const Kids* const>(nb2.mods.data() + kFirst, nb2.n - kFirst),
+                              [cx, c, own](sac::Engine& e2, std::span<const std::uint64_t* const>) {
+                                finish(e2, cx, c, own, near_of(e2, cx, c));
+                              });
+                });
+  }
+
+  /// Every neighbour's kids has been read by an enclosing event of this body: current().
+  static void finish(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c, std::uint64_t own, const Near& nb) {
+    std::array<std::uint64_t, 27> near{};
+    near[leaf_bit(0, 0, 0)] = own;
+    for (unsigned i = 0; i < nb.n; ++i) near[nb.bit[i]] = r.current(*nb.mods[i]);
+    int owner = -1;
+    for (unsigned w = 0; w < 8; ++w)
+      if (is_block_owner(kid(own, w))) owner = static_cast<int>(w);
+    if (owner < 0) {
+      r.make<OctreeBlock>(cx->log, group_shape(c, near, Point<3>{}));
+      return;
+    }
+    r.read(cx->slot(r, child(c, static_cast<unsigned>(owner))).pts, [cx, c, near](sac::Engine& e, Node* p) {
+      if (!p) throw InvariantError("dynmesh: a block owner without its point");
+      e.make<OctreeBlock>(cx->log, group_shape(c, near, static_cast<const InputNode<3>*>(p)->point));
+    });
+  }
+};
+
+}  // namespace dynmesh::detail
