@@ -2,9 +2,10 @@
 //
 // Purpose: the conversions every binding shares, so that each crosses in one way only:
 // points as (n, d) float64 arrays copied in one block (no Python object per element), one
-// point as a sequence of d numbers, canonical meshes as (V, 2) float64 vertices and (T, 3)
-// int64 triangles, changes as (t, 3, 2) corners, boxes as (o1, o2, [o3,] L) tuples, edit
-// lists as [("+" | "-", coordinates...)], update figures as dicts.
+// point as a sequence of d numbers, canonical meshes as (V, d) float64 vertices and (T, 3)
+// int64 triangles or (T, 4) int64 tetrahedra, changes as (t, 3, 2) or (t, 4, 3) corners,
+// boxes as (o1, o2, [o3,] L) tuples, edit lists as [("+" | "-", coordinates...)], update
+// figures as dicts.
 // Invariants: every function reads or makes Python objects, so it runs with the GIL held;
 // a malformed argument throws InputError(Malformed) naming it (an edit also by its index),
 // before any library call, so a failed call changes nothing.
@@ -27,6 +28,7 @@
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
+#include "dynmesh/tet_mesh.hpp"
 
 namespace dynmesh::python {
 
@@ -46,6 +48,17 @@ std::vector<Point<d>> points_from(const py::handle& obj, const char* what) {
   std::vector<Point<d>> pts(static_cast<std::size_t>(a.shape(0)));
   std::memcpy(pts.data(), a.data(), pts.size() * sizeof(Point<d>));
   return pts;
+}
+
+/// The dimension of a points argument: 2 or 3 by its shape (n, 2) or (n, 3); 2 for an empty
+/// array of no shape (`[]`). InputError(Malformed) naming `what` otherwise.
+inline std::size_t points_dim(const py::handle& obj, const char* what) {
+  const DoubleArray a = DoubleArray::ensure(obj);
+  if (!a) throw InputError(Kind::Malformed, std::string(what) + " must be an array of numbers");
+  if (a.size() == 0 && a.ndim() != 2) return 2;
+  if (a.ndim() != 2 || (a.shape(1) != 2 && a.shape(1) != 3))
+    throw InputError(Kind::Malformed, std::string(what) + " must have shape (n, 2) or (n, 3)");
+  return static_cast<std::size_t>(a.shape(1));
 }
 
 /// One point: a sequence of d numbers.
@@ -71,6 +84,30 @@ inline py::array_t<double> corners_of(const std::vector<Triangle>& ts) {
   py::array_t<double> out({static_cast<py::ssize_t>(ts.size()), py::ssize_t{3}, py::ssize_t{2}});
   static_assert(sizeof(Triangle) == 6 * sizeof(double));
   if (!ts.empty()) std::memcpy(out.mutable_data(), ts.data(), ts.size() * sizeof(Triangle));
+  return out;
+}
+
+/// Tetrahedra by corners, (t, 4, 3): the 3D change feed's form.
+inline py::array_t<double> corners_of(const std::vector<Tetrahedron>& ts) {
+  py::array_t<double> out({static_cast<py::ssize_t>(ts.size()), py::ssize_t{4}, py::ssize_t{3}});
+  static_assert(sizeof(Tetrahedron) == 12 * sizeof(double));
+  if (!ts.empty()) std::memcpy(out.mutable_data(), ts.data(), ts.size() * sizeof(Tetrahedron));
+  return out;
+}
+
+/// The tetrahedra of a canonical mesh, (t, 4) int64 indices into its vertices.
+inline py::array_t<std::int64_t> tetrahedron_array(const TetMesh& mesh) {
+  py::array_t<std::int64_t> tets({static_cast<py::ssize_t>(mesh.tetrahedra.size()), py::ssize_t{4}});
+  auto t = tets.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < mesh.tetrahedra.size(); ++i)
+    for (py::ssize_t k = 0; k < 4; ++k) t(static_cast<py::ssize_t>(i), k) = mesh.tetrahedra[i][static_cast<std::size_t>(k)];
+  return tets;
+}
+
+inline py::dict mesh_dict(const TetMesh& mesh) {
+  py::dict out;
+  out["vertices"] = array_of<3>(mesh.vertices);
+  out["tetrahedra"] = tetrahedron_array(mesh);
   return out;
 }
 

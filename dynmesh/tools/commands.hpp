@@ -2,11 +2,11 @@
 //
 // Purpose: one options struct and one entry point per subcommand; main.cpp parses the
 // command line into these with CLI11 and calls the entry point. The contracts are
-// docs/FORMATS.md's `dynmesh quadtree`, `dynmesh mesh` (2D) and `dynmesh stability` (on a
-// distribution, or on a point file and an edit file); `demo` is the README's main job.
+// docs/FORMATS.md's `dynmesh quadtree`, `dynmesh mesh` (2D and 3D) and `dynmesh stability`
+// (on a distribution, or on a point file and an edit file); `demo` is the README's main job.
 // Invariants: an entry point returns the exit status (0 success, 1 failure) or throws; every
-// exception becomes one line `dynmesh: <message>` on stderr in main.cpp, so the commands
-// never print errors themselves.
+// exception becomes one line `dynmesh: <message>` on stderr in main.cpp (exit status 1, or 2
+// for a CommandLineError), so the commands never print errors themselves.
 // Complexity: see each command's source file.
 // Paper: Acar & Hudson, "Optimal-time dynamic mesh refinement" (the quadtree; the stability
 // bound O(lg L/s) that `stability` measures).
@@ -14,6 +14,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -37,12 +38,14 @@ struct QuadtreeOptions {
   bool force = false;       // --force: skip the memory guard (memory_guard.hpp)
 };
 
-// `dynmesh mesh` (2D); named apart from dynmesh::MeshOptions, the library's.
+// `dynmesh mesh` (2D and 3D); named apart from dynmesh::MeshOptions, the library's.
 struct MeshCommandOptions {
-  std::string points;            // POINTS: .node or plain text (2D)
-  std::vector<double> box;       // --box o1 o2 L (empty: derive from the initial points)
+  std::string points;            // POINTS: .node or plain text
+  int dim = 2;                   // --dim
+  bool dim_given = false;        // --dim appeared (else the file decides: io.hpp point_file_shape)
+  std::vector<double> box;       // --box o1 o2 [o3] L (empty: derive from the initial points)
   bool skip_duplicates = false;  // --duplicates skip (default error)
-  std::string postprocess;       // --postprocess hpu|quadtree (empty: the default, hpu)
+  std::string postprocess;       // --postprocess hpu|quadtree (empty: the default, hpu in 2D, quadtree in 3D)
   double min_angle = 0;          // --min-angle DEG
   bool min_angle_given = false;  // --min-angle appeared
   std::string edits;             // --edits FILE
@@ -84,6 +87,12 @@ struct DemoOptions {
   std::size_t updates = 2000;
   std::uint64_t seed = 1;
   std::string svg = "dynmesh-demo.svg";
+};
+
+/// A command line that is malformed for what the files turn out to hold (an option of the
+/// 2D mesh given 3D points): main.cpp prints it as CLI11's errors, one line, exit status 2.
+struct CommandLineError : std::runtime_error {
+  using std::runtime_error::runtime_error;
 };
 
 int run_quadtree(const QuadtreeOptions& options);

@@ -12,15 +12,21 @@
 // Points so close together that a box derived from them cannot be divided (the library's
 // "too small for its offset") are named as that pair. A skipped column header is noted on
 // stderr ("dynmesh: note: ...") and the run goes on.
+// The dimension of POINTS (docs/FORMATS.md, "Input points": --dim, a `.node` header, or the
+// count of numbers on the first line of plain text) is decided by points_shape, in an order
+// that keeps the memory guard ahead of any reading that could wait (a pipe).
 // Invariants: every error thrown names the POINTS file, and a line when one is known.
-// Complexity: O(n log n) (locating, duplicates); a resolution error costs O(n) more.
+// Complexity: O(n log n) (locating, duplicates); a resolution error costs O(n) more;
+// points_shape reads the first lines of a regular file.
 #pragma once
 
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
+#include <system_error>
 #include <span>
 #include <string>
 #include <utility>
@@ -144,14 +150,35 @@ template <std::size_t d>
       .with_points({a, b});
 }
 
-/// Reads `path` (its format by extension), drops later copies of a point when
-/// `skip_duplicates`, takes the box from `box_option` (--box) or derives it, and locates
-/// every point. Throws InputError naming the file and line.
+/// The dimension of POINTS and how its lines are read (point_file_shape; `dim_option` is
+/// --dim, 0 when not given), with `guard(dim)` (the command's memory guard for that
+/// dimension) run before any reading that could wait: a regular file's first lines are looked
+/// at first, since the guard's estimate depends on the dimension; standard input and pipes
+/// only after the guard, because looking at them waits for their writer, and the guard counts
+/// none of their points (it then assumes --dim, else 2, for the points the edits insert).
+template <class Guard>
+PointFileShape points_shape(const std::string& path, int dim_option, Guard&& guard) {
+  std::error_code ec;
+  const bool pipe = path == kStandardInput || (std::filesystem::exists(path, ec) &&
+                                               !std::filesystem::is_regular_file(path, ec) &&
+                                               !std::filesystem::is_directory(path, ec));
+  if (pipe && dim_option == 0) {
+    guard(2);
+    return point_file_shape(path, 0);
+  }
+  const PointFileShape shape = point_file_shape(path, dim_option);
+  guard(shape.dim);
+  return shape;
+}
+
+/// Reads `path` (its format by extension; plain-text lines as `columns` says), drops later
+/// copies of a point when `skip_duplicates`, takes the box from `box_option` (--box) or
+/// derives it, and locates every point. Throws InputError naming the file and line.
 template <std::size_t d>
 InitialPoints<d> read_initial_points(const std::string& path, const std::vector<double>& box_option,
-                                     bool skip_duplicates) {
+                                     bool skip_duplicates, Columns columns = Columns::AtLeast) {
   InitialPoints<d> in;
-  in.file = read_points_file<d>(path);
+  in.file = read_points_file<d>(path, PointFormat::Auto, columns);
   if (in.file.header_line != 0) {
     // A note, not an error: the run goes on. On stderr, so that stdout stays the outputs'.
     std::fflush(stdout);

@@ -2,10 +2,11 @@
 //   dynmesh quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--duplicates error|skip]
 //                   [--edits FILE] [--batch K] --cells OUT [--check] [--svg OUT.svg]
 //                   [--svg-point-radius PX] [--svg-max-points N] [--force]
-//   dynmesh mesh POINTS [--box o1 o2 L] [--duplicates error|skip] [--postprocess hpu|quadtree]
-//                [--min-angle DEG] [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F]
-//                [--msh F] [--svg F] [--svg-point-radius PX] [--svg-max-points N] [--check]
-//                [--stats] [--force]
+//   dynmesh mesh POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--duplicates error|skip]
+//                [--postprocess hpu|quadtree] [--min-angle DEG] [--edits FILE] [--batch K]
+//                -o OUTBASE [--feed F] [--vtk F] [--msh F] [--svg F] [--svg-point-radius PX]
+//                [--svg-max-points N] [--check] [--stats] [--force]
+//                (3D: the octree's tetrahedral mesh; hpu, --min-angle and --svg are 2D only)
 //   dynmesh stability --dim 2|3 --dist NAME --n N [--spread S] [--updates U] [--seed X]
 //                     [--postprocess none|quadtree|hpu] [--min-angle DEG] --csv OUT.csv [--plot OUT.svg]
 //                     [--force]
@@ -16,8 +17,8 @@
 //   dynmesh --version
 // Exit status: 0 on success; 1 with exactly one line `dynmesh: <message>` on stderr on any
 // error (a build refused by the memory guard included); 2 for a command line CLI11 rejects
-// (also one line), a bad --postprocess or --min-angle, or an output path naming an input
-// file (distinct_paths.hpp). Messages have their control bytes escaped (one_line). Progress lines (progress.hpp) go to stderr too, only on runs longer than a
+// (also one line), a bad --postprocess or --min-angle, an option of the 2D mesh given 3D
+// points (CommandLineError), or an output path naming an input file (distinct_paths.hpp). Messages have their control bytes escaped (one_line). Progress lines (progress.hpp) go to stderr too, only on runs longer than a
 // second (DYNMESH_PROGRESS_DELAY_MS overrides the second, for tests).
 #include <cstddef>
 #include <cstdint>
@@ -63,6 +64,11 @@ int main(int argc, char** argv) {
   constexpr std::uint64_t kMaxCount = 1'000'000'000;  // points or updates: beyond memory anyway
   const char* const duplicates_help =
       "error (the default): a repeated point is an error; skip: drop later copies of a point and say how many";
+  // The dimension rule of docs/FORMATS.md, "Input points" (io.hpp point_file_shape).
+  const char* const dim_help =
+      "dimension of the points (default: a .node header's, or the count of numbers on the first line of plain "
+      "text, 2 or 3, which every line must then hold; given, the first 2 or 3 numbers of each line are the "
+      "coordinates and further columns are ignored)";
   const char* const force_help = "build even when the estimated memory exceeds the memory available (see below)";
   const std::string svg_max_help = "--svg draws no input points when there are more than N (default " +
                                    std::to_string(dynmesh::kSvgMaxPoints) + ")";
@@ -107,7 +113,7 @@ int main(int argc, char** argv) {
                         "line; a first line without numbers is a header); - reads standard input")
       ->required();
   CLI::Option* dim_opt =
-      quadtree->add_option("--dim", q.dim, "dimension of plain-text points (a .node header decides when omitted)")
+      quadtree->add_option("--dim", q.dim, dim_help)
           ->check(CLI::IsMember({2, 3}));
   quadtree->add_option("--box", q.box, "domain box: origin and side length (default: derived from the initial points)")
       ->expected(3, 4)
@@ -135,30 +141,42 @@ int main(int argc, char** argv) {
 
   MeshCommandOptions me;
   CLI::App* mesh = app.add_subcommand(
-      "mesh", "Mesh the box of a 2D point file, apply an edit script dynamically, write the final mesh");
-  mesh->add_option("POINTS", me.points, "point file: .node (Triangle), the vertices of a .poly, or plain text (x y per line; a first "
-                    "line without numbers is a header); - reads standard input")->required();
+      "mesh", "Mesh the box of a point file (triangles in 2D, tetrahedra in 3D), apply an edit script dynamically, "
+              "write the final mesh");
+  mesh->add_option("POINTS", me.points, "point file: .node (Triangle/TetGen), the vertices of a .poly, or plain text (x y [z] per "
+                    "line; a first line without numbers is a header); - reads standard input")->required();
+  CLI::Option* mesh_dim_opt =
+      mesh->add_option("--dim", me.dim, dim_help)
+          ->check(CLI::IsMember({2, 3}));
   mesh->add_option("--box", me.box, "domain box: origin and side length (default: derived from the initial points)")
-      ->expected(3)
-      ->type_name("o1 o2 L");
+      ->expected(3, 4)
+      ->type_name("o1 o2 [o3] L");
   mesh->add_option_function<std::string>(
           "--duplicates", [&me](const std::string& v) { me.skip_duplicates = v == "skip"; }, duplicates_help)
       ->check(CLI::IsMember({"error", "skip"}));
   mesh->add_option("--postprocess", me.postprocess,
-                   "hpu (the default: the off-center Delaunay mesh; self-adjusting under --edits) or quadtree (the "
-                   "self-adjusting quadtree mesh, angles >= 18.4)");
+                   "2D: hpu (the default: the off-center Delaunay mesh; self-adjusting under --edits) or quadtree (the "
+                   "self-adjusting quadtree mesh, angles >= 18.4); 3D: quadtree (the default and only one: the "
+                   "octree's tetrahedral mesh)");
   CLI::Option* min_angle_opt = mesh->add_option(
       "--min-angle", me.min_angle,
-      "smallest angle in degrees: hpu 1 to 30 (default 20.7); quadtree 0 to 18.4 (its bound, always kept)");
+      "2D only: smallest angle in degrees: hpu 1 to 30 (default 20.7); quadtree 0 to 18.4 (its bound, always kept)");
+  CLI::Option* mesh_svg = nullptr;  // set below; read when parsing completes
   // A bad --postprocess or --min-angle is a malformed command line (exit 2), found before
-  // anything is read.
-  mesh->parse_complete_callback([&me, min_angle_opt] {
+  // anything is read; so are the options of the 2D mesh alone with --dim 3 (points that turn
+  // out 3D without --dim: run_mesh, before reading them).
+  mesh->parse_complete_callback([&me, min_angle_opt, mesh_dim_opt, &mesh_svg] {
+    if (mesh_dim_opt->count() > 0 && me.dim == 3) {
+      const std::string why =
+          mesh_options_2d_only(me.postprocess, min_angle_opt->count() > 0, mesh_svg && mesh_svg->count() > 0);
+      if (!why.empty()) throw CLI::ValidationError(why);
+    }
     check_postprocess_option(me.postprocess, /*allow_none=*/false, min_angle_opt, me.min_angle);
     require_distinct(me.points, me.edits,
                      {{"-o", me.outbase + ".node"}, {"-o", me.outbase + ".ele"}, {"--feed", me.feed},
                       {"--vtk", me.vtk}, {"--msh", me.msh}, {"--svg", me.svg}});
   });
-  mesh->add_option("--edits", me.edits, "edit script: '+ x y' inserts, '- x y' deletes, one per line");
+  mesh->add_option("--edits", me.edits, "edit script: '+ x y [z]' inserts, '- x y [z]' deletes, one per line");
   mesh->add_option("--batch", me.batch, "propagate K consecutive edits together (default: each edit alone)")
       ->check(at_least_one);
   mesh->add_option("-o", me.outbase, "output base: writes OUTBASE.node and OUTBASE.ele")
@@ -167,21 +185,23 @@ int main(int argc, char** argv) {
   mesh->add_option("--feed", me.feed, "also write the change feed of every propagation");
   mesh->add_option("--vtk", me.vtk, "also write the mesh as legacy VTK");
   mesh->add_option("--msh", me.msh, "also write the mesh as Gmsh 2.2 ASCII");
-  CLI::Option* mesh_svg = mesh->add_option("--svg", me.svg, "also draw the mesh and its input points");
+  mesh_svg = mesh->add_option("--svg", me.svg, "also draw the mesh and its input points (2D only)");
   add_svg_density(mesh, mesh_svg, me.svg_point_radius, me.svg_max_points);
   mesh->add_flag("--check", me.check, "also mesh the final points from scratch and fail unless the meshes agree");
   mesh->add_flag("--stats", me.stats, "print a quality report on stderr");
   mesh->add_flag("--force", me.force, force_help);
   mesh->footer(
       "\nSynopsis (docs/FORMATS.md):\n"
-      "  dynmesh mesh POINTS [--box o1 o2 L] [--duplicates error|skip] [--postprocess hpu|quadtree]\n"
-      "               [--min-angle DEG] [--edits FILE] [--batch K] -o OUTBASE [--feed F] [--vtk F]\n"
-      "               [--msh F] [--svg F [--svg-point-radius PX] [--svg-max-points N]] [--check]\n"
-      "               [--stats] [--force]\n\n" +
+      "  dynmesh mesh POINTS [--dim 2|3] [--box o1 o2 [o3] L] [--duplicates error|skip]\n"
+      "               [--postprocess hpu|quadtree] [--min-angle DEG] [--edits FILE] [--batch K]\n"
+      "               -o OUTBASE [--feed F] [--vtk F] [--msh F]\n"
+      "               [--svg F [--svg-point-radius PX] [--svg-max-points N]] [--check] [--stats] [--force]\n"
+      "  In 3D the mesh is the octree's tetrahedral mesh: --postprocess hpu, --min-angle and --svg are 2D only.\n\n" +
       memory_note(hpu_cost_text("hpu mesh with --edits (self-adjusting)", kHpuDynamicCostLow, kHpuDynamicCostHigh,
                                 "with --check") + "; " +
                   hpu_cost_text("hpu mesh without --edits", kHpuMeshCostLow, kHpuMeshCostHigh, "with --check") + "; " +
-                  cost_text("quadtree mesh", kQuadtreeMeshCost, "with --check")));
+                  cost_text("quadtree mesh", kQuadtreeMeshCost, "with --check") + "; " +
+                  cost_text("octree mesh (3D)", kOctreeMeshCost, "with --check")));
 
   StabilityOptions s;
   CLI::App* stability = app.add_subcommand(
@@ -192,7 +212,7 @@ int main(int argc, char** argv) {
       "log2_spread is log2(L/s) of the point set after that update, exact for every row (the closest-pair "
       "distance is maintained)");
   CLI::Option* stability_dim_opt =
-      stability->add_option("--dim", s.dim, "dimension (with --points: of plain-text points; a .node header decides when omitted)")
+      stability->add_option("--dim", s.dim, std::string("dimension (with --dist: required); with --points: ") + dim_help)
           ->check(CLI::IsMember({2, 3}));
   std::string distribution_names;
   for (const dynmesh::Distribution dist : dynmesh::all_distributions())
@@ -232,8 +252,8 @@ int main(int argc, char** argv) {
     require_distinct(s.points, s.edits, {{"--csv", s.csv}, {"--plot", s.plot}});
   });
   stability->add_option("--postprocess", s.postprocess,
-                        "none (the default: the quadtree alone), quadtree (2D: the quadtree mesh too) or hpu (2D: "
-                        "the off-center Delaunay mesh too); "
+                        "none (the default: the quadtree alone), quadtree (the quadtree mesh too; in 3D the octree's "
+                        "tetrahedral mesh) or hpu (2D: the off-center Delaunay mesh too); "
                         "with a mesh, trace_distance and seconds count the whole update, tree and mesh");
   stability_angle_opt = stability->add_option(
       "--min-angle", s.min_angle, "with a mesh: hpu's angle bound, 1 to 30 (default 20.7); quadtree: the smallest angle checked on the final mesh, 0 to 18.4");
@@ -251,6 +271,7 @@ int main(int argc, char** argv) {
       memory_note(cost_text("quadtree (2D)", kQuadtree2dCost, "for the final check") + "; " +
                   cost_text("octree (3D)", kOctree3dCost, "for the final check") + "; " +
                   cost_text("quadtree mesh", kQuadtreeMeshCost, "for the final check") + "; " +
+                  cost_text("octree mesh (3D)", kOctreeMeshCost, "for the final check") + "; " +
                   hpu_cost_text("hpu mesh", kHpuDynamicCostLow, kHpuDynamicCostHigh, "for the final check") +
                   "; the structure holds at most N + U/2 points (--dist), or the points of POINTS and the '+' "
                   "lines of FILE (--points)"));
@@ -282,6 +303,7 @@ int main(int argc, char** argv) {
     }
     if (*mesh) {
       me.min_angle_given = min_angle_opt->count() > 0;
+      me.dim_given = mesh_dim_opt->count() > 0;
       return run_mesh(me);
     }
     if (*stability) {
@@ -291,6 +313,10 @@ int main(int argc, char** argv) {
       return run_stability(s);
     }
     if (*demo) return run_demo(m);
+  } catch (const CommandLineError& e) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "dynmesh: %s (see dynmesh --help)\n", one_line(e.what()).c_str());
+    return 2;
   } catch (const std::bad_alloc&) {
     std::fflush(stdout);
     std::fprintf(stderr, "dynmesh: %s\n", out_of_memory_message().c_str());

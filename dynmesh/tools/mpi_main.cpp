@@ -97,14 +97,14 @@ void print_stats(MPI_Comm comm, const MpiQuadtree<d>& tree) {
 }
 
 template <std::size_t d>
-int run(MPI_Comm comm, const Options& o) {
+int run(MPI_Comm comm, const Options& o, Columns columns) {
   const bool root = rank_of(comm) == 0;
   std::optional<InitialPoints<d>> initial;
   EditScript<d> script;
   std::string message;
   if (root) {
     try {
-      initial.emplace(read_initial_points<d>(o.points, o.box, o.skip_duplicates));
+      initial.emplace(read_initial_points<d>(o.points, o.box, o.skip_duplicates, columns));
       if (!o.edits.empty()) script = read_edits_file<d>(o.edits);
     } catch (const std::exception& e) {
       message = e.what();
@@ -183,7 +183,10 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
   Options o;
   CLI::App* q = app.add_subcommand("quadtree", "Build T* of a point file on the ranks, apply an edit script, write the leaves");
   q->add_option("POINTS", o.points, "point file: .node, the vertices of a .poly, or plain text; read by rank 0")->required();
-  CLI::Option* dim = q->add_option("--dim", o.dim, "dimension of plain-text points")->check(CLI::IsMember({2, 3}));
+  CLI::Option* dim = q->add_option("--dim", o.dim,
+                                   "dimension (default: a .node header's, or the count of numbers on the first line "
+                                   "of plain text; given, the first 2 or 3 numbers of each line are the coordinates)")
+                         ->check(CLI::IsMember({2, 3}));
   q->add_option("--box", o.box, "domain box: origin and side length (default: derived from the initial points)")
       ->expected(3, 4)
       ->type_name("o1 o2 [o3] L");
@@ -216,21 +219,25 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
     return 2;
   }
   o.dim_given = dim->count() > 0;
-  int d = o.dim;
-  // As `dynmesh quadtree`: a .node header decides the dimension unless --dim does. Rank 0
-  // reads it; a bad header is left for the reader to report.
-  int announced = 0;
-  if (root && !o.dim_given && format_for_path(o.points) == PointFormat::Node) {
+  // As `dynmesh quadtree`: --dim, else a .node header's, else the count of numbers on the
+  // first line of plain text (io.hpp point_file_shape). Rank 0 looks; its error is everyone's.
+  int shape[2] = {o.dim, 0};  // the dimension, and 1 for Columns::Exactly
+  std::string message;
+  if (root) {
     try {
-      announced = node_file_dimension(o.points);
-    } catch (const std::exception&) {
-      announced = 0;
+      const PointFileShape found = point_file_shape(o.points, o.dim_given ? o.dim : 0);
+      shape[0] = found.dim;
+      shape[1] = found.columns == Columns::Exactly ? 1 : 0;
+    } catch (const std::exception& e) {
+      message = e.what();
     }
   }
-  MPI_Bcast(&announced, 1, MPI_INT, 0, comm);
-  if (announced != 0) d = announced == 3 ? 3 : 2;
+  if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
+  MPI_Bcast(shape, 2, MPI_INT, 0, comm);
+  const int d = shape[0];
+  const Columns columns = shape[1] != 0 ? Columns::Exactly : Columns::AtLeast;
   try {
-    return d == 3 ? run<3>(comm, o) : run<2>(comm, o);
+    return d == 3 ? run<3>(comm, o, columns) : run<2>(comm, o, columns);
   } catch (const std::exception& e) {
     // Only agreed failures reach here (MpiQuadtree throws on every rank alike).
     if (root) print_error(e.what());

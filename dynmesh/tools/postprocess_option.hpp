@@ -1,5 +1,6 @@
 // dynmesh/tools/postprocess_option.hpp — the `--postprocess` and `--min-angle` options of
-// `dynmesh mesh` and `dynmesh stability` (docs/FORMATS.md), checked in one place.
+// `dynmesh mesh` and `dynmesh stability` (docs/FORMATS.md), checked in one place, and the
+// options of the 2D mesh alone that `dynmesh mesh` refuses in 3D.
 //
 // Purpose: both commands name a postprocess and may ask for an angle bound; the names, the
 // defaults and the bound each postprocess guarantees are stated once here so the two
@@ -20,6 +21,7 @@
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/hpu_mesh.hpp"
+#include "dynmesh/octree_mesh.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
 
 namespace dynmesh::tool {
@@ -67,6 +69,20 @@ inline PostprocessChoice check_postprocess(const std::string& name, bool allow_n
                                             angle_text(kQuadtreeMinAngle) + " degrees");
   }
   return choice;
+}
+
+/// Why `dynmesh mesh` cannot take these options for 3D points (empty: it can): the 3D mesh
+/// is the octree's (`quadtree`, the 3D default), whose angle bounds are fixed, and there is
+/// no 3D picture. `postprocess` and `min_angle_given` as for check_postprocess; `svg`: --svg
+/// was given.
+inline std::string mesh_options_2d_only(const std::string& postprocess, bool min_angle_given, bool svg) {
+  if (postprocess == "hpu")
+    return "--postprocess hpu is 2D only; the 3D mesh is the octree's (--postprocess quadtree)";
+  if (min_angle_given)
+    return "--min-angle is 2D only; the 3D mesh is the octree's, whose dihedral angles lie between " +
+           angle_text(kOctreeMinDihedral) + " and " + angle_text(kOctreeMaxDihedral) + " degrees";
+  if (svg) return "--svg draws 2D meshes only; for a 3D mesh, write --vtk or --msh and view it in ParaView or Gmsh";
+  return {};
 }
 
 /// check_postprocess at parse time: a bad value is CLI11's ValidationError, so that the

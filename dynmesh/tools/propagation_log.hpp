@@ -4,7 +4,8 @@
 // Purpose: `demo` and `mesh --edits --stats` report the same figures of their propagations,
 // measured the same way: the time of each (UpdateStats::seconds, the wall time of the
 // propagation as the structure measures it, which UpdateDriver hands on), its trace distance,
-// and for a mesh the triangles it changed (removed + added: the sizes of the change feed).
+// and for a mesh the triangles (tetrahedra in 3D) it changed (removed + added: the sizes of
+// the change feed).
 // PropagationLog records them one propagation at a time and gives count, means, medians and
 // maxima; format_propagation_stats writes the lines `mesh --stats` adds after the quality
 // report, in that report's style (format_stats in mesh_io.hpp).
@@ -23,7 +24,6 @@
 #include <vector>
 
 #include "dynmesh/dynamic_quadtree.hpp"
-#include "dynmesh/mesh.hpp"
 
 namespace dynmesh::tool {
 
@@ -55,8 +55,10 @@ double maximum(const std::vector<T>& v) {
 
 class PropagationLog {
  public:
-  /// One propagation of a mesh: its last_update() and last_change().
-  void record(const UpdateStats& stats, const MeshChange& change) {
+  /// One propagation of a mesh: its last_update() and last_change() (a MeshChange or a
+  /// TetMeshChange).
+  template <class Change>
+  void record(const UpdateStats& stats, const Change& change) {
     seconds_.push_back(stats.seconds);
     distances_.push_back(stats.trace_distance);
     changed_.push_back(change.removed.size() + change.added.size());
@@ -81,9 +83,10 @@ class PropagationLog {
 ///     Mean time:      1.23e-05 s    |  Median time:    1.1e-05 s
 ///     Maximum time:   4.5e-05 s     |  Mean trace distance: 1234.5
 ///     Mean triangles changed: 23.4 (removed + added)
-/// (only the first two lines when there was no propagation). Numbers have six significant
-/// digits at most.
-inline std::string format_propagation_stats(const PropagationLog& log, std::size_t edits) {
+/// (only the first two lines when there was no propagation; `cells` names what changed:
+/// "triangles", or "tetrahedra" in 3D). Numbers have six significant digits at most.
+inline std::string format_propagation_stats(const PropagationLog& log, std::size_t edits,
+                                            const char* cells = "triangles") {
   auto number = [](double x) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%g", x);
@@ -101,7 +104,7 @@ inline std::string format_propagation_stats(const PropagationLog& log, std::size
          number(median(log.seconds())) + " s\n";
   out += "  " + pad("Maximum time:", 16) + pad(number(maximum(log.seconds())) + " s", 14) +
          "|  Mean trace distance: " + number(mean(log.distances())) + "\n";
-  out += "  Mean triangles changed: " + number(mean(log.changed())) + " (removed + added)\n";
+  out += std::string("  Mean ") + cells + " changed: " + number(mean(log.changed())) + " (removed + added)\n";
   return out;
 }
 

@@ -22,6 +22,7 @@
 
 #include "atomic_file.hpp"
 #include "commands.hpp"
+#include "edit_runner.hpp"
 #include "initial_points.hpp"
 #include "input_labels.hpp"
 #include "dynmesh/box.hpp"
@@ -42,18 +43,17 @@ using Kind = InputError::Kind;
 const char* tree_name(int dim) { return dim == 3 ? "octree" : "quadtree"; }
 
 template <std::size_t d>
-int run(const QuadtreeOptions& o) {
+int run(const QuadtreeOptions& o, Columns columns) {
   if (d != 2 && !o.svg.empty())
     throw InputError(Kind::Malformed, "--svg draws 2D trees only; " + o.points + " holds " + std::to_string(d) +
                                           "D points");
 
   std::optional<Phase> reading(std::in_place, "reading " + o.points);
-  const InitialPoints<d> initial = read_initial_points<d>(o.points, o.box, o.skip_duplicates);
+  const InitialPoints<d> initial = read_initial_points<d>(o.points, o.box, o.skip_duplicates, columns);
   const PointFile<d>& file = initial.file;
   const Box<d>& box = initial.box;
   // Read the whole script before building, so a malformed script fails fast.
   const EditScript<d> script = o.edits.empty() ? EditScript<d>{} : read_edits_file<d>(o.edits);
-  const std::vector<Edit<d>>& edits = script.edits;
   reading.reset();
 
   std::optional<DynamicQuadtree<d>> built;
@@ -68,36 +68,7 @@ int run(const QuadtreeOptions& o) {
   }
   DynamicQuadtree<d>& tree = *built;
 
-  if (!edits.empty()) {
-    const std::span<const Edit<d>> all(edits);
-    Progress progress("edits", edits.size());
-    if (o.batch == 0) {
-      for (std::size_t i = 0; i < edits.size(); ++i) {
-        const Edit<d>& e = edits[i];
-        try {
-          if (e.op == EditOp::Insert)
-            tree.insert(e.point);
-          else
-            tree.erase(e.point);
-        } catch (const InputError& err) {
-          throw edit_error<d>(script, i, err);
-        }
-        progress.tick(i + 1);
-      }
-    } else {
-      for (std::size_t i = 0; i < edits.size(); i += o.batch) {
-        const std::size_t k = std::min(o.batch, edits.size() - i);
-        try {
-          tree.apply(all.subspan(i, k));
-        } catch (const InputError& err) {
-          // apply() names the failing edit by its index in the batch.
-          if (err.point_indices().empty()) rethrow_in(err, o.edits);
-          throw edit_error<d>(script, i + err.point_indices().back(), err);
-        }
-        progress.tick(i + k);
-      }
-    }
-  }
+  apply_edits<d>(tree, script, o.batch);
 
   if (o.check) {
     Verification v;
@@ -137,18 +108,17 @@ int run(const QuadtreeOptions& o) {
 }  // namespace
 
 int run_quadtree(const QuadtreeOptions& o) {
-  int dim = o.dim;
-  // A `.node` header announces its dimension; without --dim it decides, with --dim the two
-  // must agree (read_node reports a mismatch, naming the header line).
-  const bool node = format_for_path(o.points) == PointFormat::Node;
-  if (!o.dim_given && node) dim = node_file_dimension(o.points) == 3 ? 3 : 2;
-  if (!o.force) {
+  // The dimension: --dim, else a `.node` header's, else the count of numbers on the first
+  // line of plain text (with --dim, a `.node` header that announces another is an error
+  // naming its line).
+  const PointFileShape shape = points_shape(o.points, o.dim_given ? o.dim : 0, [&o](int dim) {
+    if (o.force) return;
     const std::uint64_t points = points_held(o.points, o.edits);
     guard_memory(std::string("building the ") + tree_name(dim) + " of " + std::to_string(points) + " points" +
                      (o.check ? " with --check" : ""),
                  estimated_bytes(dim == 3 ? kOctree3dCost : kQuadtree2dCost, points, o.check));
-  }
-  return dim == 3 ? run<3>(o) : run<2>(o);
+  });
+  return shape.dim == 3 ? run<3>(o, shape.columns) : run<2>(o, shape.columns);
 }
 
 }  // namespace dynmesh::tool

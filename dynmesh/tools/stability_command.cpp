@@ -5,8 +5,9 @@
 // `--points POINTS --edits FILE`, builds on POINTS (read, boxed and located as `quadtree` and
 // `mesh` read them: initial_points.hpp) and measures every edit of FILE as one propagation.
 // Either way it appends one CSV row per update. With `--postprocess quadtree` or `hpu` (2D)
-// the structure is a DynamicMesh: QuadTreeRefine and the mesh run in one trace, so each row's
-// trace_distance and seconds are the whole update, tree and mesh (FORMATS.md).
+// the structure is a DynamicMesh, and with `--postprocess quadtree` in 3D a DynamicOctreeMesh:
+// QuadTreeRefine and the mesh run in one trace, so each row's trace_distance and seconds are
+// the whole update, tree and mesh (FORMATS.md).
 //
 // The N initial points and the insertion pool come from one call generate(dist, N + U, seed,
 // spread): the generators return their points in a seeded random order, so the first N are
@@ -36,9 +37,11 @@
 #include "atomic_file.hpp"
 #include "commands.hpp"
 #include "dynmesh/box.hpp"
+#include "dynmesh/detail/mesh_grid.hpp"
 #include "dynmesh/detail/quadtree_mesh_rules.hpp"
 #include "dynmesh/distributions.hpp"
 #include "dynmesh/dynamic_mesh.hpp"
+#include "dynmesh/dynamic_octree_mesh.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/io.hpp"
@@ -99,6 +102,10 @@ inline DynamicMesh build(const Box<2>& box, std::span<const Point<2>> pts, const
                          const MeshOptions& options) {
   return DynamicMesh(box, pts, options);
 }
+inline DynamicOctreeMesh build(const Box<3>& box, std::span<const Point<3>> pts, const DynamicOctreeMesh*,
+                               const MeshOptions&) {
+  return DynamicOctreeMesh(box, pts);
+}
 template <std::size_t d>
 DynamicQuadtree<d> build(const Box<d>& box, std::span<const Point<d>> pts, const DynamicQuadtree<d>* t,
                          const MeshOptions&) {
@@ -110,6 +117,7 @@ Verification verify_final(const DynamicQuadtree<d>& tree, double) {
   return verify(tree);
 }
 inline Verification verify_final(const DynamicMesh& mesh, double min_angle) { return verify(mesh, min_angle); }
+inline Verification verify_final(const DynamicOctreeMesh& mesh, double) { return verify(mesh); }
 
 // One row's fields after `dist,dim,n,`: log2_spread,op,trace_distance,seconds and the line end.
 std::string row_tail(double log2_spread, EditOp op, const UpdateStats& stats) {
@@ -163,7 +171,7 @@ template <std::size_t d, class Structure>
 int run(const StabilityOptions& o, Distribution dist, const char* what, const MemoryCost& cost,
         const MeshOptions& mesh_options = {}) {
   // On stderr, a 3D tree is called what it is.
-  const char* structure_name = d == 3 ? "octree" : what;
+  const char* structure_name = d == 3 && std::is_same_v<Structure, DynamicQuadtree<d>> ? "octree" : what;
   if (!o.force) {
     // Deletions and insertions alternate, so the structure never holds more than N + ⌈U/2⌉.
     const std::uint64_t points = std::uint64_t{o.n} + (std::uint64_t{o.updates} + 1) / 2;
@@ -212,8 +220,8 @@ std::string points_label(const std::string& path) {
 // (initial_points.hpp): the tree's grid, or the mesh's coarser resolution level.
 template <class Structure, std::size_t d>
 int resolution_level(const Box<d>& box) {
-  if constexpr (std::is_same_v<Structure, DynamicMesh>) {
-    const int level = dynmesh::detail::MeshGrid::resolution_level(box);
+  if constexpr (!std::is_same_v<Structure, DynamicQuadtree<d>>) {
+    const int level = dynmesh::detail::BasicMeshGrid<d>::resolution_level(box);
     return level >= 2 ? level : -1;
   } else {
     return kMaxLevel;
@@ -222,19 +230,14 @@ int resolution_level(const Box<d>& box) {
 
 // --points POINTS --edits FILE: every edit of FILE, in order, one propagation each; one row per
 // edit. Errors name POINTS or FILE and the line, as `quadtree` and `mesh` name them.
+// The memory guard ran before (run_stability_points: it needs the points' dimension).
 template <std::size_t d, class Structure>
-int run_points(const StabilityOptions& o, const char* what, const MemoryCost& cost,
-               const MeshOptions& mesh_options = {}) {
-  const char* structure_name = d == 3 ? "octree" : what;
+int run_points(const StabilityOptions& o, Columns columns, const char* what, const MeshOptions& mesh_options = {}) {
+  // On stderr, a 3D tree is called what it is.
+  const char* structure_name = d == 3 && std::is_same_v<Structure, DynamicQuadtree<d>> ? "octree" : what;
   const std::string label = points_label(o.points);
-  if (!o.force) {
-    // As `quadtree` and `mesh` count: the lines of POINTS and the `+` lines of FILE.
-    const std::uint64_t points = points_held(o.points, o.edits);
-    guard_memory(std::string("building the ") + structure_name + " of " + std::to_string(points) + " points",
-                 estimated_bytes(cost, points, /*check=*/true));
-  }
   std::optional<Phase> reading(std::in_place, "reading " + o.points);
-  const InitialPoints<d> initial = read_initial_points<d>(o.points, o.box, /*skip_duplicates=*/false);
+  const InitialPoints<d> initial = read_initial_points<d>(o.points, o.box, /*skip_duplicates=*/false, columns);
   // The whole script before building, so a malformed script fails fast.
   const EditScript<d> script = read_edits_file<d>(o.edits);
   reading.reset();
@@ -289,22 +292,42 @@ MeshOptions hpu_mesh_options(const StabilityOptions& o) {
   return MeshOptions{.postprocess = Postprocess::Hpu, .min_angle = o.min_angle_given ? o.min_angle : kHpuDefaultMinAngle};
 }
 
-// --points: the dimension is --dim's, else a .node header's, else 2 (as `dynmesh quadtree`).
+// In 3D the mesh is the octree's (--postprocess quadtree): hpu and --min-angle are 2D only, a
+// malformed command line (exit status 2) as for `dynmesh mesh`.
+void require_3d_options(const StabilityOptions& o) {
+  const std::string why = mesh_options_2d_only(o.postprocess, o.min_angle_given, /*svg=*/false);
+  if (!why.empty()) throw CommandLineError(why);
+}
+
+// --points: the dimension is --dim's, else a .node header's, else the count of numbers on the
+// first line of plain text (as `dynmesh quadtree` and `dynmesh mesh`: initial_points.hpp).
 int run_stability_points(const StabilityOptions& o, PostprocessChoice choice) {
-  int dim = o.dim;
-  if (!o.dim_given && format_for_path(o.points) == PointFormat::Node)
-    dim = node_file_dimension(o.points) == 3 ? 3 : 2;
-  if (choice == PostprocessChoice::None)
-    return dim == 3 ? run_points<3, DynamicQuadtree<3>>(o, "quadtree", kOctree3dCost)
-                    : run_points<2, DynamicQuadtree<2>>(o, "quadtree", kQuadtree2dCost);
-  if (dim != 2)
-    throw InputError(Kind::Malformed, "--postprocess " + o.postprocess + " meshes in 2D only, and " + o.points +
-                                          " holds 3D points");
+  const PointFileShape shape = points_shape(o.points, o.dim_given ? o.dim : 0, [&o, choice](int dim) {
+    if (dim == 3) require_3d_options(o);
+    if (o.force) return;
+    // As `quadtree` and `mesh` count: the lines of POINTS and the `+` lines of FILE.
+    const std::uint64_t points = points_held(o.points, o.edits);
+    const char* what = dim == 3 ? (choice == PostprocessChoice::None ? "octree" : "octree mesh")
+                       : choice == PostprocessChoice::None     ? "quadtree"
+                       : choice == PostprocessChoice::Quadtree ? "quadtree mesh"
+                                                               : "hpu mesh";
+    const MemoryCost cost = dim == 3 ? (choice == PostprocessChoice::None ? kOctree3dCost : kOctreeMeshCost)
+                            : choice == PostprocessChoice::None     ? kQuadtree2dCost
+                            : choice == PostprocessChoice::Quadtree ? kQuadtreeMeshCost
+                                                                    : hpu_dynamic_cost(hpu_mesh_options(o).min_angle);
+    guard_memory(std::string("building the ") + what + " of " + std::to_string(points) + " points",
+                 estimated_bytes(cost, points, /*check=*/true));
+  });
+  const Columns columns = shape.columns;
+  if (shape.dim == 3) {
+    require_3d_options(o);  // again: a pipe's dimension is known only now
+    if (choice == PostprocessChoice::None) return run_points<3, DynamicQuadtree<3>>(o, columns, "quadtree");
+    return run_points<3, DynamicOctreeMesh>(o, columns, "octree mesh");
+  }
+  if (choice == PostprocessChoice::None) return run_points<2, DynamicQuadtree<2>>(o, columns, "quadtree");
   if (choice == PostprocessChoice::Quadtree)
-    return run_points<2, DynamicMesh>(o, "quadtree mesh", kQuadtreeMeshCost,
-                                      MeshOptions{.postprocess = Postprocess::Quadtree});
-  const MeshOptions hpu = hpu_mesh_options(o);
-  return run_points<2, DynamicMesh>(o, "hpu mesh", hpu_dynamic_cost(hpu.min_angle), hpu);
+    return run_points<2, DynamicMesh>(o, columns, "quadtree mesh", MeshOptions{.postprocess = Postprocess::Quadtree});
+  return run_points<2, DynamicMesh>(o, columns, "hpu mesh", hpu_mesh_options(o));
 }
 
 }  // namespace
@@ -326,7 +349,10 @@ int run_stability(const StabilityOptions& o) {
   if (choice == PostprocessChoice::None)
     return o.dim == 3 ? run<3, DynamicQuadtree<3>>(o, *dist, "quadtree", kOctree3dCost)
                       : run<2, DynamicQuadtree<2>>(o, *dist, "quadtree", kQuadtree2dCost);
-  if (o.dim != 2) throw InputError(Kind::Malformed, "--postprocess " + o.postprocess + " meshes in 2D only (--dim 2)");
+  if (o.dim == 3) {
+    require_3d_options(o);
+    return run<3, DynamicOctreeMesh>(o, *dist, "octree mesh", kOctreeMeshCost);
+  }
   if (choice == PostprocessChoice::Quadtree)
     return run<2, DynamicMesh>(o, *dist, "quadtree mesh", kQuadtreeMeshCost,
                                MeshOptions{.postprocess = Postprocess::Quadtree});

@@ -6,6 +6,8 @@
 //   2. check_tree on the dynamic leaves and the located points must pass
 //      (require_valid_tree: tiling, occupancy, separation, grading, crowding, minimality);
 //   3. the tree's own check_invariants() (engine, indexes, directory) must pass.
+// The meshes likewise: verify(DynamicMesh) for the 2D meshes, verify(DynamicOctreeMesh) for
+// the 3D one (`mesh --check` and `stability --postprocess quadtree` in 3D).
 // The first failure is reported as one line (multi-line checker summaries are folded).
 // Invariants: verify() does not modify the tree.
 // Complexity: one static build and one check_tree on the final points, plus
@@ -23,13 +25,17 @@
 #include <sac/errors.hpp>
 
 #include "dynmesh/dynamic_mesh.hpp"
+#include "dynmesh/dynamic_octree_mesh.hpp"
 #include "dynmesh/hpu_mesh.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/io.hpp"
 #include "dynmesh/mesh_check.hpp"
+#include "dynmesh/octree_mesh.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
 #include "dynmesh/static_quadtree.hpp"
+#include "dynmesh/tet_mesh_check.hpp"
+#include "dynmesh/tet_mesh_io.hpp"
 
 namespace dynmesh::tool {
 
@@ -135,6 +141,40 @@ inline Verification verify(const DynamicMesh& dm, double min_angle_deg) {
     v.problem = "the dynamic mesh differs from a from-scratch mesh of the final " + std::to_string(pts.size()) +
                 " points (" + std::to_string(mesh.num_triangles()) + " vs " + std::to_string(fresh.num_triangles()) +
                 " triangles)";
+    return v;
+  }
+  v.ok = true;
+  return v;
+}
+
+/// The 3D counterpart: the engine's and the mesh's invariants, require_valid_tet_mesh with
+/// the octree mesh's dihedral bounds on the final mesh, then the static twin OctreeMesh on
+/// the final points must give the same `.node` and `.ele` texts; static_seconds is its time.
+inline Verification verify(const DynamicOctreeMesh& dm) {
+  Verification v;
+  std::vector<Point<3>> pts;
+  for (const auto& entry : dm.points()) pts.push_back(entry.second);
+  const TetMesh mesh = dm.mesh();
+  try {
+    dm.check_invariants();
+    TetMeshCheckOptions options;
+    options.min_dihedral_deg = kOctreeMinDihedral;
+    options.max_dihedral_deg = kOctreeMaxDihedral;
+    require_valid_tet_mesh(mesh, dm.box(), pts, options);
+  } catch (const dynmesh::InvariantError& e) {
+    v.problem = "invariant check failed: " + one_line(e.what());
+    return v;
+  } catch (const sac::InvariantError& e) {
+    v.problem = "runtime invariant check failed: " + one_line(e.what());
+    return v;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const TetMesh fresh = OctreeMesh(dm.box(), pts).mesh();
+  v.static_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (format_node(fresh, dm.box()) != format_node(mesh, dm.box()) || format_ele(fresh) != format_ele(mesh)) {
+    v.problem = "the dynamic mesh differs from a from-scratch mesh of the final " + std::to_string(pts.size()) +
+                " points (" + std::to_string(mesh.num_tetrahedra()) + " vs " +
+                std::to_string(fresh.num_tetrahedra()) + " tetrahedra)";
     return v;
   }
   v.ok = true;

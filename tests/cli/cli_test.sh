@@ -68,13 +68,16 @@ case $case_name in
     cmp p3.cells p3b.cells || fail "--dim 3 on a 3D .node changes the result"
     run "$dynmesh" quadtree "$data/scan.xyz" --dim 3 --cells xyz.cells --check
     grep -qx '# dim 3' xyz.cells || fail "scan.xyz --dim 3: not 3D"
-    run "$dynmesh" quadtree "$data/scan.xyz" --cells xyz2.cells --check  # first two columns
+    run "$dynmesh" quadtree "$data/scan.xyz" --dim 2 --cells xyz2.cells --check  # first two columns
+    grep -qx '# dim 2' xyz2.cells || fail "scan.xyz --dim 2: not 2D"
     run "$dynmesh" quadtree "$data/boundary.txt" --box 0 0 1 --cells boundary.cells --check
     grep -qx '# box 0 0 1' boundary.cells || fail "--box not recorded exactly"
     run "$dynmesh" quadtree "$data/boundary.txt" --cells boundary2.cells --check
     run "$dynmesh" quadtree "$data/collinear.txt" --cells collinear.cells --check
     run "$dynmesh" quadtree "$data/grid.txt" --cells grid.cells --check
     run "$dynmesh" quadtree "$data/final3d.txt" --dim 3 --cells f3.cells --check
+    run "$dynmesh" quadtree "$data/final3d.txt" --cells f3b.cells --check # x y z lines: 3D without --dim
+    cmp f3.cells f3b.cells || fail "final3d.txt without --dim is not its 3D tree"
     # One leaf line per leaf after the three header lines, sorted by (level, i, j).
     tail -n +4 grid.cells | sort -n -k1,1 -k2,2 -k3,3 -c || fail "grid.cells is not sorted"
     ;;
@@ -145,10 +148,10 @@ case $case_name in
       END { exit bad }' || fail "hpu rows do not follow the tree rows (same ops and spreads, larger distances)"
     expect_error 2 '--min-angle for hpu must be between 1 and 30 degrees, got 31' "$dynmesh" stability --dim 2 \
       --dist uniform --n 50 --postprocess hpu --min-angle 31 --csv e.csv
-    expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess hpu \
-      --csv e.csv
-    expect_error 1 'meshes in 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 --postprocess quadtree \
-      --csv e.csv
+    expect_error 2 '--postprocess hpu is 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 \
+      --postprocess hpu --csv e.csv
+    expect_error 2 '--min-angle is 2D only' "$dynmesh" stability --dim 3 --dist uniform --n 50 \
+      --postprocess quadtree --min-angle 10 --csv e.csv
     expect_error 2 '--min-angle needs a mesh' "$dynmesh" stability --dim 2 --dist uniform --n 50 --min-angle 10 \
       --csv e.csv
     expect_error 2 'above the quadtree' "$dynmesh" stability --dim 2 --dist uniform --n 50 --postprocess quadtree \
@@ -222,8 +225,8 @@ case $case_name in
       --edits "$data/edits_outside.txt" --csv none.csv
     expect_error 1 'bad_number.txt:3: ' "$dynmesh" stability --points "$data/bad_number.txt" \
       --edits "$data/edits2d.txt" --csv none.csv
-    expect_error 1 'meshes in 2D only' "$dynmesh" stability --points "$data/points3d.node" \
-      --edits "$data/edits3d.txt" --postprocess quadtree --csv none.csv
+    expect_error 2 '--postprocess hpu is 2D only' "$dynmesh" stability --points "$data/points3d.node" \
+      --edits "$data/edits3d.txt" --postprocess hpu --csv none.csv
     cmp none.csv saved.csv || fail "a failed run changed the CSV"
     expect_error 1 'bad_edits.txt:5: ' "$dynmesh" stability --points "$data/points2d.node" --edits bad_edits.txt \
       --csv new.csv
@@ -418,7 +421,7 @@ case $case_name in
         "$data/points2d.node" --min-angle "$angle" -o old
     done
     expect_error 1 'duplicate.txt:5: ' "$dynmesh" mesh "$data/duplicate.txt" -o old
-    expect_error 1 'points3d.node:1: ' "$dynmesh" mesh "$data/points3d.node" "${qt[@]}" -o old
+    expect_error 1 'points3d.node:1: ' "$dynmesh" mesh "$data/points3d.node" --dim 2 "${qt[@]}" -o old
     # An output that cannot be written: nothing else of the run is renamed into place.
     expect_error 1 'no-such-dir/x.svg' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}" \
       --edits "$data/edits2d.txt" -o old --svg no-such-dir/x.svg
@@ -837,6 +840,9 @@ GNUPLOT
         limited "$dynmesh" mesh p.txt --edits e.txt -o e --min-angle 25.35
       expect_error 1 'building the hpu mesh of 1010 points needs about 75.3 MiB' \
         limited "$dynmesh" mesh p.txt --edits e.txt -o e --min-angle 30
+      # The octree's tetrahedral mesh (3D points: x y z lines without --dim) has its own cost.
+      awk 'BEGIN { for (i = 1; i <= 1000; i++) printf "%d %d %d\n", i, (i * 7919) % 1009, (i * 104729) % 1013 }' >p3.txt
+      expect_error 1 'building the octree mesh of 1000 points needs about ' limited "$dynmesh" mesh p3.txt -o e
       # stability --points counts as they do: the 1000 points and the 10 '+' lines (and its check).
       expect_error 1 'building the quadtree of 1010 points needs about 46.4 MiB' \
         limited "$dynmesh" stability --points p.txt --edits e.txt --csv e.csv
@@ -938,6 +944,194 @@ GNUPLOT
     expect_error 2 '--svg-max-points' "$dynmesh" mesh "$data/points2d.node" --postprocess quadtree -o e \
       --svg e.svg --svg-max-points -1
     [[ ! -e e.cells && ! -e e.svg ]] || fail "a refused run wrote its output file"
+    ;;
+
+  dimensions) # the dimension of a point file (docs/FORMATS.md, "Input points"), in every command
+    # that reads one: --dim, a .node header, or the count of numbers on the first line
+    awk '/^#/ { next } { print $1, $2 }' "$data/final3d.txt" >xy.txt # final3d.txt's first two columns
+    # x y z lines without --dim are 3D, never their (x, y) projection.
+    run "$dynmesh" quadtree "$data/final3d.txt" --cells a.cells
+    grep -qx '# dim 3' a.cells || fail "final3d.txt without --dim: not 3D"
+    run "$dynmesh" mesh "$data/final3d.txt" -o m3
+    [[ $(head -1 m3.node | cut -d' ' -f2-) == '3 0 1' ]] || fail "mesh final3d.txt: $(head -1 m3.node)"
+    # With --dim 2 the first two numbers are the coordinates and the third is ignored.
+    run "$dynmesh" quadtree "$data/final3d.txt" --dim 2 --cells q2.cells
+    run "$dynmesh" quadtree xy.txt --cells qxy.cells
+    cmp q2.cells qxy.cells || fail "--dim 2 on x y z lines is not the tree of their (x, y)"
+    run "$dynmesh" mesh "$data/final3d.txt" --dim 2 --postprocess quadtree -o m2
+    run "$dynmesh" mesh xy.txt --postprocess quadtree -o mxy
+    cmp m2.node mxy.node && cmp m2.ele mxy.ele || fail "mesh --dim 2 on x y z lines is not the mesh of their (x, y)"
+    # More numbers than 3 on the first line (normals after the coordinates): --dim says which.
+    for cmd in "quadtree --cells e.cells" "mesh -o e"; do
+      # shellcheck disable=SC2086  # $cmd is several words
+      expect_error 1 'scan.xyz:1: the first line of numbers holds 6 numbers' "$dynmesh" $cmd "$data/scan.xyz"
+      grep -qF -- 'pass --dim 2 or --dim 3' err.txt || fail "no --dim hint: $(cat err.txt)"
+    done
+    printf '+ 1 1 1\n' >e3.txt
+    expect_error 1 'scan.xyz:1: the first line of numbers holds 6' "$dynmesh" stability --points "$data/scan.xyz" \
+      --edits e3.txt --csv e.csv
+    run "$dynmesh" mesh "$data/scan.xyz" --dim 3 -o s3 --check
+    [[ $(head -1 s3.node | cut -d' ' -f2-) == '3 0 1' ]] || fail "scan.xyz --dim 3: $(head -1 s3.node)"
+    # Every later line holds as many numbers as the first: an error naming the line otherwise.
+    printf '0.1 0.2 0.3\n0.4 0.5 0.6\n0.7 0.8\n0.9 0.1 0.2\n' >mixed.txt
+    expect_error 1 'mixed.txt:3: expected 3 numbers as on line 1' "$dynmesh" quadtree mixed.txt --cells e.cells
+    expect_error 1 'mixed.txt:3: expected 3 numbers as on line 1' "$dynmesh" mesh mixed.txt -o e
+    expect_error 1 'mixed.txt:3: expected 3 numbers' "$dynmesh" stability --points mixed.txt --edits e3.txt --csv e.csv
+    printf '# two, then three\n0.1 0.2\n0.4 0.5 0.6\n' >mixed2.txt
+    expect_error 1 'mixed2.txt:3: expected 2 numbers as on line 2' "$dynmesh" mesh mixed2.txt -o e
+    # With --dim, only the count below it is an error: --dim 2 reads mixed.txt, --dim 3 refuses line 3.
+    run "$dynmesh" quadtree mixed.txt --dim 2 --cells mixed.cells
+    expect_error 1 'mixed.txt:3: expected 3 coordinates, found 2' "$dynmesh" quadtree mixed.txt --dim 3 --cells e.cells
+    # A 2D file given --dim 3, and a .node header that disagrees with --dim, either way.
+    first=$(grep -n -m1 -v '^#' "$data/final2d.txt" | cut -d: -f1)
+    expect_error 1 "final2d.txt:$first: expected 3 coordinates, found 2" "$dynmesh" mesh "$data/final2d.txt" --dim 3 -o e
+    expect_error 1 'points3d.node:1: ' "$dynmesh" mesh "$data/points3d.node" --dim 2 -o e
+    expect_error 1 'points2d.node:2: ' "$dynmesh" mesh "$data/points2d.node" --dim 3 -o e
+    expect_error 1 'points2d.node:2: ' "$dynmesh" quadtree "$data/points2d.node" --dim 3 --cells e.cells
+    # A column header, ',' separators and standard input: the count is of the numbers.
+    { echo 'x,y,z'; awk '/^#/ { next } { print $1 "," $2 "," $3 }' "$data/final3d.txt"; } >h.csv
+    run "$dynmesh" quadtree h.csv --cells h.cells
+    cmp a.cells h.cells || fail "a header and commas changed the tree"
+    grep -v '^#' "$data/final3d.txt" | run "$dynmesh" quadtree - --cells stdin.cells
+    cmp a.cells stdin.cells || fail "'-': not the 3D tree of the same points"
+    grep -v '^#' "$data/final3d.txt" | run "$dynmesh" mesh - -o stdin
+    cmp m3.node stdin.node && cmp m3.ele stdin.ele || fail "'-': not the 3D mesh of the same points"
+    # A pipe (not a regular file) is read once: looking at its first line loses nothing.
+    run "$dynmesh" quadtree <(grep -v '^#' "$data/final3d.txt") --cells pipe.cells
+    cmp a.cells pipe.cells || fail "a pipe: not the 3D tree of the same points"
+    # Edit scripts give as many coordinates as the points have.
+    printf '+ 0.5 0.5\n' >e2.txt
+    expect_error 1 'e2.txt:1: an edit needs exactly 3 coordinates (the points are 3D), found 2' \
+      "$dynmesh" quadtree "$data/final3d.txt" --edits e2.txt --cells e.cells
+    expect_error 1 'e2.txt:1: an edit needs exactly 3 coordinates' "$dynmesh" mesh "$data/final3d.txt" --edits e2.txt -o e
+    expect_error 1 'e3.txt:1: an edit needs exactly 2 coordinates (the points are 2D), found 3' \
+      "$dynmesh" mesh xy.txt --edits e3.txt -o e
+    [[ ! -e e.cells && ! -e e.node && ! -e e.csv ]] || fail "a failed run wrote its output file"
+    ;;
+
+  mesh3d) # `dynmesh mesh` in 3D: the octree's tetrahedral mesh (docs/FORMATS.md, "dynmesh mesh in 3D")
+    edits=$(grep -c '^[+-]' "$data/edits3d.txt")
+    # tets_of NODE ELE: one sorted line per tetrahedron, its corners as the .node writes them
+    # (%.17g), in the .ele's order: the form of the feed's lines.
+    tets_of() {
+      awk 'NR == FNR { if (FNR > 1) xyz[$1] = $2 " " $3 " " $4; next }
+        FNR > 1 { print xyz[$2], xyz[$3], xyz[$4], xyz[$5] }' "$1" "$2" | LC_ALL=C sort
+    }
+    # replay TETS FEED: TETS with every update's '-' lines removed and '+' lines added, in order;
+    # fails when a removed tetrahedron is absent or an added one is present.
+    replay() {
+      awk 'NR == FNR { have[$0] = 1; next }
+        /^[-+] / { t = substr($0, 3); if ($1 == "-") { bad = bad || !(t in have); delete have[t] }
+                   else { bad = bad || (t in have); have[t] = 1 } }
+        END { for (t in have) print t; exit bad }' "$1" "$2" | LC_ALL=C sort
+    }
+    run "$dynmesh" quadtree "$data/points3d.node" --cells box.cells
+    box=$(box_of box.cells) # the box derived from points3d.node, as the mesh derives it
+    # A 3D .node header decides the dimension; every output, --check and --stats.
+    run "$dynmesh" mesh "$data/points3d.node" --edits "$data/edits3d.txt" -o dyn --check --feed dyn.feed \
+      --vtk dyn.vtk --msh dyn.msh --stats
+    cp err.txt stats.txt
+    [[ $(head -1 dyn.node | cut -d' ' -f2-) == '3 0 1' ]] || fail "dyn.node header: $(head -1 dyn.node)"
+    [[ $(head -1 dyn.ele | cut -d' ' -f2-) == '4 0' ]] || fail "dyn.ele header: $(head -1 dyn.ele)"
+    [[ $(head -1 dyn.node | cut -d' ' -f1) -eq $(($(wc -l <dyn.node) - 1)) ]] || fail "dyn.node: vertex count"
+    [[ $(head -1 dyn.ele | cut -d' ' -f1) -eq $(($(wc -l <dyn.ele) - 1)) ]] || fail "dyn.ele: tetrahedron count"
+    awk 'NR > 1 && (NF != 5 || $1 != NR - 1 || ($5 != 0 && $5 != 1)) { bad = 1; print } END { exit bad }' dyn.node ||
+      fail "dyn.node lines"
+    # Canonical: numbered from 1, the smallest vertex first, then the smallest of the other three;
+    # tetrahedra sorted.
+    awk 'NR > 1 && (NF != 5 || $1 != NR - 1 || !($2 < $3 && $2 < $4 && $2 < $5 && $3 < $4 && $3 < $5)) { bad = 1; print }
+      END { exit bad }' dyn.ele || fail "dyn.ele lines are not canonical"
+    tail -n +2 dyn.ele | cut -d' ' -f2- | sort -c -n -k1,1 -k2,2 -k3,3 -k4,4 || fail "dyn.ele is not sorted"
+    # The same files with --dim 3, and from scratch on the final points in the same box.
+    run "$dynmesh" mesh "$data/points3d.node" --dim 3 --edits "$data/edits3d.txt" -o again
+    cmp dyn.node again.node && cmp dyn.ele again.ele || fail "two runs differ"
+    # shellcheck disable=SC2086  # the box is several numbers
+    run "$dynmesh" mesh "$data/final3d.txt" --box $box -o scratch --check --postprocess quadtree
+    cmp dyn.node scratch.node || fail "dynamic .node differs from a from-scratch run on final3d.txt"
+    cmp dyn.ele scratch.ele || fail "dynamic .ele differs from a from-scratch run on final3d.txt"
+    run "$dynmesh" mesh "$data/points3d.node" --edits "$data/edits3d.txt" --batch 3 -o batch3 --feed batch3.feed --check
+    cmp dyn.node batch3.node && cmp dyn.ele batch3.ele || fail "--batch 3 differs from single edits"
+    [[ $(grep -c '^update ' batch3.feed) -eq $(((edits + 2) / 3)) ]] || fail "--batch 3: wrong number of updates"
+    # The feed: one update per edit, 12 numbers a line, and replayed on the initial mesh it gives
+    # the final one.
+    [[ $(head -1 dyn.feed) == '# dynmesh feed v1' ]] || fail "feed header: $(head -1 dyn.feed)"
+    [[ $(grep -c '^update ' dyn.feed) -eq $edits ]] || fail "feed: expected $edits updates"
+    [[ $(grep -m1 '^update ' dyn.feed | cut -d' ' -f2) == 1 ]] || fail "feed: first update is not 1"
+    awk '/^[-+] / && NF != 13 { bad = 1; print } END { exit bad }' dyn.feed || fail "feed lines of other than 12 numbers"
+    run "$dynmesh" mesh "$data/points3d.node" -o start
+    tets_of start.node start.ele >start.tets
+    tets_of dyn.node dyn.ele >final.tets
+    replay start.tets dyn.feed >replayed.tets || fail "the feed removes an absent tetrahedron or adds a present one"
+    cmp replayed.tets final.tets || fail "the feed replayed on the initial mesh does not give the final .ele"
+    replay start.tets batch3.feed >replayed3.tets && cmp replayed3.tets final.tets || fail "--batch 3 feed replay"
+    # --stats: the tetrahedral report, then the propagations as in 2D.
+    for want in 'Smallest dihedral' 'Largest dihedral' 'radius-edge ratio' 'Tetrahedra per input point' \
+      'Propagation statistics:' "  Propagations: $edits    Edits: $edits"; do
+      grep -qF "$want" stats.txt || fail "--stats lacks '$want': $(cat stats.txt)"
+    done
+    want=$(awk '/^update / { t += $4 + $6; k++ } END { printf "%g", t / k }' dyn.feed)
+    grep -qx "  Mean tetrahedra changed: $want (removed + added)" stats.txt || fail "not the feed's mean $want"
+    grep -qE '^  Maximum time: +[0-9.e+-]+ s +\|  Mean trace distance: [1-9][0-9.e+]*$' stats.txt ||
+      fail "--stats: maximum time, trace distance"
+    # VTK cell type 10, Gmsh element type 4.
+    head -1 dyn.vtk | grep -q '^# vtk DataFile' || fail "dyn.vtk is not legacy VTK"
+    awk '/^CELL_TYPES/ { n = $2; on = 1; next } on && n-- > 0 && $1 != 10 { bad = 1 } END { exit bad || !on }' dyn.vtk ||
+      fail "dyn.vtk: cell types other than 10"
+    awk '/^\$Elements/ { on = 1; getline; next } /^\$EndElements/ { on = 0 } on && $2 != 4 { bad = 1 }
+      END { exit bad }' dyn.msh || fail "dyn.msh: elements other than type 4"
+    # Plain x y z lines without --dim mesh in 3D.
+    run "$dynmesh" mesh "$data/final3d.txt" -o plain --check
+    [[ $(head -1 plain.ele | cut -d' ' -f2-) == '4 0' ]] || fail "final3d.txt: not tetrahedra"
+    # The 2D mesh's options are malformed command lines in 3D (exit 2), with --dim 3 or without.
+    for dim in "" "--dim 3"; do
+      # shellcheck disable=SC2086  # $dim is zero or two words
+      expect_error 2 '--postprocess hpu is 2D only; the 3D mesh is the octree'"'"'s (--postprocess quadtree)' \
+        "$dynmesh" mesh "$data/final3d.txt" $dim --postprocess hpu -o e
+      # shellcheck disable=SC2086
+      expect_error 2 '--min-angle is 2D only' "$dynmesh" mesh "$data/final3d.txt" $dim --min-angle 10 -o e
+      # shellcheck disable=SC2086
+      expect_error 2 '--min-angle is 2D only' "$dynmesh" mesh "$data/final3d.txt" $dim --postprocess quadtree \
+        --min-angle 10 -o e
+      # shellcheck disable=SC2086
+      expect_error 2 '--svg draws 2D meshes only' "$dynmesh" mesh "$data/final3d.txt" $dim --svg e.svg -o e
+    done
+    expect_error 2 '--postprocess hpu is 2D only' "$dynmesh" mesh "$data/points3d.node" --postprocess hpu -o e
+    [[ ! -e e.node && ! -e e.svg ]] || fail "a refused run wrote its output"
+    # Bad edit lines (a wrong count, an absent point, a point outside the box): one line naming
+    # the line, exit 1, and the files of the earlier run as they were.
+    for f in node ele feed; do cp "dyn.$f" "saved.$f"; done
+    { head -3 "$data/edits3d.txt"; echo '+ 1.5 2.5'; } >count3.txt
+    { head -3 "$data/edits3d.txt"; echo '- 1.5 2.5 3.5'; } >absent3.txt
+    { head -3 "$data/edits3d.txt"; echo '+ 100 0 0'; } >outside3.txt
+    expect_error 1 'count3.txt:4: an edit needs exactly 3 coordinates' "$dynmesh" mesh "$data/points3d.node" \
+      --edits count3.txt -o dyn --feed dyn.feed
+    for batch in "" "--batch 2"; do
+      # shellcheck disable=SC2086  # $batch is zero or two words
+      expect_error 1 'absent3.txt:4: ' "$dynmesh" mesh "$data/points3d.node" --edits absent3.txt $batch -o dyn \
+        --feed dyn.feed
+      grep -q 'not in the set' err.txt || fail "absent point: unclear message: $(cat err.txt)"
+      # shellcheck disable=SC2086
+      expect_error 1 'outside3.txt:4: insert' "$dynmesh" mesh "$data/points3d.node" --edits outside3.txt $batch \
+        -o dyn --feed dyn.feed
+      grep -qF 'pass --box o1 o2 o3 L' err.txt || fail "no --box hint: $(cat err.txt)"
+    done
+    for f in node ele feed; do cmp "dyn.$f" "saved.$f" || fail "a failed run changed dyn.$f"; done
+    [[ -z $(find . -name '.*.tmp-*') ]] || fail "temporary files left behind: $(find . -name '.*.tmp-*')"
+    # stability --postprocess quadtree in 3D: the same updates as the octree alone, each costing
+    # more (the whole update, tree and mesh), the final mesh verified.
+    run "$dynmesh" stability --dim 3 --dist clusters --n 300 --updates 20 --seed 3 --csv tree.csv
+    run "$dynmesh" stability --dim 3 --dist clusters --n 300 --updates 20 --seed 3 --postprocess quadtree \
+      --csv mesh.csv
+    grep -q '^stability: octree mesh, clusters 3D' out.txt || fail "the 3D mesh run: $(cat out.txt)"
+    [[ $(wc -l <mesh.csv) -eq 21 ]] || fail "3D mesh CSV: expected header + 20 rows"
+    paste -d, <(tail -n +2 tree.csv) <(tail -n +2 mesh.csv) | awk -F, '$2 != 3 || $4 != $11 || $5 != $12 ||
+      $13 <= $6 { bad = 1; print } END { exit bad }' || fail "3D mesh rows do not follow the octree rows"
+    run "$dynmesh" stability --points "$data/points3d.node" --edits "$data/edits3d.txt" --csv ptree.csv
+    run "$dynmesh" stability --points "$data/points3d.node" --edits "$data/edits3d.txt" --postprocess quadtree \
+      --csv pmesh.csv
+    [[ $(wc -l <pmesh.csv) -eq $((edits + 1)) ]] || fail "3D --points: expected header + $edits rows"
+    paste -d, <(tail -n +2 ptree.csv) <(tail -n +2 pmesh.csv) | awk -F, '$1 != "points3d" || $2 != 3 || $4 != $11 ||
+      $5 != $12 || $13 <= $6 { bad = 1; print } END { exit bad }' || fail "3D --points mesh rows"
     ;;
 
   *)

@@ -15,11 +15,14 @@
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh.hpp"
+#include "text_test_support.hpp"
 
 namespace {
 
 using namespace dynmesh;
 using Kind = InputError::Kind;
+using dynmesh_test::input_error_kind;
+using dynmesh_test::lines_of;
 
 Box<2> square(double o1, double o2, double side) { return Box<2>{{o1, o2}, side}; }
 
@@ -45,24 +48,6 @@ std::size_t occurrences(const std::string& text, const std::string& what) {
   std::size_t n = 0;
   for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
   return n;
-}
-
-std::vector<std::string> lines_of(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) out.push_back(line);
-  return out;
-}
-
-template <class F>
-Kind input_error_kind(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.kind();
-  }
-  ADD_FAILURE() << "no InputError thrown";
-  return Kind::Io;
 }
 
 // ---- .node / .ele ----------------------------------------------------------------------------

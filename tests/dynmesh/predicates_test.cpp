@@ -1,13 +1,15 @@
-// predicates_test.cpp — orient2d and incircle (predicates.hpp) against exact GMP arithmetic.
+// predicates_test.cpp — orient2d, incircle, pencil and orient3d (predicates.hpp) against exact
+// GMP arithmetic.
 //
 // Purpose: every case is decided twice, by dynmesh's predicates and by an exact evaluation of
 // the same determinant in GMP integers, and the two signs must agree on every case. Three
 // families of input, each from fixed seeds (printed through SCOPED_TRACE):
 //   random            – 10^6 cases per predicate (fewer in slow builds), from four mixes:
 //                       uniform, a small integer grid, wide exponents, tight clusters;
-//   nearly degenerate – a few ulps (std::nextafter) off collinear and cocircular inputs,
-//                       including the 256×256 orient2d grid of Kettner et al.;
-//   exactly degenerate – lattice points on x²+y²=r², collinear lattices, both scaled by
+//   nearly degenerate – a few ulps (std::nextafter) off collinear, cocircular and coplanar
+//                       inputs, including the 256×256 orient2d grid of Kettner et al. and
+//                       its orient3d analogue on a plane;
+//   exactly degenerate – lattice points on x²+y²=r², collinear and coplanar lattices, scaled by
 //                       powers of two up to 2^±1000, the same rounded by decimal scales
 //                       (1e15 … 1e300, 1e-300, subnormal), and mixed magnitudes up to
 //                       DBL_MAX.
@@ -61,6 +63,9 @@ struct OrientCase {
 struct IncircleCase {
   Point<2> a, b, c, d;
 };
+struct Orient3dCase {
+  Point<3> a, b, c, d;
+};
 
 std::string describe(const OrientCase& k) {
   return "orient2d" + dynmesh::to_string<2>(k.a) + dynmesh::to_string<2>(k.b) +
@@ -70,10 +75,14 @@ std::string describe(const IncircleCase& k) {
   return "incircle" + dynmesh::to_string<2>(k.a) + dynmesh::to_string<2>(k.b) +
          dynmesh::to_string<2>(k.c) + dynmesh::to_string<2>(k.d);
 }
+std::string describe(const Orient3dCase& k) {
+  return "orient3d" + dynmesh::to_string<3>(k.a) + dynmesh::to_string<3>(k.b) +
+         dynmesh::to_string<3>(k.c) + dynmesh::to_string<3>(k.d);
+}
 
 // --- the exact reference ------------------------------------------------------------------
 
-/// Exact signs of the two determinants in GMP integers. Members are reused scratch space, so
+/// Exact signs of the three determinants in GMP integers. Members are reused scratch space, so
 /// evaluation allocates only when a case needs more limbs than the previous ones.
 class ExactSign {
  public:
@@ -104,6 +113,28 @@ class ExactSign {
     add_lift_times_minor(ax_, ay_, bx_, by_, cx_, cy_);  // alift · (bx·cy − cx·by)
     add_lift_times_minor(bx_, by_, cx_, cy_, ax_, ay_);  // blift · (cx·ay − ax·cy)
     add_lift_times_minor(cx_, cy_, ax_, ay_, bx_, by_);  // clift · (ax·by − bx·ay)
+    return sgn(det_);
+  }
+
+  int orient3d(const Orient3dCase& k) {
+    load(std::array{k.a[0], k.a[1], k.a[2], k.b[0], k.b[1], k.b[2], k.c[0], k.c[1], k.c[2], k.d[0], k.d[1],
+                    k.d[2]});
+    // det [b − a, c − a, d − a], expanded along b − a = (bx, by, bz); c − a and d − a are
+    // (cx, cy, cz) and (ax, ay, az) here, reusing the 2D scratch names.
+    bx_ = v_[3] - v_[0];
+    by_ = v_[4] - v_[1];
+    bz_ = v_[5] - v_[2];
+    cx_ = v_[6] - v_[0];
+    cy_ = v_[7] - v_[1];
+    cz_ = v_[8] - v_[2];
+    ax_ = v_[9] - v_[0];
+    ay_ = v_[10] - v_[1];
+    az_ = v_[11] - v_[2];
+    det_ = bx_ * (cy_ * az_ - cz_ * ay_);
+    minor_ = cx_ * az_ - cz_ * ax_;
+    det_ -= by_ * minor_;
+    minor_ = cx_ * ay_ - cy_ * ax_;
+    det_ += bz_ * minor_;
     return sgn(det_);
   }
 
@@ -145,8 +176,8 @@ class ExactSign {
     det_ += t1_;
   }
 
-  std::array<mpz_class, 8> v_;
-  mpz_class ax_, ay_, bx_, by_, cx_, cy_, t1_, t2_, lift_, minor_, det_;
+  std::array<mpz_class, 12> v_;
+  mpz_class ax_, ay_, az_, bx_, by_, bz_, cx_, cy_, cz_, t1_, t2_, lift_, minor_, det_;
 };
 
 // --- tallies ------------------------------------------------------------------------------
@@ -170,6 +201,7 @@ struct Tally {
 
 using OrientFn = int (*)(const Point<2>&, const Point<2>&, const Point<2>&);
 using IncircleFn = int (*)(const Point<2>&, const Point<2>&, const Point<2>&, const Point<2>&);
+using Orient3dFn = int (*)(const Point<3>&, const Point<3>&, const Point<3>&, const Point<3>&);
 
 Tally check(std::span<const OrientCase> cases, OrientFn fn = dynmesh::orient2d) {
   ExactSign exact;
@@ -182,6 +214,13 @@ Tally check(std::span<const IncircleCase> cases, IncircleFn fn = dynmesh::incirc
   ExactSign exact;
   Tally t;
   for (const auto& k : cases) t.record(k, fn(k.a, k.b, k.c, k.d), exact.incircle(k));
+  return t;
+}
+
+Tally check(std::span<const Orient3dCase> cases, Orient3dFn fn = dynmesh::orient3d) {
+  ExactSign exact;
+  Tally t;
+  for (const auto& k : cases) t.record(k, fn(k.a, k.b, k.c, k.d), exact.orient3d(k));
   return t;
 }
 
@@ -201,6 +240,12 @@ int naive_incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, cons
                      (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady);
   return (det > 0) - (det < 0);
 }
+int naive_orient3d(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d) {
+  const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2], vx = c[0] - a[0], vy = c[1] - a[1],
+               vz = c[2] - a[2], wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
+  const double det = ux * (vy * wz - vz * wy) - uy * (vx * wz - vz * wx) + uz * (vx * wy - vy * wx);
+  return (det > 0) - (det < 0);
+}
 
 // --- generators ---------------------------------------------------------------------------
 
@@ -211,29 +256,43 @@ double ulps(double x, int k) {
   return x;
 }
 Point<2> ulps(const Point<2>& p, int kx, int ky) { return {ulps(p[0], kx), ulps(p[1], ky)}; }
+Point<3> ulps(const Point<3>& p, int kx, int ky, int kz) { return {ulps(p[0], kx), ulps(p[1], ky), ulps(p[2], kz)}; }
 
-Point<2> scaled(const Point<2>& p, double s) { return {p[0] * s, p[1] * s}; }
+template <std::size_t d>
+Point<d> scaled(const Point<d>& p, double s) {
+  Point<d> out;
+  for (std::size_t a = 0; a < d; ++a) out[a] = p[a] * s;
+  return out;
+}
 
-/// Random points from one of four mixes, picked per case: uniform in [−1, 1]²; integers in
+/// Random points from one of four mixes, picked per case: uniform in [−1, 1]^d; integers in
 /// [−4, 4] (many exact zeros); sign·[1, 2)·2^[−30, 30] per coordinate; a cluster of width
-/// 1e-9 around a center in [−1e6, 1e6]² (coordinates a few ulps apart).
+/// 1e-9 around a center in [−1e6, 1e6]^d (coordinates a few ulps apart). Coordinates are
+/// drawn in axis order, so the 2D sequences do not depend on the 3D use.
+template <std::size_t d = 2>
 class RandomPoints {
  public:
   explicit RandomPoints(std::uint64_t seed) : rng_(seed) {}
 
   int next_mix() { return static_cast<int>(rng_() % 4); }
 
-  Point<2> point(int mix) {
-    switch (mix) {
-      case 0: return {unit_(rng_), unit_(rng_)};
-      case 1: return {static_cast<double>(small_(rng_)), static_cast<double>(small_(rng_))};
-      case 2: return {wide(), wide()};
-      default: return {center_[0] + 1e-9 * unit_(rng_), center_[1] + 1e-9 * unit_(rng_)};
+  Point<d> point(int mix) {
+    Point<d> p;
+    for (std::size_t a = 0; a < d; ++a) {
+      switch (mix) {
+        case 0: p[a] = unit_(rng_); break;
+        case 1: p[a] = static_cast<double>(small_(rng_)); break;
+        case 2: p[a] = wide(); break;
+        default: p[a] = center_[a] + 1e-9 * unit_(rng_); break;
+      }
     }
+    return p;
   }
 
   /// A fresh cluster center (mix 3) for the next case.
-  void recenter() { center_ = {1e6 * unit_(rng_), 1e6 * unit_(rng_)}; }
+  void recenter() {
+    for (std::size_t a = 0; a < d; ++a) center_[a] = 1e6 * unit_(rng_);
+  }
 
  private:
   double wide() {
@@ -246,7 +305,7 @@ class RandomPoints {
   std::uniform_real_distribution<double> unit_{-1.0, 1.0};
   std::uniform_int_distribution<int> small_{-4, 4};
   std::uniform_int_distribution<int> exponent_{-30, 30};
-  Point<2> center_{0.0, 0.0};
+  Point<d> center_{};
 };
 
 /// The integer points of the circle x² + y² = r², sorted by angle (counter-clockwise).
@@ -564,6 +623,158 @@ TEST(Predicates, MixedMagnitudesAgreeWithGmp) {
   EXPECT_GT(c.exact_zeros, 0u);
 }
 
+// --- orient3d ----------------------------------------------------------------------------
+
+TEST(Predicates, Orient3dConvention) {
+  // The unit tetrahedron is positive (FORMATS.md's orientation); an odd permutation flips it,
+  // an even one (a rotation of three corners) keeps it.
+  const Point<3> o{0, 0, 0}, x{1, 0, 0}, y{0, 1, 0}, z{0, 0, 1};
+  EXPECT_EQ(dynmesh::orient3d(o, x, y, z), 1);
+  EXPECT_EQ(dynmesh::orient3d(o, y, x, z), -1);
+  EXPECT_EQ(dynmesh::orient3d(x, y, o, z), 1);
+  EXPECT_EQ(dynmesh::orient3d(o, x, y, Point<3>{1, 1, 0}), 0);  // coplanar
+  EXPECT_EQ(dynmesh::orient3d(o, x, x, z), 0);                  // repeated point
+  // Below the plane of a counter-clockwise (seen from +z) triangle: negative.
+  EXPECT_EQ(dynmesh::orient3d(o, x, y, Point<3>{0.25, 0.25, -1e-300}), -1);
+  // Far from the unit scale the filter overflows or underflows; the exact stage decides.
+  for (const double s : {0x1p1000, 0x1p-1000, 5e-324 * 0x1p10}) {
+    EXPECT_EQ(dynmesh::orient3d(o, scaled(x, s), scaled(y, s), scaled(z, s)), 1) << s;
+    EXPECT_EQ(dynmesh::orient3d(o, scaled(y, s), scaled(x, s), scaled(z, s)), -1) << s;
+  }
+  // CGAL's sign convention, where the filter does not decide: its exact stage called directly.
+  EXPECT_EQ(dynmesh::detail::orient3d_exact(o, x, y, z), 1);
+  EXPECT_EQ(dynmesh::detail::orient3d_exact(o, y, x, z), -1);
+  EXPECT_EQ(dynmesh::detail::orient3d_exact(o, x, y, Point<3>{1, 1, 0}), 0);
+  ExactSign exact;
+  EXPECT_EQ(exact.orient3d({o, x, y, z}), 1);
+  EXPECT_EQ(exact.orient3d({o, y, x, z}), -1);
+  EXPECT_EQ(exact.orient3d({{0.5, 0.5, 0.5}, {12, 12, 12}, {24, 24, 24}, {1, 2, 3}}), 0);
+  // The 2D reference's case lifted: a, b, c in the plane z = 0, counter-clockwise by about
+  // 1e-300 (seen from +z), and d above it.
+  EXPECT_EQ(exact.orient3d({{1e-300, 0, 0}, {0, 1e300, 0}, {5e-324, 5e-324, 0}, {0, 0, 1}}), 1);
+  EXPECT_EQ(dynmesh::orient3d({1e-300, 0, 0}, {0, 1e300, 0}, {5e-324, 5e-324, 0}, {0, 0, 1}), 1);
+}
+
+/// Random points, as the 2D families, in 3D.
+TEST(Predicates, Orient3dRandomAgreesWithGmp) {
+  constexpr std::uint64_t kSeed = 20261207;
+  SCOPED_TRACE(seed_trace(kSeed) + ", cases " + std::to_string(kRandomCases));
+  RandomPoints<3> gen(kSeed);
+  ExactSign exact;
+  Tally t;
+  for (std::size_t i = 0; i < kRandomCases; ++i) {
+    const int mix = gen.next_mix();
+    gen.recenter();
+    const Orient3dCase k{gen.point(mix), gen.point(mix), gen.point(mix), gen.point(mix)};
+    t.record(k, dynmesh::orient3d(k.a, k.b, k.c, k.d), exact.orient3d(k));
+  }
+  EXPECT_AGREES(t);
+  EXPECT_GT(t.exact_zeros, 0u);
+}
+
+/// Kettner et al.'s grid on a plane: a = (0.5 + i·2^-53, 0.5 + j·2^-53, 1) near the plane
+/// z = x + y through b, c, d, i, j < 256, in the four cyclic rotations.
+std::vector<Orient3dCase> planar_grid() {
+  std::vector<Orient3dCase> cases;
+  const double u = std::ldexp(1.0, -53);
+  const Point<3> b{12, 12, 24}, c{24, 12, 36}, d{3, 20, 23};
+  for (int i = 0; i < 256; ++i)
+    for (int j = 0; j < 256; ++j) {
+      const Point<3> a{0.5 + i * u, 0.5 + j * u, 1.0};
+      cases.push_back({a, b, c, d});
+      cases.push_back({b, c, d, a});
+      cases.push_back({c, d, a, b});
+      cases.push_back({d, a, b, c});
+    }
+  return cases;
+}
+
+/// d on the plane through random a, b, c (rounded), then moved by up to 2 ulps per axis, at
+/// scales from 1e-200 to 1e300.
+std::vector<Orient3dCase> near_coplanar(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), along(-1.0, 2.0);
+  std::uniform_int_distribution<int> nudge(-2, 2);
+  std::vector<Orient3dCase> cases;
+  for (double s : {1.0, 0x1p40, 0x1p-40, 1e200, 1e-200, 1e300}) {
+    for (int i = 0; i < 5000; ++i) {
+      const auto random_point = [&] { return Point<3>{s * unit(rng), s * unit(rng), s * unit(rng)}; };
+      const Point<3> a = random_point(), b = random_point(), c = random_point();
+      const double t1 = along(rng), t2 = along(rng);
+      Point<3> d;
+      for (std::size_t k = 0; k < 3; ++k) d[k] = a[k] + t1 * (b[k] - a[k]) + t2 * (c[k] - a[k]);
+      cases.push_back({a, b, c, ulps(d, nudge(rng), nudge(rng), nudge(rng))});
+    }
+  }
+  return cases;
+}
+
+TEST(Predicates, Orient3dNearlyDegenerateAgreesWithGmp) {
+  const Tally grid = check(planar_grid());
+  EXPECT_AGREES(grid);
+  EXPECT_GT(grid.exact_zeros, 0u);
+  constexpr std::uint64_t kSeed = 7003;
+  SCOPED_TRACE(seed_trace(kSeed));
+  const Tally random = check(near_coplanar(kSeed));
+  EXPECT_AGREES(random);
+  // The harness can fail here: the textbook double determinant disagrees with GMP.
+  EXPECT_GT(check(planar_grid(), naive_orient3d).mismatches, 0u);
+  EXPECT_GT(check(near_coplanar(kSeed), naive_orient3d).mismatches, 0u);
+}
+
+/// Quadruples of o + i·u + j·v, i, j ∈ [−100, 100], for a random integer o ∈ [−10^6, 10^6]³
+/// and directions u, v ∈ [−1000, 1000]³, scaled by s: coplanar (and below 2^21, so exact
+/// under the power-of-two scales).
+std::vector<Orient3dCase> coplanar_quadruples(std::uint64_t seed, double s, int n) {
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> shift(-1'000'000, 1'000'000), dir(-1000, 1000), step(-100, 100);
+  std::vector<Orient3dCase> cases;
+  const auto draw = [&](std::uniform_int_distribution<int>& dist) {
+    return Point<3>{static_cast<double>(dist(rng)), static_cast<double>(dist(rng)), static_cast<double>(dist(rng))};
+  };
+  for (int i = 0; i < n; ++i) {
+    const Point<3> o = draw(shift), u = draw(dir), v = draw(dir);
+    auto at = [&] {
+      const double j = step(rng), k = step(rng);
+      return scaled(Point<3>{o[0] + j * u[0] + k * v[0], o[1] + j * u[1] + k * v[1], o[2] + j * u[2] + k * v[2]}, s);
+    };
+    cases.push_back({at(), at(), at(), at()});
+  }
+  return cases;
+}
+
+TEST(Predicates, Orient3dExactlyDegenerateAgreesWithGmp) {
+  constexpr std::uint64_t kSeed = 9004;
+  SCOPED_TRACE(seed_trace(kSeed));
+  for (double s : kExactScales) {
+    SCOPED_TRACE("exact scale " + dynmesh::format_exact(s));
+    const Tally t = check(coplanar_quadruples(kSeed, s, 2000));
+    EXPECT_AGREES(t);
+    EXPECT_EQ(t.exact_zeros, t.cases);  // the reference sees the construction
+  }
+  for (double s : kRoundingScales) {
+    SCOPED_TRACE("rounding scale " + dynmesh::format_exact(s));
+    EXPECT_AGREES(check(coplanar_quadruples(kSeed, s, 2000)));
+  }
+}
+
+/// As MixedMagnitudesAgreeWithGmp: a pool from the smallest subnormal to DBL_MAX.
+TEST(Predicates, Orient3dMixedMagnitudesAgreeWithGmp) {
+  constexpr std::array<double, 15> kPool{0.0, 5e-324, 3e-320, 2.2250738585072014e-308, 1e-300,
+                                         1e-150, 0.1, 1.0, 3.0, 1e15, 1e15 + 1, 1e150, 1e300,
+                                         0x1p-1000, std::numeric_limits<double>::max()};
+  constexpr std::uint64_t kSeed = 9005;
+  SCOPED_TRACE(seed_trace(kSeed));
+  std::mt19937_64 rng(kSeed);
+  auto coord = [&] { return ((rng() & 1) ? -1.0 : 1.0) * kPool[rng() % kPool.size()]; };
+  auto point = [&] { return Point<3>{coord(), coord(), coord()}; };
+  std::vector<Orient3dCase> cases;
+  for (int i = 0; i < 20000; ++i) cases.push_back({point(), point(), point(), point()});
+  const Tally t = check(cases);
+  EXPECT_AGREES(t);
+  EXPECT_GT(t.exact_zeros, 0u);
+}
+
 // --- the pencil of circles through p and q (DynHPU's leaves) -------------------------------
 
 /// The definition, in rationals: is |x − c|² − |p − c|² (c = m + h·J(q − p)) positive?
@@ -652,18 +863,29 @@ TEST(Predicates, FarFromTheUnitScaleTheFiltersStillDecide) {
   constexpr std::uint64_t kSeed = 20261206;
   SCOPED_TRACE(seed_trace(kSeed));
   RandomPoints gen(kSeed);
+  RandomPoints<3> gen3(kSeed + 1);
   std::mt19937_64 rng(kSeed);
   std::array<std::vector<OrientCase>, 3> orient;
   std::array<std::vector<IncircleCase>, 3> circle;
+  std::array<std::vector<Orient3dCase>, 3> solid;
   std::array<std::uint64_t, 3> pencil_exact{};
   constexpr std::array<int, 3> kScales{0, 960, -960};
-  const auto at = [](const Point<2>& p, int e) { return Point<2>{std::ldexp(p[0], e), std::ldexp(p[1], e)}; };
-  const auto exact_scale = [&](const Point<2>& p) {
+  const auto at = []<std::size_t d>(const Point<d>& p, int e) {
+    Point<d> out;
+    for (std::size_t k = 0; k < d; ++k) out[k] = std::ldexp(p[k], e);
+    return out;
+  };
+  const auto exact_scale = [&](const auto& p) {
     return at(at(p, 960), -960) == p && at(at(p, -960), 960) == p;  // nothing rounded
   };
   for (std::size_t i = 0; i < kRandomCases / 20; ++i) {
     const int mix = gen.next_mix();
     gen.recenter();
+    gen3.recenter();
+    const Point<3> p = gen3.point(mix), q = gen3.point(mix), r = gen3.point(mix), t = gen3.point(mix);
+    if (exact_scale(p) && exact_scale(q) && exact_scale(r) && exact_scale(t))
+      for (std::size_t s = 0; s < kScales.size(); ++s)
+        solid[s].push_back({at(p, kScales[s]), at(q, kScales[s]), at(r, kScales[s]), at(t, kScales[s])});
     const Point<2> a = gen.point(mix), b = gen.point(mix), c = gen.point(mix), d = gen.point(mix);
     if (!(exact_scale(a) && exact_scale(b) && exact_scale(c) && exact_scale(d))) continue;
     const double h = 0.5 / std::tan(20.7 * std::numbers::pi / 180) * (rng() % 2 ? 1 : -1);
@@ -676,26 +898,33 @@ TEST(Predicates, FarFromTheUnitScaleTheFiltersStillDecide) {
       pencil_exact[s] += dynmesh::detail::exact_stage_calls() - before;
     }
   }
-  std::array<std::uint64_t, 3> orient_exact{}, circle_exact{};
+  std::array<std::uint64_t, 3> orient_exact{}, circle_exact{}, solid_exact{};
+  // The exact-stage calls of one family, whose signs must all agree with GMP.
+  const auto exact_calls = [](const auto& cases) {
+    const std::uint64_t before = dynmesh::detail::exact_stage_calls();
+    const Tally t = check(cases);
+    const std::uint64_t calls = dynmesh::detail::exact_stage_calls() - before;
+    EXPECT_AGREES(t);
+    return calls;
+  };
   for (std::size_t s = 0; s < kScales.size(); ++s) {
     SCOPED_TRACE("scale 2^" + std::to_string(kScales[s]));
-    std::uint64_t before = dynmesh::detail::exact_stage_calls();
-    const Tally o = check(orient[s]);
-    orient_exact[s] = dynmesh::detail::exact_stage_calls() - before;
-    EXPECT_AGREES(o);
-    before = dynmesh::detail::exact_stage_calls();
-    const Tally c = check(circle[s]);
-    circle_exact[s] = dynmesh::detail::exact_stage_calls() - before;
-    EXPECT_AGREES(c);
+    orient_exact[s] = exact_calls(orient[s]);
+    circle_exact[s] = exact_calls(circle[s]);
+    solid_exact[s] = exact_calls(solid[s]);
   }
-  std::printf("[ Predicates ] %zu cases: exact-stage calls orient2d %llu, incircle %llu, pencil %llu at the unit scale\n",
+  std::printf("[ Predicates ] %zu cases: exact-stage calls orient2d %llu, incircle %llu, pencil %llu, orient3d %llu "
+              "(of %zu) at the unit scale\n",
               orient[0].size(), static_cast<unsigned long long>(orient_exact[0]),
-              static_cast<unsigned long long>(circle_exact[0]), static_cast<unsigned long long>(pencil_exact[0]));
+              static_cast<unsigned long long>(circle_exact[0]), static_cast<unsigned long long>(pencil_exact[0]),
+              static_cast<unsigned long long>(solid_exact[0]), solid[0].size());
   EXPECT_GT(orient_exact[0] + circle_exact[0], 0u);  // the degenerate cases of the mixes reach it
+  EXPECT_GT(solid_exact[0], 0u);
   for (std::size_t s = 1; s < kScales.size(); ++s) {
     EXPECT_EQ(orient_exact[s], orient_exact[0]) << "orient2d at 2^" << kScales[s];
     EXPECT_EQ(circle_exact[s], circle_exact[0]) << "incircle at 2^" << kScales[s];
     EXPECT_EQ(pencil_exact[s], pencil_exact[0]) << "pencil at 2^" << kScales[s];
+    EXPECT_EQ(solid_exact[s], solid_exact[0]) << "orient3d at 2^" << kScales[s];
   }
 }
 
@@ -718,6 +947,8 @@ TEST(Predicates, FiltersComputeNoSubnormalOnMeshingInput) {
       const auto pt = [&] { return Point<2>{1.5 + u(rng) * scale, 0.25 + u(rng) * scale}; };
       const Point<2> a = pt(), b = pt(), c = pt(), d = pt();
       sum += dynmesh::orient2d(a, b, c) + dynmesh::incircle(a, b, c, d) + dynmesh::pencil(a, b, u(rng), c);
+      const auto pt3 = [&] { return Point<3>{1.5 + u(rng) * scale, 0.25 + u(rng) * scale, -3 + u(rng) * scale}; };
+      sum += dynmesh::orient3d(pt3(), pt3(), pt3(), pt3());
     }
     EXPECT_FALSE(std::fetestexcept(FE_UNDERFLOW)) << "a filter computed a subnormal number (sum " << sum << ")";
   }

@@ -46,7 +46,7 @@ def read_node_points(path):
 
 
 def read_edits(path):
-    """An edit script as [("+", x, y), ...]."""
+    """An edit script as [("+", x, y[, z]), ...]."""
     edits = []
     for line in pathlib.Path(path).read_text().splitlines():
         fields = line.split("#", 1)[0].split()
@@ -56,24 +56,29 @@ def read_edits(path):
 
 
 def format_node(vertices, box):
-    """The .node text `dynmesh mesh` writes (docs/FORMATS.md): %.17g, marker 1 on the box."""
-    o1, o2, side = box
-    x1, y1 = o1 + side, o2 + side
-    lines = [f"{len(vertices)} 2 0 1"]
-    for i, (x, y) in enumerate(vertices, start=1):
-        on_box = x == o1 or x == x1 or y == o2 or y == y1
-        lines.append("%d %.17g %.17g %d" % (i, x, y, 1 if on_box else 0))
+    """The .node text `dynmesh mesh` writes (docs/FORMATS.md) in 2D or 3D (by the box's
+    length): %.17g, marker 1 on the box boundary."""
+    *origin, side = box
+    dim = len(origin)
+    far = [o + side for o in origin]
+    lines = [f"{len(vertices)} {dim} 0 1"]
+    for i, v in enumerate(vertices, start=1):
+        on_box = any(v[a] == origin[a] or v[a] == far[a] for a in range(dim))
+        lines.append("%d %s %d" % (i, " ".join("%.17g" % c for c in v), 1 if on_box else 0))
     return "\n".join(lines) + "\n"
 
 
-def format_ele(triangles):
-    """The .ele text `dynmesh mesh` writes: numbered from 1, vertices from 1."""
-    lines = [f"{len(triangles)} 3 0"]
-    for i, (a, b, c) in enumerate(triangles, start=1):
-        lines.append(f"{i} {a + 1} {b + 1} {c + 1}")
+def format_ele(cells):
+    """The .ele text `dynmesh mesh` writes: numbered from 1, vertices from 1; triangles
+    (`<#> 3 0`) or tetrahedra (`<#> 4 0`)."""
+    cells = list(cells)
+    per = len(cells[0]) if cells else 3
+    lines = [f"{len(cells)} {per} 0"]
+    for i, c in enumerate(cells, start=1):
+        lines.append(f"{i} " + " ".join(str(v + 1) for v in c))
     return "\n".join(lines) + "\n"
 
 
 def triangle_set(vertices, triangles):
-    """The triangles as a set of corner tuples (the feed's form)."""
+    """The triangles (or tetrahedra) as a set of corner tuples (the feed's form)."""
     return {tuple(map(tuple, vertices[t])) for t in triangles}

@@ -77,7 +77,7 @@ def test_bad_construction():
     expect("Malformed", lambda: dynmesh.triangulate(POINTS, min_angle=[1]))
     expect("Malformed", lambda: dynmesh.Mesh(POINTS, min_angle=25, postprocess="quadtree"))
     expect("Malformed", lambda: dynmesh.Mesh(POINTS, postprocess="delaunay"))
-    expect("Malformed", lambda: dynmesh.Mesh(np.zeros((3, 3))))
+    expect("Malformed", lambda: dynmesh.Mesh(np.zeros((3, 4))))  # (n, 3) is the 3D mesh (test_mesh3d.py)
     expect("Empty", lambda: dynmesh.Mesh(np.empty((0, 2))))
     expect("Malformed", lambda: dynmesh.triangulate(POINTS, min_angle=0.5))
     expect("Duplicate", lambda: dynmesh.triangulate([[0.1, 0.2], [0.1, 0.2]]))

@@ -14,8 +14,12 @@
 //     is one with no vertices of its own (they would be in a separate `.node`).
 //   * `.ele` (Triangle's triangles): refused (Unsupported) with a message naming the format.
 //   * plain text (any other name): one point per non-blank line, fields separated by
-//     whitespace or by ',' / ';' (whitespace around them allowed: "0.5,0.25", "0.5; 0.25");
-//     the first d fields are the coordinates and further columns are ignored (not parsed).
+//     whitespace or by ',' / ';' (whitespace around them allowed: "0.5,0.25", "0.5; 0.25").
+//     Columns::AtLeast (the dimension given, the commands' --dim): the first d fields are
+//     the coordinates and further columns are ignored (not parsed). Columns::Exactly (the
+//     dimension taken from the file, point_file_shape): every line holds exactly d numbers,
+//     as many as the file's first line of numbers, so that a file of `x y z` lines is never
+//     read as its (x, y) projection.
 //     The separators up to the last coordinate's must be of one kind, so that a decimal
 //     comma ("1,5 2") is an error rather than the point (1, 5); an empty field (",,") is an
 //     error. `#` comments are allowed here too. A first line without a single number is a
@@ -23,9 +27,12 @@
 //     shaped like Triangle's formats (a first line starting with two whole numbers, then
 //     rows of three fields or more numbered from 0 or 1, as many as announced) is refused
 //     (Unsupported) naming the format it looks like.
-//   * the path "-" is standard input, read as plain text (named "<stdin>" in messages).
-//   * edit scripts: `+ x y [z]` / `- x y [z]`, exactly d coordinates separated as in plain
-//     text, blank lines and `#` comments ignored. The sign must be a token of its own.
+//   * the path "-" is standard input, read as plain text (named "<stdin>" in messages). It is
+//     read whole on first use, so that point_file_shape can look at its first lines before
+//     read_points_file reads it as points.
+//   * edit scripts: `+ x y [z]` / `- x y [z]`, exactly d coordinates (the points' dimension)
+//     separated as in plain text, blank lines and `#` comments ignored. The sign must be a
+//     token of its own.
 //   * `.cells`: "# dynmesh cells v1", "# dim D", "# box o1 o2 [o3] L" (numbers printed as
 //     %.17g in the C locale), then one line `level i j [k] npoints` per leaf, sorted by
 //     (level, i, j, k); '\n' line ends.
@@ -75,6 +82,11 @@ struct PointFile {
 
 enum class PointFormat { Auto, Node, Plain, Poly, Ele };
 
+/// How many fields of a plain-text line are read (docs/FORMATS.md, "Input points"): with the
+/// dimension given, the first d and further columns ignored (AtLeast); with the dimension
+/// taken from the file, exactly d, on every line (Exactly). `.node` and `.poly` files ignore it.
+enum class Columns { AtLeast, Exactly };
+
 /// By the name's ending, in any letter case: Node for ".node", Poly for ".poly", Ele for
 /// ".ele" (refused by the readers), Plain otherwise.
 PointFormat format_for_path(std::string_view path) noexcept;
@@ -92,18 +104,37 @@ PointFile<d> read_node(std::istream& in, const std::string& name);
 template <std::size_t d>
 PointFile<d> read_poly(std::istream& in, const std::string& name);
 template <std::size_t d>
-PointFile<d> read_plain(std::istream& in, const std::string& name);
+PointFile<d> read_plain(std::istream& in, const std::string& name, Columns columns = Columns::AtLeast);
 /// Reads `in` as `format` (Auto: by the extension of `name`); Ele is refused.
 template <std::size_t d>
-PointFile<d> read_points(std::istream& in, const std::string& name, PointFormat format = PointFormat::Auto);
+PointFile<d> read_points(std::istream& in, const std::string& name, PointFormat format = PointFormat::Auto,
+                         Columns columns = Columns::AtLeast);
 /// Opens `path` (standard input for "-", as plain text unless `format` says otherwise) and
 /// reads it as `format` (Auto: by extension).
 template <std::size_t d>
-PointFile<d> read_points_file(const std::string& path, PointFormat format = PointFormat::Auto);
+PointFile<d> read_points_file(const std::string& path, PointFormat format = PointFormat::Auto,
+                              Columns columns = Columns::AtLeast);
 
 /// The dimension announced by a `.node` file's header (2 when the field is omitted, as in
 /// Triangle). Throws InputError naming the file and line for a malformed header.
 int node_file_dimension(const std::string& path);
+
+/// The dimension of a point file and how its plain-text lines are read.
+struct PointFileShape {
+  int dim = 2;
+  Columns columns = Columns::AtLeast;
+};
+
+/// The dimension rule of docs/FORMATS.md ("Input points"), for a path read by extension as
+/// read_points_file reads it. `dim` is the dimension asked for (the commands' --dim), 0 when
+/// none was. Given, it is the dimension, with Columns::AtLeast (a `.node` or `.poly` header
+/// that announces another is reported when the file is read). Otherwise a `.node` or `.poly`
+/// header decides (2 when it omits the field), and plain text is looked at up to its first
+/// line that holds numbers: their count is the dimension, with Columns::Exactly; a count other
+/// than 2 or 3 is InputError(Count) naming that line and asking for --dim (unless the file
+/// has the shape of Triangle's formats, refused as read_plain refuses it). A file without
+/// any number is 2D. Reads only the first lines, except to tell Triangle's shape.
+PointFileShape point_file_shape(const std::string& path, int dim = 0);
 
 /// Locates every point in `box`, in file order. Throws InputError(OutsideBox) naming the
 /// line of the first point outside the box; for the first point (in file order) whose

@@ -1,12 +1,13 @@
-// dynmesh/predicates.hpp — exact 2D orientation and in-circle predicates.
+// dynmesh/predicates.hpp — exact 2D orientation and in-circle predicates, and 3D orientation.
 //
 // Purpose: the geometric decisions the meshes make (is a triangle counter-clockwise, is a
-// point strictly inside a circumcircle, does a point encroach a segment) decided exactly on IEEE double inputs, so that the
-// static and the self-adjusting meshers, and the mesh checker, never disagree through
-// rounding. Each test first evaluates its determinant in double, inline, and returns the
-// sign when it exceeds Shewchuk's a-priori error bound for that evaluation (his
-// ccwerrboundA and iccerrboundA) plus a small absolute term for the products that underflow
-// (an overflow leaves the comparison undecided); otherwise it asks CGAL's
+// point strictly inside a circumcircle, does a point encroach a segment, is a tetrahedron
+// positively oriented) decided exactly on IEEE double inputs, so that the static and the
+// self-adjusting meshers, and the mesh checkers, never disagree through rounding. Each test
+// first evaluates its determinant in double, inline, and returns the sign when it exceeds
+// Shewchuk's a-priori error bound for that evaluation (his ccwerrboundA, iccerrboundA and
+// o3derrboundA) plus a small absolute term for the products that underflow (an overflow
+// leaves the comparison undecided); otherwise it asks CGAL's
 // Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
 // interval filter with an exact fallback. Before that, a call whose coordinates are so large
 // (or small) that the filter's products overflow (or underflow) is rescaled by a power of
@@ -34,14 +35,17 @@ namespace detail {
 int orient2d_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c) noexcept;
 int incircle_exact(const Point<2>& a, const Point<2>& b, const Point<2>& c, const Point<2>& d) noexcept;
 int pencil_exact(const Point<2>& p, const Point<2>& q, double h, const Point<2>& x) noexcept;
+int orient3d_exact(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d) noexcept;
 /// How many calls on this thread reached exact arithmetic (CGAL's kernel or GMP rationals)
-/// in orient2d, incircle and pencil: for tests and experiments that check the filters decide.
+/// in orient2d, incircle, pencil and orient3d: for tests and experiments that check the
+/// filters decide.
 std::uint64_t exact_stage_calls() noexcept;
 /// Shewchuk's bounds, ε = 2^−53: the error of the double evaluations below is at most
 /// bound × permanent when no intermediate value overflows or underflows.
 inline constexpr double kEpsilon = 0x1p-53;
 inline constexpr double kOrientBound = (3.0 + 16.0 * kEpsilon) * kEpsilon;
 inline constexpr double kIncircleBound = (10.0 + 96.0 * kEpsilon) * kEpsilon;
+inline constexpr double kOrient3dBound = (7.0 + 56.0 * kEpsilon) * kEpsilon;
 /// For pencil(): a term carries at most 5ε of relative error (a rounded difference in each
 /// factor, the product, the h product, a sum) and the final difference ε more; 12ε leaves room.
 inline constexpr double kPencilBound = 12.0 * kEpsilon;
@@ -122,6 +126,35 @@ inline int pencil(const Point<2>& p, const Point<2>& q, double h, const Point<2>
     if (-det > bound) return -1;
   }
   return detail::pencil_exact(p, q, h, x);
+}
+
+/// Sign of det[b − a, c − a, d − a]: +1 when a, b, c, d are positively oriented (d on the
+/// side of the plane abc from which a, b, c turn counter-clockwise; the unit tetrahedron
+/// (0,0,0), (1,0,0), (0,1,0), (0,0,1) is positive), −1 negatively, 0 coplanar. This is
+/// FORMATS.md's orientation of a tetrahedron, and the opposite of Shewchuk's orient3d sign.
+/// Inputs must be finite.
+inline int orient3d(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d) noexcept {
+  // Shewchuk's evaluation, relative to d: his determinant is det[a − d, b − d, c − d], which
+  // is −det[b − a, c − a, d − a], so the signs below are his, negated.
+  const double adx = a[0] - d[0], ady = a[1] - d[1], adz = a[2] - d[2];
+  const double bdx = b[0] - d[0], bdy = b[1] - d[1], bdz = b[2] - d[2];
+  const double cdx = c[0] - d[0], cdy = c[1] - d[1], cdz = c[2] - d[2];
+  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy;
+  const double cdxady = cdx * ady, adxcdy = adx * cdy;
+  const double adxbdy = adx * bdy, bdxady = bdx * ady;
+  const double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+  const double permanent = (std::fabs(bdxcdy) + std::fabs(cdxbdy)) * std::fabs(adz) +
+                           (std::fabs(cdxady) + std::fabs(adxcdy)) * std::fabs(bdz) +
+                           (std::fabs(adxbdy) + std::fabs(bdxady)) * std::fabs(cdz);
+  // As incircle: an underflowed product (off by at most 2^-1075) is multiplied by at most one
+  // difference, below M, so (M + 1)·2^-1000 covers all of them, and stays a normal number;
+  // an overflow leaves both comparisons false.
+  const double m = std::max({std::fabs(adz), std::fabs(bdz), std::fabs(cdz), std::fabs(adx), std::fabs(ady),
+                             std::fabs(bdx), std::fabs(bdy), std::fabs(cdx), std::fabs(cdy)});
+  const double bound = detail::kOrient3dBound * permanent + (m + 1) * detail::kUnderflowRoom;
+  if (det > bound) return -1;
+  if (-det > bound) return 1;
+  return detail::orient3d_exact(a, b, c, d);
 }
 
 /// True when x lies strictly inside the circle with diameter ab, i.e. (a−x)·(b−x) < 0: x

@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include "check/check_support.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/predicates.hpp"
 #include "geometry/powers_of_two.hpp"
@@ -56,18 +57,7 @@ bool MeshReport::ok() const noexcept {
 std::string MeshReport::summary() const {
   if (ok())
     return "mesh ok: angles in [" + format_exact(min_angle_deg) + ", " + format_exact(max_angle_deg) + "] degrees";
-  std::size_t total = 0;
-  std::string kinds;
-  for (std::size_t k = 0; k < kMeshDefectKinds; ++k) {
-    if (counts[k] == 0) continue;
-    total += counts[k];
-    if (!kinds.empty()) kinds += ", ";
-    kinds += std::string(defect_name(static_cast<MeshDefect>(k))) + " " + std::to_string(counts[k]);
-  }
-  std::string s = "mesh invalid: " + std::to_string(total) + " problem" + (total == 1 ? "" : "s") + " (" + kinds + ")";
-  for (const std::string& p : problems) s += "\n  " + p;
-  if (truncated) s += "\n  ... (" + std::to_string(total - problems.size()) + " more)";
-  return s;
+  return detail::invalid_summary<MeshDefect>("mesh", *this);
 }
 
 namespace {
@@ -75,46 +65,19 @@ namespace {
 using Index = std::uint32_t;
 using Tri = std::array<Index, 3>;
 
-// The closed domain: its side lines, computed once as the contract states (fl(o + L)).
-struct Domain {
-  double x0, x1, y0, y1;
-  explicit Domain(const Box<2>& box)
-      : x0(box.origin[0]), x1(box.origin[0] + box.side), y0(box.origin[1]), y1(box.origin[1] + box.side) {}
-  bool contains(const Point<2>& p) const noexcept { return p[0] >= x0 && p[0] <= x1 && p[1] >= y0 && p[1] <= y1; }
-  // Both ends on one side line: the only edges that may be used by one triangle alone.
-  bool on_one_side(const Point<2>& a, const Point<2>& b) const noexcept {
-    return (a[0] == x0 && b[0] == x0) || (a[0] == x1 && b[0] == x1) || (a[1] == y0 && b[1] == y0) ||
-           (a[1] == y1 && b[1] == y1);
-  }
-};
-
-// Collects defects: counts all, keeps the first max_problems messages. The message is built
-// only when it is kept, so a badly broken large mesh stays cheap to check.
-class Recorder {
- public:
-  Recorder(MeshReport& report, std::size_t max_problems) : report_(report), max_(max_problems) {}
-
-  template <class Describe>
-  void add(MeshDefect defect, Describe&& describe) {
-    ++report_.counts[static_cast<std::size_t>(defect)];
-    if (report_.problems.size() < max_) {
-      report_.problems.push_back(std::string(defect_name(defect)) + ": " + describe());
-    } else {
-      report_.truncated = true;
-    }
-  }
-
- private:
-  MeshReport& report_;
-  std::size_t max_;
-};
+// The closed domain B, with its side lines at o and fl(o + L) on each axis.
+using Domain = detail::ClosedBox<2>;
+using Recorder = detail::DefectRecorder<MeshReport, MeshDefect>;
 
 std::string describe_triangle(const Mesh& mesh, std::size_t t) {
   const Tri& tri = mesh.triangles[t];
   std::string s = "triangle " + std::to_string(t) + " [" + std::to_string(tri[0]) + " " + std::to_string(tri[1]) + " " +
                   std::to_string(tri[2]) + "]";
   for (Index i : tri)
-    if (i < mesh.num_vertices()) s += " " + to_string(mesh.vertices[i]);
+    if (i < mesh.num_vertices()) {
+      s += ' ';  // appended apart: " " + string trips GCC 12's -Wrestrict false positive (bug 105651)
+      s += to_string(mesh.vertices[i]);
+    }
   return s;
 }
 
@@ -137,8 +100,8 @@ class VertexTree {
   static constexpr std::size_t kScan = 48;  // runs up to this long are scanned directly
 
   VertexTree(const Mesh& mesh, const Domain& domain)
-      : x0_(domain.x0), y0_(domain.y0), position_(mesh.num_vertices(), kAbsent) {
-    const double width = domain.x1 - domain.x0, height = domain.y1 - domain.y0;
+      : x0_(domain.lo[0]), y0_(domain.lo[1]), position_(mesh.num_vertices(), kAbsent) {
+    const double width = domain.hi[0] - domain.lo[0], height = domain.hi[1] - domain.lo[1];
     sx_ = width > 0 ? 0x1p32 / width : 0;
     sy_ = height > 0 ? 0x1p32 / height : 0;
     std::vector<std::pair<std::uint64_t, Index>> order;
@@ -387,37 +350,10 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
   const auto& vs = mesh.vertices;
 
   // Canonical vertex order. Lookups below need a sorted list; a broken mesh gets a copy.
-  bool vertices_sorted = true;
-  for (std::size_t i = 1; i < nv; ++i) {
-    if (!xy_less(vs[i - 1], vs[i])) {
-      vertices_sorted = false;
-      record.add(MeshDefect::Canonical, [&] {
-        return "vertices " + std::to_string(i - 1) + " " + to_string(vs[i - 1]) + " and " + std::to_string(i) + " " +
-               to_string(vs[i]) + " are not in strictly increasing (x, y) order";
-      });
-    }
-  }
-  std::vector<Point<2>> sorted_copy;
-  if (!vertices_sorted) {
-    sorted_copy = vs;
-    std::sort(sorted_copy.begin(), sorted_copy.end(),
-              [](const Point<2>& l, const Point<2>& r) { return xy_less(l, r); });
-  }
-  const std::vector<Point<2>>& lookup = vertices_sorted ? vs : sorted_copy;
-  auto is_vertex = [&](const Point<2>& p) {
-    const auto it = std::lower_bound(lookup.begin(), lookup.end(), p,
-                                     [](const Point<2>& l, const Point<2>& r) { return xy_less(l, r); });
-    return it != lookup.end() && !xy_less(p, *it);
-  };
-
-  for (Index i = 0; i < nv; ++i)
-    if (!domain.contains(vs[i]))
-      record.add(MeshDefect::OutsideBox, [&] { return describe_vertex(mesh, i) + " is outside the box"; });
-  const Point<2> corners[4] = {
-      {domain.x0, domain.y0}, {domain.x1, domain.y0}, {domain.x0, domain.y1}, {domain.x1, domain.y1}};
-  for (const Point<2>& c : corners)
-    if (!is_vertex(c))
-      record.add(MeshDefect::MissingCorner, [&] { return "box corner " + to_string(c) + " is not a vertex"; });
+  const bool vertices_sorted = detail::check_vertex_order<MeshDefect>(vs, &xy_less, "(x, y)", record);
+  const detail::PointLookup<2, decltype(&xy_less)> lookup(vs, vertices_sorted, &xy_less);
+  detail::check_box<MeshDefect>(vs, domain, lookup, record,
+                                [&](std::size_t i) { return describe_vertex(mesh, static_cast<Index>(i)); });
 
   // Per triangle: indices, canonical rotation and order, orientation, area, angles. Areas are
   // in units of 2^(2k) with 2^k <= L < 2^(k+1) (exact scaling), so that neither the box's
@@ -425,7 +361,7 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
   const int side_exponent = std::isfinite(box.side) && box.side > 0 ? std::ilogb(box.side) : 0;
   auto scaled = [&](double length) { return std::ldexp(length, -side_exponent); };
   std::vector<char> well_formed(nt, 0), ccw(nt, 0);
-  double area = 0, area_compensation = 0;  // Neumaier summation: 10^6 terms of mixed sizes
+  detail::CompensatedSum area;
   double min_angle = std::numeric_limits<double>::infinity(), max_angle = 0;
   for (std::size_t t = 0; t < nt; ++t) {
     const Tri& tri = mesh.triangles[t];
@@ -451,9 +387,7 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
     }
     const double twice =
         scaled(b[0] - a[0]) * scaled(c[1] - a[1]) - scaled(b[1] - a[1]) * scaled(c[0] - a[0]);
-    const double sum = area + twice;
-    area_compensation += std::abs(area) >= std::abs(twice) ? (area - sum) + twice : (twice - sum) + area;
-    area = sum;
+    area.add(twice);
 
     const double angles[3] = {corner_angle_deg(a, b, c), corner_angle_deg(b, c, a), corner_angle_deg(c, a, b)};
     const double lo = std::min({angles[0], angles[1], angles[2]}), hi = std::max({angles[0], angles[1], angles[2]});
@@ -470,8 +404,8 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
     report.max_angle_deg = max_angle;
   }
 
-  const double box_area = scaled(domain.x1 - domain.x0) * scaled(domain.y1 - domain.y0);
-  const double mesh_area = (area + area_compensation) / 2;
+  const double box_area = scaled(domain.hi[0] - domain.lo[0]) * scaled(domain.hi[1] - domain.lo[1]);
+  const double mesh_area = area.value() / 2;
   if (!(std::abs(mesh_area - box_area) <= 1e-9 * box_area))
     record.add(MeshDefect::Area, [&] {
       const std::string unit = side_exponent == 0 ? "" : " (in units of 2^" + std::to_string(2 * side_exponent) + ")";
@@ -504,7 +438,7 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
       const std::size_t reverse = back.first;
       const Index across = back.second;
       if (reverse == 0) {
-        if (!domain.on_one_side(vs[u], vs[v]))
+        if (!domain.on_one_side(std::array{vs[u], vs[v]}))
           record.add(MeshDefect::OpenEdge, [&] {
             return "edge " + std::to_string(u) + " -> " + std::to_string(v) + " " + to_string(vs[u]) + " -> " +
                    to_string(vs[v]) + " of triangle " + std::to_string(t) +
@@ -541,10 +475,7 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
     });
   }
 
-  for (std::size_t i = 0; i < inputs.size(); ++i)
-    if (!is_vertex(inputs[i]))
-      record.add(MeshDefect::MissingInput,
-                 [&] { return "input point " + std::to_string(i) + " " + to_string(inputs[i]) + " is not a vertex"; });
+  detail::check_inputs<MeshDefect>(inputs, lookup, record);
   return report;
 }
 

@@ -1,7 +1,7 @@
-// predicates.cpp — the exact stage of orient2d and incircle, and encroaches, on CGAL's
-// filtered kernel (see predicates.hpp).
+// predicates.cpp — the exact stage of orient2d, incircle and orient3d, and encroaches, on
+// CGAL's filtered kernel (see predicates.hpp).
 //
-// Purpose: the only translation unit that sees CGAL. Both predicates forward to
+// Purpose: the only translation unit that sees CGAL. The predicates forward to
 // Exact_predicates_inexact_constructions_kernel, whose predicates are filtered: a static
 // error bound on the double evaluation, then interval arithmetic, then exact rationals (GMP)
 // when neither can certify the sign.
@@ -30,8 +30,10 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using KPoint = Kernel::Point_2;
+using KPoint3 = Kernel::Point_3;
 
 KPoint to_kernel(const Point<2>& p) noexcept { return KPoint(p[0], p[1]); }
+KPoint3 to_kernel(const Point<3>& p) noexcept { return KPoint3(p[0], p[1], p[2]); }
 
 thread_local std::uint64_t exact_evaluations = 0;
 
@@ -47,19 +49,21 @@ constexpr double kRescaleBelow = 0x1p-200;
 /// magnitude is outside [2^-200, 2^200] and every coordinate scales exactly; returns whether
 /// it did. A common positive scale leaves each sign unchanged: orient2d, encroachment and the
 /// pencil's determinant are homogeneous of degree 2 in the coordinates, incircle of degree 4,
-/// and the pencil's h is a ratio. So a call whose inline filter overflowed (a fuzzed input
-/// near 10^291 sent every call to GMP) is decided by the filters again.
-template <std::size_t N>
-bool rescale(std::array<Point<2>, N>& pts) noexcept {
+/// orient3d of degree 3, and the pencil's h is a ratio. So a call whose inline filter
+/// overflowed (a fuzzed input near 10^291 sent every call to GMP) is decided by the filters
+/// again.
+template <std::size_t d, std::size_t N>
+bool rescale(std::array<Point<d>, N>& pts) noexcept {
   double m = 0;
-  for (const auto& p : pts) m = std::max({m, std::fabs(p[0]), std::fabs(p[1])});
+  for (const auto& p : pts)
+    for (std::size_t c = 0; c < d; ++c) m = std::max(m, std::fabs(p[c]));
   if (!(m > kRescaleAbove || (m < kRescaleBelow && m > 0))) return false;
   // 2^−(⌊log2 m⌋ + 1), though never above 2^1000: for m down to 2^−1074 the result's
   // largest coordinate is then at least 2^−74, so no call rescales twice.
   const double s = detail::pow2(std::min(-detail::exponent_of(m) - 1, 1000));
-  std::array<Point<2>, N> scaled;
+  std::array<Point<d>, N> scaled;
   for (std::size_t i = 0; i < N; ++i)
-    for (int c = 0; c < 2; ++c) {
+    for (std::size_t c = 0; c < d; ++c) {
       // A product by a power of two is exact unless it rounds into the subnormal range,
       // which only a scale below 1 can do, and which the way back then detects.
       const double x = pts[i][c], y = x * s;
@@ -108,6 +112,14 @@ int detail::pencil_exact(const Point<2>& p, const Point<2>& q, double h, const P
   const Q px(p[0]), py(p[1]), qx(q[0]), qy(q[1]), xx(x[0]), xy(x[1]), hh(h);
   const Q det = (xx - px) * (xx - qx) + (xy - py) * (xy - qy) - 2 * hh * ((qx - px) * (xy - py) - (qy - py) * (xx - px));
   return CGAL::sign(det);
+}
+
+int detail::orient3d_exact(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d) noexcept {
+  if (std::array pts{a, b, c, d}; rescale(pts)) return orient3d(pts[0], pts[1], pts[2], pts[3]);
+  ++exact_evaluations;
+  // CGAL's POSITIVE == +1 is the sign of det[b − a, c − a, d − a]: the unit tetrahedron is
+  // positive in both (tests/dynmesh/predicates_test.cpp, Predicates.Orient3dConvention).
+  return static_cast<int>(Kernel::Orientation_3()(to_kernel(a), to_kernel(b), to_kernel(c), to_kernel(d)));
 }
 
 bool encroaches(const Point<2>& a, const Point<2>& b, const Point<2>& x) noexcept {

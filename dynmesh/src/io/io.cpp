@@ -11,10 +11,14 @@
 #include <iostream>
 #include <istream>
 #include <limits>
+#include <iterator>
 #include <numeric>
+#include <optional>
 #include <ostream>
 #include <sstream>
+#include <streambuf>
 #include <system_error>
+#include <utility>
 
 #include "dynmesh/errors.hpp"
 
@@ -472,7 +476,7 @@ class NumberedRows {
   }
 
   void row(const std::vector<std::string_view>& f) {
-    if (!candidate_ || rows_ == count_) return;
+    if (settled()) return;
     long long id = 0;
     if (f.size() < 3 || !whole(f[0], id) || (rows_ == 0 ? id != 0 && id != 1 : id != base_ + rows_)) {
       candidate_ = false;
@@ -484,6 +488,30 @@ class NumberedRows {
     for (std::size_t k = 1; k < f.size() && ints; ++k) ints = whole(f[k], id);
     all_integer_ = all_integer_ && ints;
     ++rows_;
+  }
+
+  /// No later row can change the verdict: the file is no candidate, or every announced row
+  /// has been seen.
+  bool settled() const noexcept { return !candidate_ || rows_ >= count_; }
+
+  /// After an error (or a first line that sets no dimension): feeds the rows that follow
+  /// until the verdict is settled, then throws as check() does. A line too broken to split
+  /// ends the look (the caller's own error is then the one reported).
+  void check_after_error(LineReader& r, std::size_t header_line) {
+    std::vector<std::string_view> f;
+    bool at_end = false;
+    try {
+      while (!settled()) {
+        if (!r.next(f)) {
+          at_end = true;
+          break;
+        }
+        row(f);
+      }
+    } catch (const InputError&) {
+      return;
+    }
+    check(r, header_line, at_end);
   }
 
   /// Throws InputError(Unsupported) naming the likely format when the file had the shape:
@@ -523,7 +551,7 @@ class NumberedRows {
 }  // namespace
 
 template <std::size_t d>
-PointFile<d> read_plain(std::istream& in, const std::string& name) {
+PointFile<d> read_plain(std::istream& in, const std::string& name, Columns columns) {
   LineReader r(in, name, Separators::Lists);
   PointFile<d> out;
   out.name = name;
@@ -545,18 +573,33 @@ PointFile<d> read_plain(std::istream& in, const std::string& name) {
       numbered.header(f);
     else
       numbered.row(f);
-    r.require_one_separator_kind(f, 0, d);  // up to the separator after the last coordinate
-    if (f.size() < d)
-      r.fail(Kind::Count, "expected " + std::to_string(d) + " coordinates, found " + std::to_string(f.size()));
     Point<d> p;
-    for (std::size_t a = 0; a < d; ++a) p[a] = r.coordinate(f[a]);
+    if (columns == Columns::Exactly) {
+      // The dimension is the file's: every field is a coordinate, as many as on the first line.
+      r.require_one_separator_kind(f, 0, f.size());
+      for (std::size_t a = 0; a < f.size(); ++a) {
+        const double v = r.coordinate(f[a]);
+        if (a < d) p[a] = v;
+      }
+      if (f.size() != d)
+        r.fail(Kind::Count, "expected " + std::to_string(d) + " numbers as on line " +
+                                std::to_string(out.lines.empty() ? r.line() : out.lines.front()) +
+                                " (the first line of numbers sets the file's dimension), found " +
+                                std::to_string(f.size()) + "; --dim 2 or --dim 3 reads the first 2 or 3 numbers of "
+                                                           "each line and ignores further columns");
+    } else {
+      r.require_one_separator_kind(f, 0, d);  // up to the separator after the last coordinate
+      if (f.size() < d)
+        r.fail(Kind::Count, "expected " + std::to_string(d) + " coordinates, found " + std::to_string(f.size()));
+      for (std::size_t a = 0; a < d; ++a) p[a] = r.coordinate(f[a]);
+    }
     out.points.push_back(p);
     out.lines.push_back(r.line());
   }
   } catch (const InputError&) {
     // A line after a numbered list (a .poly's segment count, say) is no point: say what the
     // file looks like rather than what its later line lacks.
-    if (!out.lines.empty()) numbered.check(r, out.lines.front(), /*at_end=*/false);
+    if (!out.lines.empty()) numbered.check_after_error(r, out.lines.front());
     throw;
   }
   if (!out.lines.empty()) numbered.check(r, out.lines.front(), /*at_end=*/true);
@@ -564,7 +607,7 @@ PointFile<d> read_plain(std::istream& in, const std::string& name) {
 }
 
 template <std::size_t d>
-PointFile<d> read_points(std::istream& in, const std::string& name, PointFormat format) {
+PointFile<d> read_points(std::istream& in, const std::string& name, PointFormat format, Columns columns) {
   if (format == PointFormat::Auto) format = format_for_path(name);
   switch (format) {
     case PointFormat::Node: return read_node<d>(in, name);
@@ -574,16 +617,125 @@ PointFile<d> read_points(std::istream& in, const std::string& name, PointFormat 
                        "a Triangle .ele file holds triangles (vertex numbers), not points: give the .node file of "
                        "its vertices",
                        name);
-    default: return read_plain<d>(in, name);
+    default: return read_plain<d>(in, name, columns);
   }
 }
 
+namespace {
+
+/// Standard input or a pipe (any path that is not a regular file) whose first lines
+/// point_file_shape looked at: read whole then, because such an input cannot be read twice,
+/// and kept here until read_points_file reads it as points (and releases it).
+struct ReadAhead {
+  std::string path;
+  std::string text;
+  bool held = false;
+};
+ReadAhead& read_ahead() {
+  static ReadAhead input;
+  return input;
+}
+
+/// Can `path` be opened again to read it a second time? Standard input cannot, nor can a
+/// FIFO or a process substitution; a path that does not exist counts as one (its reader
+/// reports it).
+bool rereadable(const std::string& path) {
+  if (path == kStandardInput) return false;
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  return ec || !std::filesystem::exists(status) || std::filesystem::is_regular_file(status) ||
+         std::filesystem::is_directory(status);
+}
+
+/// The whole text of a path that cannot be read twice, read now and held for
+/// read_points_file.
+const std::string& read_ahead_text(const std::string& path) {
+  ReadAhead& input = read_ahead();
+  if (input.held && input.path == path) return input.text;
+  std::string text;
+  if (path == kStandardInput) {
+    text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+    if (std::cin.bad()) throw InputError(Kind::Io, "read error", kStandardInputName);
+  } else {
+    std::ifstream in = open_input(path);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    if (in.bad()) throw InputError(Kind::Io, "read error", path);
+  }
+  input = ReadAhead{path, std::move(text), true};
+  return input.text;
+}
+
+/// A read-only stream buffer over text that stays alive and unchanged while it is read.
+class TextBuffer : public std::streambuf {
+ public:
+  explicit TextBuffer(std::string_view text) {
+    char* p = const_cast<char*>(text.data());  // the get area only: never written through
+    setg(p, p, p + text.size());
+  }
+};
+
+}  // namespace
+
 template <std::size_t d>
-PointFile<d> read_points_file(const std::string& path, PointFormat format) {
-  if (path == kStandardInput)
-    return read_points<d>(std::cin, kStandardInputName, format == PointFormat::Auto ? PointFormat::Plain : format);
+PointFile<d> read_points_file(const std::string& path, PointFormat format, Columns columns) {
+  const bool standard_input = path == kStandardInput;
+  const std::string& name = standard_input ? kStandardInputName : path;
+  if (standard_input && format == PointFormat::Auto) format = PointFormat::Plain;
+  ReadAhead& input = read_ahead();
+  if (input.held && input.path == path) {
+    // Read as points once, then released, as the pipe itself was consumed.
+    const std::string text = std::move(input.text);
+    input = ReadAhead{};
+    TextBuffer buffer(text);
+    std::istream in(&buffer);
+    return read_points<d>(in, name, format, columns);
+  }
+  if (standard_input) return read_points<d>(std::cin, name, format, columns);
   std::ifstream in = open_input(path);
-  return read_points<d>(in, path, format);
+  return read_points<d>(in, path, format, columns);
+}
+
+PointFileShape point_file_shape(const std::string& path, int dim) {
+  if (dim != 0) return {dim, Columns::AtLeast};
+  const bool standard_input = path == kStandardInput;
+  const PointFormat format = standard_input ? PointFormat::Plain : format_for_path(path);
+  if (format == PointFormat::Ele) return {2, Columns::AtLeast};  // refused when read
+  // A pipe is read whole now and held for read_points_file; a regular file is opened again.
+  const bool once = !rereadable(path);
+  std::ifstream file;
+  std::optional<TextBuffer> buffer;
+  std::optional<std::istream> held;
+  if (once) {
+    buffer.emplace(read_ahead_text(path));
+    held.emplace(&*buffer);
+  } else {
+    file = open_input(path);
+  }
+  std::istream& in = once ? *held : static_cast<std::istream&>(file);
+  const std::string& name = standard_input ? kStandardInputName : path;
+  if (format == PointFormat::Node || format == PointFormat::Poly) {
+    LineReader r(in, name);
+    return {read_node_header(r).dim == 3 ? 3 : 2, Columns::AtLeast};
+  }
+  LineReader r(in, name, Separators::Lists);
+  std::vector<std::string_view> f;
+  bool first = true;
+  while (r.next(f)) {
+    // A first line without a single number is a column header, as read_plain skips it.
+    if (std::exchange(first, false) && std::none_of(f.begin(), f.end(), is_number)) continue;
+    r.require_one_separator_kind(f, 0, f.size());  // a decimal comma is no extra column
+    if (f.size() == 2 || f.size() == 3) return {static_cast<int>(f.size()), Columns::Exactly};
+    const std::size_t line = r.line();
+    NumberedRows numbered;
+    numbered.header(f);
+    numbered.check_after_error(r, line);
+    r.fail_at(Kind::Count,
+              "the first line of numbers holds " + std::to_string(f.size()) +
+                  " numbers, and without --dim their count is the dimension of plain-text points, 2 or 3: pass "
+                  "--dim 2 or --dim 3 to read the first 2 or 3 numbers of each line and ignore further columns",
+              line);
+  }
+  return {2, Columns::Exactly};
 }
 
 template <std::size_t d>
@@ -686,8 +838,8 @@ EditScript<d> read_edits(std::istream& in, const std::string& name) {
     else
       r.fail(Kind::Malformed, "an edit starts with '+' or '-' as a field of its own, got " + quoted(f[0]));
     if (f.size() != 1 + d)
-      r.fail(Kind::Count, "an edit needs exactly " + std::to_string(d) + " coordinates, found " +
-                              std::to_string(f.size() - 1));
+      r.fail(Kind::Count, "an edit needs exactly " + std::to_string(d) + " coordinates (the points are " +
+                              std::to_string(d) + "D), found " + std::to_string(f.size() - 1));
     Edit<d> e{op, {}};
     for (std::size_t a = 0; a < d; ++a) e.point[a] = r.coordinate(f[1 + a]);
     out.edits.push_back(e);
@@ -805,10 +957,10 @@ CellsFile<d> read_cells_file(const std::string& path) {
 
 #define DYNMESH_INSTANTIATE_IO(D)                                                                    \
   template PointFile<D> read_node<D>(std::istream&, const std::string&);                             \
-  template PointFile<D> read_plain<D>(std::istream&, const std::string&);                            \
+  template PointFile<D> read_plain<D>(std::istream&, const std::string&, Columns);                   \
   template PointFile<D> read_poly<D>(std::istream&, const std::string&);                             \
-  template PointFile<D> read_points<D>(std::istream&, const std::string&, PointFormat);              \
-  template PointFile<D> read_points_file<D>(const std::string&, PointFormat);                        \
+  template PointFile<D> read_points<D>(std::istream&, const std::string&, PointFormat, Columns);     \
+  template PointFile<D> read_points_file<D>(const std::string&, PointFormat, Columns);               \
   template std::vector<Position<D>> locate_points<D>(const PointFile<D>&, const Box<D>&);            \
   template std::size_t drop_duplicate_points<D>(PointFile<D>&);                                      \
   template EditScript<D> read_edits<D>(std::istream&, const std::string&);                           \

@@ -2,256 +2,41 @@
 #include "dynmesh/mesh_io.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <string_view>
 #include <utility>
 #include <vector>
 
-#include "dynmesh/errors.hpp"
 #include "dynmesh/mesh_check.hpp"
 #include "geometry/powers_of_two.hpp"
+#include "io/mesh_text.hpp"
 
 namespace dynmesh {
-namespace {
-
-void append_line_end(std::string& out) { out += '\n'; }
-
-void append_number(std::string& out, std::size_t n) {
-  char buf[24];
-  const auto r = std::to_chars(buf, buf + sizeof buf, n);
-  out.append(buf, r.ptr);
-}
-
-void append_exact(std::string& out, double x) { out += format_exact(x); }
-
-}  // namespace
 
 // ---- Triangle's .node / .ele --------------------------------------------------------------
 
 std::string format_node(const Mesh& mesh, const Box<2>& box) {
-  const double x0 = box.origin[0], x1 = box.origin[0] + box.side;
-  const double y0 = box.origin[1], y1 = box.origin[1] + box.side;
-  std::string out;
-  out.reserve(32 + mesh.num_vertices() * 48);
-  append_number(out, mesh.num_vertices());
-  out += " 2 0 1";
-  append_line_end(out);
-  for (std::size_t i = 0; i < mesh.num_vertices(); ++i) {
-    const Point<2>& p = mesh.vertices[i];
-    const bool boundary = p[0] == x0 || p[0] == x1 || p[1] == y0 || p[1] == y1;
-    append_number(out, i + 1);
-    out += ' ';
-    append_exact(out, p[0]);
-    out += ' ';
-    append_exact(out, p[1]);
-    out += boundary ? " 1" : " 0";
-    append_line_end(out);
-  }
-  return out;
+  return detail::node_text<2>(mesh.vertices, box);
 }
 
-std::string format_ele(const Mesh& mesh) {
-  std::string out;
-  out.reserve(32 + mesh.num_triangles() * 32);
-  append_number(out, mesh.num_triangles());
-  out += " 3 0";
-  append_line_end(out);
-  for (std::size_t t = 0; t < mesh.num_triangles(); ++t) {
-    append_number(out, t + 1);
-    for (std::uint32_t v : mesh.triangles[t]) {
-      out += ' ';
-      append_number(out, std::size_t{v} + 1);
-    }
-    append_line_end(out);
-  }
-  return out;
-}
+std::string format_ele(const Mesh& mesh) { return detail::ele_text<3>(mesh.triangles); }
 
 // ---- VTK and Gmsh -------------------------------------------------------------------------
 
 std::string format_vtk(const Mesh& mesh) {
-  const std::size_t nv = mesh.num_vertices(), nt = mesh.num_triangles();
-  std::string out;
-  out.reserve(160 + nv * 44 + nt * 30);
-  out += "# vtk DataFile Version 3.0\ndynmesh mesh\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS ";
-  append_number(out, nv);
-  out += " double\n";
-  for (const Point<2>& p : mesh.vertices) {
-    append_exact(out, p[0]);
-    out += ' ';
-    append_exact(out, p[1]);
-    out += " 0\n";
-  }
-  out += "CELLS ";
-  append_number(out, nt);
-  out += ' ';
-  append_number(out, 4 * nt);  // each cell: its point count, then three 0-based point ids
-  append_line_end(out);
-  for (const auto& tri : mesh.triangles) {
-    out += '3';
-    for (std::uint32_t v : tri) {
-      out += ' ';
-      append_number(out, v);
-    }
-    append_line_end(out);
-  }
-  out += "CELL_TYPES ";
-  append_number(out, nt);
-  append_line_end(out);
-  for (std::size_t t = 0; t < nt; ++t) out += "5\n";  // VTK_TRIANGLE
-  return out;
+  return detail::vtk_text<2, 3>(mesh.vertices, mesh.triangles, 5);  // VTK_TRIANGLE
 }
 
 std::string format_msh(const Mesh& mesh) {
-  const std::size_t nv = mesh.num_vertices(), nt = mesh.num_triangles();
-  std::string out;
-  out.reserve(160 + nv * 50 + nt * 40);
-  out += "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n";
-  append_number(out, nv);
-  append_line_end(out);
-  for (std::size_t i = 0; i < nv; ++i) {
-    append_number(out, i + 1);
-    out += ' ';
-    append_exact(out, mesh.vertices[i][0]);
-    out += ' ';
-    append_exact(out, mesh.vertices[i][1]);
-    out += " 0\n";
-  }
-  out += "$EndNodes\n$Elements\n";
-  append_number(out, nt);
-  append_line_end(out);
-  for (std::size_t t = 0; t < nt; ++t) {
-    append_number(out, t + 1);
-    // Type 2 (3-node triangle), two tags: physical group 1 and elementary entity 1. Readers
-    // that keep only physical groups (dolfin-convert, some meshio paths) then keep them all.
-    out += " 2 2 1 1";
-    for (std::uint32_t v : mesh.triangles[t]) {
-      out += ' ';
-      append_number(out, std::size_t{v} + 1);
-    }
-    append_line_end(out);
-  }
-  out += "$EndElements\n";
-  return out;
+  return detail::msh_text<2, 3>(mesh.vertices, mesh.triangles, 2);  // 3-node triangle
 }
 
 // ---- reading .node / .ele back ------------------------------------------------------------
 
-namespace {
-
-// The non-comment fields of one line at a time, with the line number for messages.
-class FieldReader {
- public:
-  FieldReader(std::string_view text, std::string name) : text_(text), name_(std::move(name)) {}
-
-  /// The next line with at least one field; false at the end of the text.
-  bool next(std::vector<std::string_view>& fields) {
-    while (pos_ < text_.size()) {
-      const std::size_t end = std::min(text_.find('\n', pos_), text_.size());
-      std::string_view line = text_.substr(pos_, end - pos_);
-      pos_ = end + 1;
-      ++line_;
-      if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-      fields.clear();
-      std::size_t i = 0;
-      while (i < line.size()) {
-        while (i < line.size() && is_space(line[i])) ++i;
-        const std::size_t start = i;
-        while (i < line.size() && !is_space(line[i])) ++i;
-        if (i > start) fields.push_back(line.substr(start, i - start));
-      }
-      if (!fields.empty()) return true;
-    }
-    return false;
-  }
-
-  [[noreturn]] void fail(InputError::Kind kind, const std::string& what) const {
-    throw InputError(kind, what, name_, line_);
-  }
-
-  std::size_t integer(std::string_view field) const {
-    std::size_t value = 0;
-    const auto r = std::from_chars(field.data(), field.data() + field.size(), value);
-    if (r.ec != std::errc() || r.ptr != field.data() + field.size())
-      fail(InputError::Kind::Malformed, "expected a non-negative integer, got '" + std::string(field) + "'");
-    return value;
-  }
-
-  double number(std::string_view field) const {
-    std::string_view digits = field;
-    if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);  // from_chars rejects '+'
-    double value = 0;
-    const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), value);
-    if (r.ec == std::errc::result_out_of_range)
-      fail(InputError::Kind::NotFinite, "number '" + std::string(field) + "' is out of the range of double");
-    if (r.ec != std::errc() || r.ptr != digits.data() + digits.size() ||
-        (digits.size() < field.size() && !digits.empty() && digits.front() == '-'))
-      fail(InputError::Kind::Malformed, "expected a number, got '" + std::string(field) + "'");
-    if (!std::isfinite(value))
-      fail(InputError::Kind::NotFinite, "NaN or infinite coordinate '" + std::string(field) + "'");
-    return value;
-  }
-
- private:
-  static bool is_space(char c) noexcept { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-  std::string_view text_;
-  std::string name_;
-  std::size_t pos_ = 0;
-  std::size_t line_ = 0;
-};
-
-}  // namespace
-
 Mesh read_node_ele(const std::string& node_text, const std::string& ele_text) {
   Mesh mesh;
-  std::vector<std::string_view> fields;
-
-  FieldReader node(node_text, "node");
-  if (!node.next(fields)) node.fail(InputError::Kind::Malformed, "missing the header line");
-  const std::size_t nv = node.integer(fields[0]);
-  if (fields.size() > 1 && node.integer(fields[1]) != 2) node.fail(InputError::Kind::Malformed, "dimension must be 2");
-  std::size_t base = 0;
-  mesh.vertices.reserve(std::min(nv, node_text.size() / 4));  // a bogus count must not allocate
-  for (std::size_t i = 0; i < nv; ++i) {
-    if (!node.next(fields))
-      node.fail(InputError::Kind::Count, "expected " + std::to_string(nv) + " vertices, found " + std::to_string(i));
-    if (fields.size() < 3) node.fail(InputError::Kind::Count, "a vertex line needs a number and two coordinates");
-    const std::size_t number = node.integer(fields[0]);
-    if (i == 0) {
-      if (number > 1) node.fail(InputError::Kind::Malformed, "vertex numbering must start at 0 or 1");
-      base = number;
-    } else if (number != base + i) {
-      node.fail(InputError::Kind::Malformed,
-                "vertex number " + std::to_string(number) + ", expected " + std::to_string(base + i));
-    }
-    mesh.vertices.push_back({node.number(fields[1]), node.number(fields[2])});
-  }
-  if (node.next(fields)) node.fail(InputError::Kind::Count, "more vertices than the header's " + std::to_string(nv));
-
-  FieldReader ele(ele_text, "ele");
-  if (!ele.next(fields)) ele.fail(InputError::Kind::Malformed, "missing the header line");
-  const std::size_t nt = ele.integer(fields[0]);
-  if (fields.size() > 1 && ele.integer(fields[1]) != 3)
-    ele.fail(InputError::Kind::Malformed, "only 3-node triangles are supported");
-  mesh.triangles.reserve(std::min(nt, ele_text.size() / 6));
-  for (std::size_t t = 0; t < nt; ++t) {
-    if (!ele.next(fields))
-      ele.fail(InputError::Kind::Count, "expected " + std::to_string(nt) + " triangles, found " + std::to_string(t));
-    if (fields.size() < 4) ele.fail(InputError::Kind::Count, "a triangle line needs a number and three vertices");
-    std::array<std::uint32_t, 3> tri{};
-    for (std::size_t k = 0; k < 3; ++k) {
-      const std::size_t v = ele.integer(fields[k + 1]);
-      if (v < base || v - base >= nv)
-        ele.fail(InputError::Kind::Malformed, "vertex " + std::to_string(v) + " does not exist");
-      tri[k] = static_cast<std::uint32_t>(v - base);
-    }
-    mesh.triangles.push_back(tri);
-  }
-  if (ele.next(fields)) ele.fail(InputError::Kind::Count, "more triangles than the header's " + std::to_string(nt));
+  detail::read_node_ele_text<2, 3>(node_text, ele_text, {"triangle", "triangles"}, mesh.vertices, mesh.triangles);
   return mesh;
 }
 
@@ -272,7 +57,7 @@ void append_centi(std::string& out, Centi c) {
     out += '-';
     c = -c;
   }
-  append_number(out, static_cast<std::size_t>(c / 100));
+  detail::append_number(out, static_cast<std::size_t>(c / 100));
   const Centi frac = c % 100;
   if (frac != 0) {
     out += '.';
@@ -436,48 +221,20 @@ MeshStats mesh_stats(const Mesh& mesh) {
       const double angle = corner_angle_deg(p, q, r);
       stats.min_angle_deg = std::min(stats.min_angle_deg, angle);
       stats.max_angle_deg = std::max(stats.max_angle_deg, angle);
-      const auto bin = static_cast<std::size_t>(std::clamp(angle / 10, 0.0, 17.0));
-      ++stats.angle_histogram[bin];
+      ++stats.angle_histogram[detail::angle_bin(angle)];
     }
   }
   return stats;
 }
 
-namespace {
-
-std::string readable(double x) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, 6);
-  return std::string(buf, r.ptr);
-}
-
-std::string pad_right(std::string s, std::size_t width) {
-  if (s.size() < width) s.append(width - s.size(), ' ');
-  return s;
-}
-
-std::string pad_left(std::string s, std::size_t width) {
-  if (s.size() < width) s.insert(0, width - s.size(), ' ');
-  return s;
-}
-
-}  // namespace
-
 std::string format_stats(const MeshStats& s) {
   std::string out = "Mesh quality statistics:\n\n";
   out += "  Vertices: " + std::to_string(s.vertices) + "    Triangles: " + std::to_string(s.triangles) + "\n\n";
-  auto row = [&](const char* left, double l, const char* right, double r) {
-    out += "  " + pad_right(left, 16) + pad_right(readable(l), 14) + "|  " + pad_right(right, 16) + readable(r) + '\n';
-  };
-  row("Smallest area:", s.smallest_area, "Largest area:", s.largest_area);
-  row("Shortest edge:", s.shortest_edge, "Longest edge:", s.longest_edge);
-  row("Smallest angle:", s.min_angle_deg, "Largest angle:", s.max_angle_deg);
+  detail::append_stats_row(out, "Smallest area:", s.smallest_area, "Largest area:", s.largest_area);
+  detail::append_stats_row(out, "Shortest edge:", s.shortest_edge, "Longest edge:", s.longest_edge);
+  detail::append_stats_row(out, "Smallest angle:", s.min_angle_deg, "Largest angle:", s.max_angle_deg);
   out += "\n  Angle histogram:\n";
-  auto bin = [&](std::size_t k) {
-    return pad_left(std::to_string(10 * k), 7) + " - " + pad_left(std::to_string(10 * k + 10), 3) +
-           " degrees: " + pad_left(std::to_string(s.angle_histogram[k]), 9);
-  };
-  for (std::size_t k = 0; k < 9; ++k) out += "  " + bin(k) + "    |" + bin(k + 9) + '\n';
+  detail::append_angle_histogram(out, s.angle_histogram);
   return out;
 }
 
@@ -486,26 +243,7 @@ std::string format_stats(const MeshStats& s) {
 std::string feed_header() { return "# dynmesh feed v1\n"; }
 
 std::string format_feed_update(std::size_t k, const MeshChange& change) {
-  std::string out = "update ";
-  append_number(out, k);
-  out += " removed ";
-  append_number(out, change.removed.size());
-  out += " added ";
-  append_number(out, change.added.size());
-  append_line_end(out);
-  auto triangle_line = [&](char sign, const Triangle& t) {
-    out += sign;
-    for (const Point<2>& p : t.v) {
-      out += ' ';
-      append_exact(out, p[0]);
-      out += ' ';
-      append_exact(out, p[1]);
-    }
-    append_line_end(out);
-  };
-  for (const Triangle& t : change.removed) triangle_line('-', t);
-  for (const Triangle& t : change.added) triangle_line('+', t);
-  return out;
+  return detail::feed_update_text<Triangle>(k, change.removed, change.added);
 }
 
 }  // namespace dynmesh

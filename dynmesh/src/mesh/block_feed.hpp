@@ -5,8 +5,12 @@
 // leaf's triangles; a split cell's leaf children's tetrahedra) as one FeedBlock, a keyless
 // allocation of the running program holding only the shape the simplices are computed from.
 // Its constructor and destructor tell the BlockFeed: what a propagation creates and undoes
-// is exactly the change of the mesh. A Shape names its Grid and Simplex and has a free
-// function emit_simplices(const Grid&, const Shape&, std::vector<Simplex>&) found by ADL.
+// is exactly the change of the mesh. A Shape names its Grid and Simplex, is equality
+// comparable, has key() (the cell it is made for: a re-made block has the same key) and free
+// functions found by ADL: emit_simplices(const Grid&, const Shape&, std::vector<Simplex>&),
+// and emit_difference(grid, before, after, removed, added), which appends at least the
+// simplices of `before` not in `after` to `removed` and those of `after` not in `before` to
+// `added` (a shape may append everything; take_change subtracts the common ones).
 // Invariants: the live blocks are exactly the blocks of the current trace; a block made and
 // undone within one update leaves no trace in the feed; take_change() gives sorted, disjoint
 // removed and added lists (a block re-made with an equal shape is no change).
@@ -33,7 +37,7 @@ struct BlockFeed {
   Grid grid;
   FeedBlock<Shape>* live = nullptr;         // every live block, doubly linked
   std::vector<FeedBlock<Shape>*> created;   // blocks made in this update (null once undone)
-  std::vector<Simplex> removed;             // simplices of the blocks undone in this update
+  std::vector<Shape> removed;               // shapes of the blocks undone in this update
   std::size_t live_count = 0;
   bool closing = false;                     // the engine is being destroyed: log nothing
 
@@ -46,24 +50,41 @@ struct BlockFeed {
   }
 
   /// The change of the update just propagated: the simplices of the blocks it undid, less
-  /// those of the blocks it made. `Change` has sorted vectors `removed` and `added`.
+  /// those of the blocks it made. `Change` has sorted vectors `removed` and `added`. A block
+  /// re-made for the same cell is compared with its old shape first: an equal shape is no
+  /// change, and a different one emits only what its shape says may differ.
   template <class Change>
   void take_change(Change& change) {
-    std::vector<Simplex> added;
+    std::vector<Shape> made;
     for (FeedBlock<Shape>* b : created) {
       if (!b) continue;
-      emit_simplices(grid, b->shape, added);
+      made.push_back(b->shape);
       b->slot = FeedBlock<Shape>::kOld;
     }
     created.clear();
-    std::vector<Simplex> gone = std::move(removed);
+    std::vector<Shape> gone = std::move(removed);
     removed.clear();
-    std::sort(added.begin(), added.end());
-    std::sort(gone.begin(), gone.end());
+    const auto by_key = [](const Shape& a, const Shape& b) { return a.key() < b.key(); };
+    std::sort(made.begin(), made.end(), by_key);
+    std::sort(gone.begin(), gone.end(), by_key);
+    std::vector<Simplex> minus, plus;
+    std::size_t i = 0, j = 0;
+    while (i < gone.size() || j < made.size()) {
+      if (j == made.size() || (i < gone.size() && gone[i].key() < made[j].key())) {
+        emit_simplices(grid, gone[i++], minus);
+      } else if (i == gone.size() || made[j].key() < gone[i].key()) {
+        emit_simplices(grid, made[j++], plus);
+      } else {
+        if (!(gone[i] == made[j])) emit_difference(grid, gone[i], made[j], minus, plus);
+        ++i, ++j;
+      }
+    }
+    std::sort(minus.begin(), minus.end());
+    std::sort(plus.begin(), plus.end());
     change.removed.clear();
     change.added.clear();
-    std::set_difference(gone.begin(), gone.end(), added.begin(), added.end(), std::back_inserter(change.removed));
-    std::set_difference(added.begin(), added.end(), gone.begin(), gone.end(), std::back_inserter(change.added));
+    std::set_difference(minus.begin(), minus.end(), plus.begin(), plus.end(), std::back_inserter(change.removed));
+    std::set_difference(plus.begin(), plus.end(), minus.begin(), minus.end(), std::back_inserter(change.added));
   }
 
   /// Every live simplex, sorted.
@@ -102,7 +123,7 @@ struct FeedBlock {
     if (next) next->prev = prev;
     --log->live_count;
     if (slot != kOld) log->created[slot] = nullptr;  // made and undone in one update
-    else emit_simplices(log->grid, shape, log->removed);
+    else log->removed.push_back(shape);
   }
   FeedBlock(const FeedBlock&) = delete;
   FeedBlock& operator=(const FeedBlock&) = delete;

@@ -61,15 +61,39 @@ struct OctreeGroupShape {
   std::int8_t owner = -1;          // the child that owns a block, or −1
   std::uint8_t corner = 0;         // the owner's block corner
   bool root_leaf = false;
+
+  const CellId<3>& key() const noexcept { return cell; }
+  friend bool operator==(const OctreeGroupShape&, const OctreeGroupShape&) = default;
 };
+
+/// The tetrahedra child w contributes to the group.
+inline void emit_child(const OctreeGrid& grid, const OctreeGroupShape& s, unsigned w, std::vector<Tetrahedron>& out) {
+  if (static_cast<int>(w) == s.owner) tetrahedralize_block(grid, child(s.cell, w), s.corner, s.point, s.block, out);
+  else if (s.masks[w] != OctreeGroupShape::kNone) tetrahedralize_leaf(grid, child(s.cell, w), s.masks[w], out);
+}
 
 inline void emit_simplices(const OctreeGrid& grid, const OctreeGroupShape& s, std::vector<Tetrahedron>& out) {
   if (s.root_leaf) return tetrahedralize_leaf(grid, s.cell, 0, out);
+  for (unsigned w = 0; w < 8; ++w) emit_child(grid, s, w, out);
+}
+
+/// Only the children whose own shape changed: a leaf's tetrahedra depend on its mask alone,
+/// the owner's on its block mask, corner and point.
+inline void emit_difference(const OctreeGrid& grid, const OctreeGroupShape& before, const OctreeGroupShape& after,
+                            std::vector<Tetrahedron>& removed, std::vector<Tetrahedron>& added) {
+  if (before.root_leaf || after.root_leaf) {
+    emit_simplices(grid, before, removed);
+    emit_simplices(grid, after, added);
+    return;
+  }
   for (unsigned w = 0; w < 8; ++w) {
-    if (static_cast<int>(w) == s.owner)
-      tetrahedralize_block(grid, child(s.cell, w), s.corner, s.point, s.block, out);
-    else if (s.masks[w] != OctreeGroupShape::kNone)
-      tetrahedralize_leaf(grid, child(s.cell, w), s.masks[w], out);
+    const bool was_owner = static_cast<int>(w) == before.owner, is_owner = static_cast<int>(w) == after.owner;
+    const bool same = was_owner == is_owner && before.masks[w] == after.masks[w] &&
+                      (!is_owner || (before.block == after.block && before.corner == after.corner &&
+                                     before.point == after.point));
+    if (same) continue;
+    emit_child(grid, before, w, removed);
+    emit_child(grid, after, w, added);
   }
 }
 

@@ -161,6 +161,8 @@ inline bool side_neighbour(const CellId<2>& c, unsigned s, CellId<2>& out) noexc
 struct LeafShape {
   using Grid = MeshGrid;
   using Simplex = Triangle;
+  const CellId<2>& key() const noexcept { return cell; }
+  friend bool operator==(const LeafShape&, const LeafShape&) = default;
 
   CellId<2> cell;
   std::uint8_t midpoints = 0;  // bit s: side s has a midpoint (a smaller neighbour there)
@@ -251,9 +253,15 @@ inline void triangulate_leaf(const MeshGrid& grid, const LeafShape& s, std::vect
   evaluate(best, true);
 }
 
-/// The triangles of a leaf, for the feed's blocks (mesh/block_feed.hpp).
+/// The triangles of a leaf, for the feed's blocks (mesh/block_feed.hpp); a changed leaf
+/// gives all of its triangles, old and new.
 inline void emit_simplices(const MeshGrid& grid, const LeafShape& s, std::vector<Triangle>& out) {
   triangulate_leaf(grid, s, out);
+}
+inline void emit_difference(const MeshGrid& grid, const LeafShape& before, const LeafShape& after,
+                            std::vector<Triangle>& removed, std::vector<Triangle>& added) {
+  triangulate_leaf(grid, before, removed);
+  triangulate_leaf(grid, after, added);
 }
 
 }  // namespace dynmesh::detail
