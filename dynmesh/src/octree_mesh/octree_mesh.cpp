@@ -46,7 +46,7 @@ OctreeMesh::OctreeMesh(const Box<3>& box, std::span<const Point<3>> points)
   std::vector<detail::BlockTarget> targets(qs.size());
   for (std::size_t i = 0; i < qs.size(); ++i) {
     targets[i] = detail::block_target(grid, qs[i], points_[i], tree_.locate(qs[i]).level);
-    detail::for_each_block_cell(targets[i], [&](const CellId<3>& x, std::uint8_t) { refine(parent(x)); });
+    detail::for_each_block_parent(targets[i], refine);
   }
   // The marks: which leaf belongs to which point's block.
   struct Mark {

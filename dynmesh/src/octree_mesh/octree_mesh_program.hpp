@@ -173,7 +173,7 @@ struct OctreeMeshProgram {
   static void settle(sac::Engine& r, OctreeMeshProgram* cx, Node* n, int tree_level) {
     const auto* in = static_cast<const InputNode<3>*>(n);
     const BlockTarget t = block_target(cx->grid(), n->q, in->point, tree_level);
-    for_each_block_cell(t, [&](const CellId<3>& x, std::uint8_t) { split(r, cx, parent(x)); });
+    for_each_block_parent(t, [&](const CellId<3>& u) { split(r, cx, u); });
     for_each_block_cell(t, [&](const CellId<3>& x, std::uint8_t mark) {
       r.read(cx->slot(r, x).split, [cx, x, mark](sac::Engine& e, std::uint8_t v) {
         // A split value here would break the closure's rule; the checkers report it.
@@ -235,35 +235,45 @@ struct OctreeMeshProgram {
     });
   }
 
-  /// The neighbours of c in the box, in for_each_neighbour's order, with their offsets.
+  /// The neighbours of c in the box whose kids the group reads, in for_each_neighbour's
+  /// order, with their offsets: the 18 across c's faces and edges (every face and edge
+  /// neighbour of a child lies in one of them), and the 8 across its corners too when a child
+  /// owns a block (its ring reaches them).
   struct Near {
     std::array<const Kids*, 26> mods{};
     std::array<std::uint8_t, 26> bit{};
     unsigned n = 0;
   };
-  static Near near_of(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c) {
+  static Near near_of(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c, bool corners) {
     Near out;
     for_each_neighbour(c, [&](const CellId<3>& nb) {
       int off[3];
       for (unsigned a = 0; a < 3; ++a) off[a] = static_cast<int>(nb.index[a] - c.index[a]);
+      if (!corners && off[0] != 0 && off[1] != 0 && off[2] != 0) return;
       out.bit[out.n] = static_cast<std::uint8_t>(leaf_bit(off[0], off[1], off[2]));
       out.mods[out.n++] = &cx->slot(r, nb).kids;
     });
     return out;
   }
-  static constexpr unsigned kFirst = 13;  // of at most 26 neighbours: two events of ≤ 16
+  static bool has_owner(std::uint64_t own) noexcept {
+    for (unsigned w = 0; w < 8; ++w)
+      if (is_block_owner(kid(own, w))) return true;
+    return false;
+  }
 
+  /// Two events of at most 13 (Engine::read_many reads 16 at most).
   static void group(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c, std::uint64_t own) {
-    const Near nb = near_of(r, cx, c);
+    const Near nb = near_of(r, cx, c, has_owner(own));
     if (nb.n == 0) return finish(r, cx, c, own, nb);  // the root has no neighbours
-    const unsigned first = nb.n < kFirst ? nb.n : kFirst;
+    const unsigned first = (nb.n + 1) / 2;
     r.read_many(std::span<const Kids* const>(nb.mods.data(), first),
                 [cx, c, own](sac::Engine& e, std::span<const std::uint64_t* const>) {
-                  const Near nb2 = near_of(e, cx, c);
-                  if (nb2.n <= kFirst) return finish(e, cx, c, own, nb2);
-                  e.read_many(std::span<const Kids* const>(nb2.mods.data() + kFirst, nb2.n - kFirst),
+                  const Near all = near_of(e, cx, c, has_owner(own));
+                  const unsigned half = (all.n + 1) / 2;
+                  if (all.n == half) return finish(e, cx, c, own, all);
+                  e.read_many(std::span<const Kids* const>(all.mods.data() + half, all.n - half),
                               [cx, c, own](sac::Engine& e2, std::span<const std::uint64_t* const>) {
-                                finish(e2, cx, c, own, near_of(e2, cx, c));
+                                finish(e2, cx, c, own, near_of(e2, cx, c, has_owner(own)));
                               });
                 });
   }

@@ -111,6 +111,28 @@ void for_each_block_cell(const BlockTarget& target, F&& f) {
   }
 }
 
+/// Calls f(u) once for each distinct parent of the block's cells (the level t−1 cells whose
+/// closure holds v): on an axis where v's index is odd, both block cells share a parent.
+template <class F>
+void for_each_block_parent(const BlockTarget& target, F&& f) {
+  std::uint64_t lo[3], hi[3];
+  const std::uint64_t n = cells_per_axis(target.owner.level);
+  for (unsigned a = 0; a < 3; ++a) {
+    const std::uint64_t v = target.owner.index[a] + ((target.corner >> a) & 1u);
+    const std::uint64_t first = v == 0 ? 0 : v - 1, last = v >= n ? n - 1 : v;  // the block's cells in the box
+    lo[a] = first >> 1;
+    hi[a] = last >> 1;
+  }
+  CellId<3> u;
+  u.level = target.owner.level - 1;
+  for (std::uint64_t z = lo[2]; z <= hi[2]; ++z)
+    for (std::uint64_t y = lo[1]; y <= hi[1]; ++y)
+      for (std::uint64_t x = lo[0]; x <= hi[0]; ++x) {
+        u.index = {x, y, z};
+        f(u);
+      }
+}
+
 /// The block's target recovered from its owner's cell and mark (the inverse of the owner's
 /// entry of for_each_block_cell).
 constexpr unsigned block_corner(std::uint8_t owner_mark) noexcept { return ~block_position(owner_mark) & 7u; }
@@ -297,15 +319,17 @@ inline bool offset_cell(const CellId<3>& cell, int dx, int dy, int dz, CellId<3>
   return true;
 }
 
-/// A leaf's neighbourhood split mask from `is_split(cell)`.
+/// A leaf's neighbourhood split mask from `is_split(cell)`, over the cells across its faces
+/// and edges (kFaceEdgeNeighbours; the others never change its tetrahedra).
 template <class IsSplit>
 std::uint32_t leaf_mask(const CellId<3>& cell, IsSplit&& is_split) {
   std::uint32_t mask = 0;
   for (int z = -1; z <= 1; ++z)
     for (int y = -1; y <= 1; ++y)
       for (int x = -1; x <= 1; ++x) {
+        const std::uint32_t bit = std::uint32_t{1} << leaf_bit(x, y, z);
         CellId<3> nb;
-        if ((x || y || z) && offset_cell(cell, x, y, z, nb) && is_split(nb)) mask |= std::uint32_t{1} << leaf_bit(x, y, z);
+        if ((kFaceEdgeNeighbours & bit) && offset_cell(cell, x, y, z, nb) && is_split(nb)) mask |= bit;
       }
   return mask;
 }
