@@ -107,7 +107,7 @@ cmd_asan() {
 cmd_bench() { deps; build_release sac_suite dynmesh_bench; bench_job "$@"; }  # what bench_job runs
 
 # The libFuzzer targets of tests/fuzz/ (keep in step with tests/fuzz/CMakeLists.txt).
-FUZZ_TARGETS=(fuzz_point_readers fuzz_edit_reader fuzz_dynamic_quadtree fuzz_dynamic_mesh fuzz_hpu_mesh)
+FUZZ_TARGETS=(fuzz_point_readers fuzz_edit_reader fuzz_dynamic_quadtree fuzz_dynamic_mesh fuzz_hpu_mesh fuzz_octree_mesh)
 
 # fuzz [SECONDS]: clang build of the libraries and the fuzz targets only (no tests, tools or
 # benchmarks) into build/fuzz, then each target for SECONDS (default 60) through its ctest

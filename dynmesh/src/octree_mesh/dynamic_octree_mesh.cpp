@@ -11,6 +11,7 @@
 #include "dynmesh/detail/octree_mesh_rules.hpp"
 #include "dynmesh/tet_mesh_check.hpp"
 #include "mesh/mesh_input_rules.hpp"
+#include "mesh/tet_numbering.hpp"
 #include "octree_mesh/octree_mesh_program.hpp"
 #include "quadtree/quadtree_core.hpp"
 
@@ -144,7 +145,26 @@ std::vector<std::pair<PointId, Point<3>>> DynamicOctreeMesh::points() const { re
 
 std::vector<Tetrahedron> DynamicOctreeMesh::tetrahedra() const { return s_->log.simplices(); }
 std::size_t DynamicOctreeMesh::num_tetrahedra() const noexcept { return s_->log.num_simplices(); }
-TetMesh DynamicOctreeMesh::mesh() const { return make_tet_mesh(tetrahedra()); }
+TetMesh DynamicOctreeMesh::mesh() const {
+  // Two passes over the blocks, each making one block's tetrahedra at a time: the mesh is
+  // never held as coordinates, six times the memory of its index form.
+  TetMesh out;
+  detail::TetNumbering numbering(out);
+  std::vector<Tetrahedron> scratch;
+  std::size_t count = 0;
+  auto each = [&](auto&& f) {
+    for (const detail::OctreeBlock* b = s_->log.live; b; b = b->next) {
+      scratch.clear();
+      detail::emit_simplices(s_->log.grid, b->shape, scratch);
+      for (const Tetrahedron& t : scratch) f(t);
+    }
+  };
+  each([&](const Tetrahedron& t) { numbering.gather(t), ++count; });
+  numbering.close(count);
+  each([&](const Tetrahedron& t) { numbering.add(t); });
+  numbering.sort();
+  return out;
+}
 const TetMeshChange& DynamicOctreeMesh::last_change() const noexcept { return s_->change; }
 
 std::vector<Leaf<3>> DynamicOctreeMesh::refined_leaves() const {
