@@ -18,7 +18,10 @@
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/cell.hpp"
+#include "dynmesh/distributions.hpp"
 #include "dynmesh/dynamic_quadtree.hpp"
+#include "dynmesh/edit.hpp"
+#include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
 #include "dynmesh/static_quadtree.hpp"
 
@@ -138,6 +141,67 @@ testing::AssertionResult unchanged(const dynmesh::DynamicQuadtree<d>& tree, cons
     return testing::AssertionFailure() << "record_bytes changed: " << before.record_bytes << " -> "
                                        << now.record_bytes;
   return testing::AssertionSuccess();
+}
+
+/// One random update of a differential test, drawn with `rng` and applied to `dyn` (a
+/// DynamicMesh or DynamicOctreeMesh): 1 in 8 a batch of up to 4 insertions (drawn from
+/// `absent`) and deletions (of `present` points), else a single insertion or deletion. The
+/// expected sets follow. A point the mesh cannot resolve is refused (Resolution) and leaves
+/// the sets as they were; any other refusal fails the test.
+template <std::size_t d, class Dyn>
+void random_update(Dyn& dyn, PointMap<d>& present, std::vector<dynmesh::Point<d>>& absent, dynmesh::Rng& rng) {
+  using namespace dynmesh;
+  const std::uint64_t what = rng.below(8);
+  if (what == 0) {
+    std::vector<Edit<d>> edits;
+    std::vector<PointId> gone;
+    std::vector<Point<d>> coming;
+    std::vector<std::size_t> taken;
+    for (std::uint64_t k = 1 + rng.below(4); k-- > 0;) {
+      if (!absent.empty() && (rng.below(2) == 0 || present.size() <= gone.size())) {
+        const std::size_t i = rng.below(absent.size());
+        if (std::find(taken.begin(), taken.end(), i) != taken.end()) continue;
+        taken.push_back(i);
+        edits.push_back({EditOp::Insert, absent[i]});
+        coming.push_back(absent[i]);
+      } else if (present.size() > gone.size()) {
+        auto it = present.begin();
+        std::advance(it, static_cast<std::ptrdiff_t>(rng.below(present.size())));
+        if (std::find(gone.begin(), gone.end(), it->first) != gone.end()) continue;
+        edits.push_back({EditOp::Delete, it->second});
+        gone.push_back(it->first);
+      }
+    }
+    std::vector<PointId> ids;
+    try {
+      ids = dyn.apply(edits);
+    } catch (const InputError& e) {
+      ASSERT_EQ(e.kind(), InputError::Kind::Resolution) << e.what();
+      return;
+    }
+    std::sort(taken.rbegin(), taken.rend());
+    for (const std::size_t i : taken) absent.erase(absent.begin() + static_cast<std::ptrdiff_t>(i));
+    for (PointId id : gone) {
+      absent.push_back(present.at(id));
+      present.erase(id);
+    }
+    for (std::size_t k = 0; k < ids.size(); ++k) present[ids[k]] = coming[k];
+  } else if (what < 5 && !absent.empty()) {
+    const std::size_t i = rng.below(absent.size());
+    try {
+      present[dyn.insert(absent[i])] = absent[i];
+    } catch (const InputError& e) {
+      ASSERT_EQ(e.kind(), InputError::Kind::Resolution) << e.what();
+      return;
+    }
+    absent.erase(absent.begin() + static_cast<std::ptrdiff_t>(i));
+  } else if (!present.empty()) {
+    auto it = present.begin();
+    std::advance(it, static_cast<std::ptrdiff_t>(rng.below(present.size())));
+    dyn.erase(it->first);
+    absent.push_back(it->second);
+    present.erase(it);
+  }
 }
 
 }  // namespace dynmesh_test

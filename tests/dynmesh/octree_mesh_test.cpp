@@ -75,53 +75,8 @@ void run_differential_on(const Box<3>& box, const std::vector<Point<3>>& pool, s
   std::vector<Tetrahedron> mesh = dyn.tetrahedra();
   for (std::size_t u = 0; u < updates; ++u) {
     SCOPED_TRACE("update " + std::to_string(u));
-    const std::uint64_t what = rng.below(8);
-    if (what == 0) {  // a batch of up to 4 edits
-      std::vector<Edit<3>> edits;
-      std::vector<PointId> gone;
-      std::vector<Point<3>> coming;
-      for (std::uint64_t k = 1 + rng.below(4); k-- > 0;) {
-        if (!absent.empty() && (rng.below(2) == 0 || present.size() <= gone.size())) {
-          const std::size_t i = rng.below(absent.size());
-          edits.push_back({EditOp::Insert, absent[i]});
-          coming.push_back(absent[i]);
-          absent.erase(absent.begin() + static_cast<std::ptrdiff_t>(i));
-        } else if (present.size() > gone.size()) {
-          auto it = present.begin();
-          std::advance(it, static_cast<std::ptrdiff_t>(rng.below(present.size())));
-          if (std::find(gone.begin(), gone.end(), it->first) != gone.end()) continue;
-          edits.push_back({EditOp::Delete, it->second});
-          gone.push_back(it->first);
-        }
-      }
-      std::vector<PointId> ids;
-      try {
-        ids = dyn.apply(edits);
-      } catch (const InputError& e) {
-        ASSERT_EQ(e.kind(), Kind::Resolution) << e.what();
-        continue;
-      }
-      for (PointId id : gone) {
-        absent.push_back(present.at(id));
-        present.erase(id);
-      }
-      for (std::size_t k = 0; k < ids.size(); ++k) present[ids[k]] = coming[k];
-    } else if (what < 5 && !absent.empty()) {
-      const std::size_t i = rng.below(absent.size());
-      try {
-        present[dyn.insert(absent[i])] = absent[i];
-      } catch (const InputError& e) {
-        ASSERT_EQ(e.kind(), Kind::Resolution) << e.what();
-        continue;
-      }
-      absent.erase(absent.begin() + static_cast<std::ptrdiff_t>(i));
-    } else if (!present.empty()) {
-      auto it = present.begin();
-      std::advance(it, static_cast<std::ptrdiff_t>(rng.below(present.size())));
-      dyn.erase(it->first);
-      absent.push_back(it->second);
-      present.erase(it);
-    }
+    dynmesh_test::random_update<3>(dyn, present, absent, rng);
+    if (testing::Test::HasFatalFailure()) return;
     ASSERT_TRUE(apply_change(mesh, dyn.last_change())) << "the feed does not apply to the previous mesh";
     ASSERT_EQ(mesh, dyn.tetrahedra()) << "the feed does not replay to the new mesh";
     ASSERT_TRUE(agrees(dyn, current(), (u + 1) % full_every == 0));

@@ -44,6 +44,7 @@
 #include "dynmesh/errors.hpp"
 #include "dynmesh/tet_mesh.hpp"
 #include "mesh/block_feed.hpp"
+#include "mesh/point_placement.hpp"
 #include "quadtree/quadtree_core.hpp"
 
 namespace dynmesh::detail {
@@ -144,52 +145,24 @@ struct OctreeMeshProgram {
   sac::Mod<Node*>* input;
   OctreeFeed* log;
 
+  using Placement = PointPlacement<3, OctreeMeshProgram>;
+
   Slot<3>& slot(sac::Engine& r, const CellId<3>& c) { return dir->get(r, c); }
   const OctreeGrid& grid() const { return log->grid; }
 
   static void main(sac::Engine& r, OctreeMeshProgram* cx) {
-    r.memo_read(*cx->input, sac::fn<&place>(cx));
+    r.memo_read(*cx->input, sac::fn<&Placement::place>(cx));
     r.memo(sac::fn<&gather_root>(cx));
     r.memo(sac::fn<&emit_root>(cx));
   }
 
   // ------------------------------------------------------------------ the points
-  static void place(sac::Engine& r, Node* n, OctreeMeshProgram* cx) {
-    if (!n) return;
-    r.memo(sac::fn<&descend>(cx, n, 0));
-    r.memo_read(n->next, sac::fn<&place>(cx));
-  }
-
-  /// Reads cell_of(q, l).split; only its T* bit steers (tree_split), which no postprocess
-  /// write changes.
-  static void descend(sac::Engine& r, OctreeMeshProgram* cx, Node* n, int l) {
-    if (l >= kMaxLevel) return settle(r, cx, n, kMaxLevel);
-    r.read(cx->slot(r, cell_of(n->q, l)).split, [cx, n, l](sac::Engine& e, std::uint8_t v) {
-      if (tree_split(v)) descend(e, cx, n, l + 1);
-      else settle(e, cx, n, l);
-    });
-  }
-
   static void settle(sac::Engine& r, OctreeMeshProgram* cx, Node* n, int tree_level) {
     const auto* in = static_cast<const InputNode<3>*>(n);
     const BlockTarget t = block_target(cx->grid(), n->q, in->point, tree_level);
-    for_each_block_parent(t, [&](const CellId<3>& u) { split(r, cx, u); });
-    for_each_block_cell(t, [&](const CellId<3>& x, std::uint8_t mark) {
-      r.read(cx->slot(r, x).split, [cx, x, mark](sac::Engine& e, std::uint8_t v) {
-        // A split value here would break the closure's rule; the checkers report it.
-        if (!any_split(v)) e.write(cx->slot(e, x).split, mark);
-      });
-    });
+    for_each_block_parent(t, [&](const CellId<3>& u) { Placement::split(r, cx, u); });
+    for_each_block_cell(t, [&](const CellId<3>& x, std::uint8_t mark) { Placement::mark(r, cx, x, mark); });
     r.write(cx->slot(r, t.owner).pts, n);
-  }
-
-  /// SPLIT' and grading: c and the coarser cells it forces become split.
-  static void split(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c) {
-    r.read(cx->slot(r, c).split, [cx, c](sac::Engine& e, std::uint8_t v) {
-      if (any_split(v)) return;
-      e.write(cx->slot(e, c).split, kRefineSplit);
-      if (c.level > 0) for_each_coarser_touching(c, [&](const CellId<3>& u) { split(e, cx, u); });
-    });
   }
 
   // ------------------------------------------------------------------ first walk: the kids
