@@ -74,12 +74,14 @@ inline constexpr MemoryCost kOctree3dCost{20'500, 5'600};
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o          7,050,276 KiB: 72,112 B/point
 //   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o --check  8,130,208 KiB: +11,057 B/point
 inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};
-// The octree's tetrahedral mesh (DynamicOctreeMesh, `dynmesh mesh` in 3D): not measured yet.
-// Until it is, as above, the guard assumes this placeholder per point held, and 15% more for
-// --check (the static OctreeMesh beside it).
-inline constexpr std::uint64_t kOctreeMeshBytesPerPointPlaceholder = 60'000;
-inline constexpr MemoryCost kOctreeMeshCost{kOctreeMeshBytesPerPointPlaceholder,
-                                            kOctreeMeshBytesPerPointPlaceholder * 15 / 100};
+// The octree's tetrahedral mesh (DynamicOctreeMesh, `dynmesh mesh` in 3D), measured as above
+// at n = 5,000 (python3 random.Random(3), uniform in the unit cube; 100 deletions and their
+// reinsertions), less a 40-point run (15 MB); about 1,460 tetrahedra a point, which the peak
+// follows (the trace, the index mesh and its text), with 30% added. --check's own cost is the
+// static twin's tetrahedra held as coordinates and the checker's face lists.
+//   /usr/bin/time -v dynmesh mesh u5e3.xyz --edits u5e3.edits -o o            535,156 KiB: 106,400 B/point
+//   /usr/bin/time -v dynmesh mesh u5e3.xyz --edits u5e3.edits -o o --check  1,468,120 KiB: +191,622 B/point
+inline constexpr MemoryCost kOctreeMeshCost{135'000, 250'000};
 // The hpu meshes cost more per point as the angle bound rises (more Steiner points), and
 // far more on points along curves than on uniform ones: the mesh grades away from each dense
 // curve, so collinear and spiral points make 2 to 2.5 times the vertices (and trace) per
