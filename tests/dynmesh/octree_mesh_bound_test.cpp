@@ -1,32 +1,37 @@
 // octree_mesh_bound_test.cpp — the proof that every dihedral angle of the octree's tetrahedral
 // mesh lies in [kOctreeMinDihedral, kOctreeMaxDihedral] (octree_mesh.hpp): exhaustive
-// enumeration of the templates, interval arithmetic over the point region.
+// enumeration of the templates, outward-rounded interval and affine arithmetic over the
+// point region.
 //
 // Purpose: the machine part of docs/OCTREE_MESH.md, "The dihedral bound, proved".
-//   * Enumeration. Every tetrahedron of the mesh is Kuhn's, or (apex, triangle) with the
-//     triangle on one face of a leaf and the apex the leaf's centre or a block's point. The rule
-//     that triangulates a face reads the split state of nine cells; all 2^9 assignments of them,
-//     for the 6 faces of a leaf and the 24 outer faces of a block, go through the real
-//     cone_face, a superset of every legal neighbourhood. The cross-checks show that
+//   * Enumeration. Every tetrahedron of the mesh is one of Kuhn's six, or (apex, triangle)
+//     with the triangle on one face of a leaf and the apex the leaf's centre or a block's
+//     point. The rule that triangulates a face reads the split state of nine cells; all 2^9
+//     assignments, for the 6 faces of a leaf and the 24 outer faces of a block, go through the
+//     real cone_face: a superset of every legal neighbourhood. The cross-checks show that
 //     tetrahedralize_leaf and tetrahedralize_block emit exactly these per-face cones.
 //   * Continuum. A block's point is free in the cube |p − v|∞ ≤ s/2 around its grid vertex v.
-//     A template's coordinates are intervals; an undecided box is bisected along the widest
-//     axis of the apex, at most kMaxBisections times per path. A pass proves the bounds for
-//     every point of the region.
-//   * Enclosures. Naive interval evaluation first; when it is too wide, the mean-value form
-//     f(X) ⊆ f(x̂) + Σ ∂f/∂x_i(X)·(X_i − x̂_i), with the gradient enclosed by forward-mode
-//     differentiation in interval arithmetic (Dual). Both are enclosures; their intersection is.
-//   * Rounding. Outside dyadic boxes grid vertices round and the location of a point can
-//     shift it by a few ulps. Meshed cells are ≥ 2^13 ulps wide (detail/mesh_grid.hpp), so a
-//     grid coordinate is a variable within s·2^-11 of its exact value, shared by every corner
-//     with that grid coordinate on that axis (BasicMeshGrid::coord is a function of the axis
-//     and the grid coordinate alone), and the point region is widened by s·2^-10 per side.
-// Invariants checked: the interval operations enclose the exact (GMP) results, the mean-value
-// form encloses sampled values; every template is positively oriented with its six dihedral
-// angles in the bounds; the same machinery refuses false bounds (14° minimum, 160° maximum).
-// Complexity: 606 distinct templates, each bisected adaptively (a few thousand boxes in all).
-// Paper: Moore, "Interval Analysis" (1966): outward rounding and the mean-value form; Kuhn's
-// subdivision of the cube.
+//     A template's coordinates are interval variables; a box that is not certified is bisected
+//     along the apex's widest axis, at most kMaxBisections times per path. A pass proves the
+//     bounds for every point of the region; no position is sampled.
+//   * Enclosures. The naive interval evaluation first; when it is too wide, affine arithmetic
+//     (first-order forms over the template's variables, remainders and rounding errors bounded
+//     from above), intersected with it. Normals are computed from a corner other than the
+//     apex, so the apex enters each of them linearly.
+//   * Rounding. In a box that is not dyadic, grid vertices round and the location of a point
+//     can be off by a few ulps; meshed cells are ≥ 2^13 ulps wide (detail/mesh_grid.hpp). So a
+//     grid coordinate is a variable within s·2^-11 of its exact value, one variable per axis
+//     and grid coordinate (BasicMeshGrid::coord depends on nothing else, so corners that share
+//     a grid coordinate share its double), and the point region is widened by s·2^-10.
+//     docs/OCTREE_MESH.md states the derivation and the one case it does not cover.
+// Invariants checked: the interval and affine operations enclose the exact (GMP) results; every
+// template is positively oriented with its six dihedral angles in the bounds; the same
+// machinery refuses false bounds (a 14° minimum, a 160° maximum).
+// Complexity: 546 templates (18 distinct triangles per face), about 250 000 boxes, ~4 s in
+// Release; under AddressSanitizer every fourth template.
+// Paper: Moore, "Interval Analysis" (1966), outward rounding; Comba & Stolfi, "Affine
+// arithmetic" (1993), and Stolfi & de Figueiredo (1997) for the Chebyshev approximation of
+// 1/√x; Kuhn's subdivision of the cube.
 #include <gmpxx.h>
 #include <gtest/gtest.h>
 
@@ -54,6 +59,7 @@
 #include "dynmesh/detail/octree_mesh_rules.hpp"
 #include "dynmesh/octree_mesh.hpp"
 #include "dynmesh/tet_mesh.hpp"
+#include "../sanitized.hpp"
 
 namespace {
 
@@ -124,54 +130,189 @@ Interval sqrt(const Interval& a) {
 Interval intersect(const Interval& a, const Interval& b) { return {std::max(a.lo, b.lo), std::min(a.hi, b.hi)}; }
 const Interval& value(const Interval& a) { return a; }
 
-// ------------------------------------------- forward-mode gradients for the mean-value form
+// ------------------------------------------------------------------------ affine arithmetic
 
 /// A template has at most this many variables (a block: 3 for its point and at most 3 grid
 /// coordinates per axis; a leaf: its 4 corners share grid coordinates).
 constexpr std::size_t kVars = 12;
 
-/// A value and its gradient with respect to the template's first n variables, each enclosed
-/// over the whole box: d[i] ∋ ∂f/∂x_i(ξ) for every ξ of the box (the chain rule in interval
-/// arithmetic). Entries from n on are zero and not computed.
-struct Dual {
-  Interval v;
-  std::array<Interval, kVars> d{};
-  std::size_t n = 0;
+constexpr double kUnitRoundoff = 0x1p-53;
+/// Covers the absolute error of a product that underflows (≤ 2^-1075); nothing here comes near.
+constexpr double kTiny = 0x1p-1000;
+
+double mul_up(double a, double b) { return up(a * b); }  // ≥ a·b for a, b ≥ 0
+
+/// An upper bound of a sum of non-negative doubles, without rounding each step: recursive
+/// summation of m ≤ 2^20 terms errs by less than m·u·sum < 2^-32·sum, so (1 + 2^-32) times the
+/// computed sum, rounded up, bounds the exact one.
+class UpperSum {
+ public:
+  void add(double v) { s_ += v; }
+  double bound() const { return up(s_ * (1 + 0x1p-32)); }
+
+ private:
+  double s_ = 0;
 };
 
-Dual operator+(const Dual& a, const Dual& b) {
-  Dual r{a.v + b.v, {}, std::max(a.n, b.n)};
-  for (std::size_t i = 0; i < r.n; ++i) r.d[i] = a.d[i] + b.d[i];
-  return r;
+/// The rounding errors of one affine operation. A double v computed by one correctly rounded
+/// + or × from exact operands is within u·|exact| < 2u·|v| of it (kTiny more on underflow), and
+/// errors of a chain add up.
+class Roundoff {
+ public:
+  void rounded(double v) {
+    values_.add(std::fabs(v));
+    ++count_;
+  }
+  void term(double t) { terms_.add(t); }  // t ≥ 0, itself an upper bound
+  double bound() const {
+    return up(up(mul_up(values_.bound(), 2 * kUnitRoundoff) + terms_.bound()) + count_ * kTiny);
+  }
+
+ private:
+  UpperSum values_, terms_;
+  int count_ = 0;
+};
+
+/// An affine form: the set c + Σ a_i·ε_i + e over ε ∈ [−1, 1]^n, |e| ≤ r. The ε_i are the
+/// template's variables scaled to [−1, 1], shared by every form of one evaluation, so linear
+/// dependencies cancel exactly (Comba & Stolfi's affine arithmetic); every nonlinear remainder
+/// and every rounding error goes into r, bounded from above.
+struct Affine {
+  double c = 0;
+  std::array<double, kVars> a{};
+  double r = 0;
+  std::size_t n = 0;
+
+  /// Σ|a_i| + r: x lies in [c − radius, c + radius].
+  double radius() const {
+    UpperSum s;
+    s.add(r);
+    for (std::size_t i = 0; i < n; ++i) s.add(std::fabs(a[i]));
+    return s.bound();
+  }
+  Interval range() const {
+    const double rad = radius();
+    return {down(c - rad), up(c + rad)};
+  }
+};
+
+/// The variable i over [lo, hi]: centre and half-width (rounded so that the form covers it).
+Affine variable(std::size_t i, std::size_t n, const Interval& x) {
+  Affine f;
+  f.n = n;
+  f.c = x.mid();
+  f.a[i] = std::max(up(x.hi - f.c), up(f.c - x.lo));
+  return f;
 }
-Dual operator-(const Dual& a, const Dual& b) {
-  Dual r{a.v - b.v, {}, std::max(a.n, b.n)};
-  for (std::size_t i = 0; i < r.n; ++i) r.d[i] = a.d[i] - b.d[i];
-  return r;
+
+/// The constant x (exact) in an evaluation over n variables.
+Affine constant(double x, std::size_t n) {
+  Affine f;
+  f.n = n;
+  f.c = x;
+  return f;
 }
-Dual operator*(const Dual& a, const Dual& b) {
-  Dual r{a.v * b.v, {}, std::max(a.n, b.n)};
-  for (std::size_t i = 0; i < r.n; ++i) r.d[i] = a.d[i] * b.v + a.v * b.d[i];
-  return r;
+
+Affine add_or_sub(const Affine& x, const Affine& y, double sign) {
+  Affine z;
+  z.n = std::max(x.n, y.n);
+  Roundoff e;
+  z.c = x.c + sign * y.c;
+  e.rounded(z.c);
+  for (std::size_t i = 0; i < z.n; ++i) {
+    z.a[i] = x.a[i] + sign * y.a[i];
+    e.rounded(z.a[i]);
+  }
+  e.term(x.r);
+  e.term(y.r);
+  z.r = e.bound();
+  return z;
 }
-Dual operator/(const Dual& a, const Dual& b) {  // (a/b)' = (a' − (a/b)·b') / b
-  Dual r{a.v / b.v, {}, std::max(a.n, b.n)};
-  for (std::size_t i = 0; i < r.n; ++i) r.d[i] = (a.d[i] - r.v * b.d[i]) / b.v;
-  return r;
+Affine operator+(const Affine& x, const Affine& y) { return add_or_sub(x, y, 1); }
+Affine operator-(const Affine& x, const Affine& y) { return add_or_sub(x, y, -1); }
+
+/// (x_c + X)(y_c + Y) = x_c·y_c + x_c·Y + y_c·X + X·Y, |X·Y| ≤ rad(X)·rad(Y).
+Affine operator*(const Affine& x, const Affine& y) {
+  Affine z;
+  z.n = std::max(x.n, y.n);
+  Roundoff e;
+  z.c = x.c * y.c;
+  e.rounded(z.c);
+  for (std::size_t i = 0; i < z.n; ++i) {
+    const double t1 = x.c * y.a[i], t2 = y.c * x.a[i];
+    z.a[i] = t1 + t2;
+    e.rounded(t1);
+    e.rounded(t2);
+    e.rounded(z.a[i]);
+  }
+  e.term(mul_up(std::fabs(x.c), y.r));
+  e.term(mul_up(std::fabs(y.c), x.r));
+  e.term(mul_up(x.radius(), y.radius()));
+  z.r = e.bound();
+  return z;
 }
-Dual square(const Dual& a) {
-  Dual r{square(a.v), {}, a.n};
-  const Interval twice = Interval::point(2) * a.v;
-  for (std::size_t i = 0; i < r.n; ++i) r.d[i] = twice * a.d[i];
-  return r;
+
+/// (x_c + X)² = x_c² + 2·x_c·X + X², with X² in [0, rad²]: its midpoint joins the centre.
+Affine square(const Affine& x) {
+  Affine z;
+  z.n = x.n;
+  Roundoff e;
+  const double rad = x.radius(), half = mul_up(mul_up(rad, rad), 0.5);
+  const double c2 = x.c * x.c;
+  z.c = c2 + half;
+  e.rounded(c2);
+  e.rounded(z.c);
+  for (std::size_t i = 0; i < z.n; ++i) {
+    z.a[i] = (2 * x.c) * x.a[i];  // 2·x_c is exact
+    e.rounded(z.a[i]);
+  }
+  e.term(mul_up(2 * std::fabs(x.c), x.r));
+  e.term(half);
+  z.r = e.bound();
+  return z;
 }
-Dual sqrt(const Dual& a) {  // only called with a.v.lo > 0; (√a)' = a' / (2√a)
-  Dual r{sqrt(a.v), {}, a.n};
-  const Interval twice = Interval::point(2) * r.v;
-  for (std::size_t i = 0; i < r.n; ++i) r.d[i] = a.d[i] / twice;
-  return r;
+
+/// 1/√x by its Chebyshev line over the range [lo, hi] (Stolfi & de Figueiredo): α the slope
+/// of the chord, g(x) = 1/√x − α·x convex, so g lies between its minimum (bounded below by the
+/// tangent at ξ, where the derivative is near α) and its larger end value. Any α and ξ are
+/// sound: they only make the bound looser. Needs range > 0.
+Affine inv_sqrt(const Affine& x) {
+  Affine z;
+  z.n = x.n;
+  const Interval range = x.range();
+  if (!(range.lo > 0 && range.hi < kInf)) {
+    z.r = kInf;  // nothing certifiable
+    return z;
+  }
+  auto f = [](double v) { return Interval::point(1) / sqrt(Interval::point(v)); };
+  auto g = [&](double v, double alpha) { return f(v) - Interval::point(alpha) * Interval::point(v); };
+  const double lo = range.lo, hi = range.hi;
+  const double alpha = hi > lo ? (1 / std::sqrt(hi) - 1 / std::sqrt(lo)) / (hi - lo) : -0.5 / (lo * std::sqrt(lo));
+  const double xi = std::clamp(std::pow(-2 * alpha, -2.0 / 3), lo, hi);  // f'(ξ) = −ξ^(−3/2)/2 = α
+  const Interval slope_at_xi = Interval::point(-0.5) / (Interval::point(xi) * sqrt(Interval::point(xi))) -
+                               Interval::point(alpha);
+  const double g_min = std::min((g(xi, alpha) + slope_at_xi * (Interval::point(lo) - Interval::point(xi))).lo,
+                                (g(xi, alpha) + slope_at_xi * (Interval::point(hi) - Interval::point(xi))).lo);
+  const double g_max = std::max(g(lo, alpha).hi, g(hi, alpha).hi);
+  // 1/√x = α·x + ζ ± δ, ζ the middle of [g_min, g_max].
+  const double zeta = 0.5 * (g_min + g_max);
+  const double delta = std::max(up(g_max - zeta), up(zeta - g_min));
+  Roundoff e;
+  const double ax = alpha * x.c;
+  z.c = ax + zeta;
+  e.rounded(ax);
+  e.rounded(z.c);
+  for (std::size_t i = 0; i < z.n; ++i) {
+    z.a[i] = alpha * x.a[i];
+    e.rounded(z.a[i]);
+  }
+  e.term(mul_up(std::fabs(alpha), x.r));
+  e.term(delta);
+  z.r = e.bound();
+  return z;
 }
-const Interval& value(const Dual& a) { return a.v; }
+Interval inv_sqrt(const Interval& x) { return Interval::point(1) / sqrt(x); }
+Interval value(const Affine& x) { return x.range(); }
 
 // --------------------------------------------------------------- the measures of a template
 
@@ -205,20 +346,29 @@ struct Measures {
   std::array<T, 6> cos;   // cos θ of the dihedral at each edge of kEdges
 };
 
-/// The measures of the tetrahedron p, in T = double-like Interval or Dual. False when a
-/// face's normal may vanish (then no cosine is defined).
+/// (P_j − P_i) × (P_k − P_i), the normal of triangle (i, j, k), computed from a corner other
+/// than 0 (a cyclic rotation gives the same vector): corner 0, the apex, then appears in one
+/// factor only, so the normal is linear in it and its enclosures stay tight.
+template <class T>
+Vec<T> normal(const std::array<Vec<T>, 4>& p, unsigned i, unsigned j, unsigned k) {
+  if (i == 0) return cross(p[k] - p[j], p[i] - p[j]);
+  return cross(p[j] - p[i], p[k] - p[i]);
+}
+
+/// The measures of the tetrahedron p, in T = Interval or Affine. False when a face's normal
+/// may vanish (then no cosine is defined).
 template <class T>
 bool measure(const std::array<Vec<T>, 4>& p, Measures<T>& m) {
-  m.det = dot(p[1] - p[0], cross(p[2] - p[0], p[3] - p[0]));
+  // det(P1 − P0, P2 − P0, P3 − P0) = (P0 − P1)·((P3 − P1) × (P2 − P1)): P0 in one factor.
+  m.det = dot(p[0] - p[1], cross(p[3] - p[1], p[2] - p[1]));
   for (unsigned k = 0; k < 6; ++k) {
     const auto& e = kEdges[k];
-    const Vec<T> edge = p[e[1]] - p[e[0]];
     // Both normals are orthogonal to the edge, and their angle is the angle between the two
-    // faces inside the tetrahedron: cos θ = n_k·n_l / √(|n_k|²|n_l|²).
-    const Vec<T> nk = cross(edge, p[e[2]] - p[e[0]]), nl = cross(edge, p[e[3]] - p[e[0]]);
-    const T d = norm2(nk) * norm2(nl);
-    if (!(value(d).lo > 0)) return false;
-    m.cos[k] = dot(nk, nl) / sqrt(d);
+    // faces inside the tetrahedron: cos θ = n_k·n_l / (|n_k|·|n_l|).
+    const Vec<T> nk = normal(p, e[0], e[1], e[2]), nl = normal(p, e[0], e[1], e[3]);
+    const T dk = norm2(nk), dl = norm2(nl);
+    if (!(value(dk).lo > 0 && value(dl).lo > 0)) return false;
+    m.cos[k] = dot(nk, nl) * inv_sqrt(dk) * inv_sqrt(dl);
   }
   return true;
 }
@@ -275,30 +425,15 @@ bool enclose_naive(const Template& t, const std::vector<Interval>& x, Measures<I
   return measure(corners(t, x), m);
 }
 
-/// The mean-value enclosure over the box x: the measures at the box's centre plus the
-/// gradients over the box times the box's offsets from its centre.
-/// `slopes`, when given, receives the gradients.
-bool enclose_mean_value(const Template& t, const std::vector<Interval>& x, Measures<Interval>& m,
-                        Measures<Dual>* slopes = nullptr) {
-  std::vector<Interval> centre(x.size());
-  for (std::size_t i = 0; i < x.size(); ++i) centre[i] = Interval::point(x[i].mid());
-  if (!measure(corners(t, centre), m)) return false;
-  std::array<Vec<Dual>, 4> p;
+/// The affine enclosure of the measures over the box x.
+bool enclose_affine(const Template& t, const std::vector<Interval>& x, Measures<Interval>& m) {
+  std::array<Vec<Affine>, 4> p;
   for (unsigned k = 0; k < 4; ++k)
-    for (unsigned a = 0; a < 3; ++a) {
-      const std::uint8_t i = t.at[k][a];
-      p[k][a].v = x[i];
-      p[k][a].d[i] = Interval::point(1);
-      p[k][a].n = x.size();
-    }
-  Measures<Dual> g;
-  if (!measure(p, g)) return false;
-  auto add_slope = [&](Interval& f, const Dual& slope) {
-    for (std::size_t i = 0; i < x.size(); ++i) f = f + slope.d[i] * (x[i] - centre[i]);
-  };
-  add_slope(m.det, g.det);
-  for (unsigned k = 0; k < 6; ++k) add_slope(m.cos[k], g.cos[k]);
-  if (slopes) *slopes = g;
+    for (unsigned a = 0; a < 3; ++a) p[k][a] = variable(t.at[k][a], x.size(), x[t.at[k][a]]);
+  Measures<Affine> f;
+  if (!measure(p, f)) return false;
+  m.det = f.det.range();
+  for (unsigned k = 0; k < 6; ++k) m.cos[k] = f.cos[k].range();
   return true;
 }
 
@@ -319,7 +454,7 @@ struct AngleBounds {
 /// What a proof saw: the certified cosine extremes over every box it accepted (so the angles
 /// they give bracket every dihedral of the mesh), its effort, and why it failed.
 struct ProofStats {
-  std::size_t templates = 0, boxes = 0, mean_value_boxes = 0;
+  std::size_t templates = 0, boxes = 0, affine_boxes = 0;
   int deepest = 0;
   double cos_lo = 1, cos_hi = -1;
   bool failed = false;
@@ -330,53 +465,37 @@ struct ProofStats {
   double max_angle_deg() const { return std::acos(std::max(-1.0, cos_lo)) * 180 / std::numbers::pi; }
 };
 
-bool det_within(const Interval& det) { return det.lo > 0; }
-bool cos_within(const Interval& c, const AngleBounds& bounds) { return c.hi <= bounds.cos_min && c.lo >= bounds.cos_max; }
+/// Positive, and every cosine in [cos_max, cos_min] (false on a NaN).
 bool within(const Measures<Interval>& m, const AngleBounds& bounds) {
-  if (!det_within(m.det)) return false;
+  if (!(m.det.lo > 0)) return false;
   for (const Interval& c : m.cos)
-    if (!cos_within(c, bounds)) return false;
+    if (!(c.hi <= bounds.cos_min && c.lo >= bounds.cos_max)) return false;
   return true;
 }
 
-double magnitude(const Interval& a) { return std::max(std::fabs(a.lo), std::fabs(a.hi)); }
-
 /// Certifies the template over the box x: positive orientation and all six angles in bounds.
-/// When it cannot, `split` names the apex coordinate to bisect: the one whose slope times
-/// width weighs most in the enclosures that failed (the widest when no slope is known).
-bool certify(const Template& t, const std::vector<Interval>& x, const AngleBounds& bounds, ProofStats& stats,
-             std::uint8_t& split) {
-  split = t.at[0][0];
-  for (unsigned a = 1; a < 3; ++a)
-    if (x[t.at[0][a]].width() > x[split].width()) split = t.at[0][a];
-  Measures<Interval> naive, mv, m;
-  Measures<Dual> slopes;
+/// The naive enclosure first (enough for a leaf's templates); then affine arithmetic, whose
+/// enclosure is intersected with the naive one (both hold).
+bool certify(const Template& t, const std::vector<Interval>& x, const AngleBounds& bounds, ProofStats& stats) {
+  Measures<Interval> naive, m;
   const bool has_naive = enclose_naive(t, x, naive);
   if (has_naive && within(naive, bounds)) {
     m = naive;
   } else {
-    ++stats.mean_value_boxes;
-    if (!enclose_mean_value(t, x, mv, &slopes)) return false;
-    m = mv;
+    ++stats.affine_boxes;
+    if (!enclose_affine(t, x, m)) return false;
     if (has_naive) {
-      m.det = intersect(naive.det, mv.det);
-      for (unsigned k = 0; k < 6; ++k) m.cos[k] = intersect(naive.cos[k], mv.cos[k]);
-    }
-    if (!within(m, bounds)) {
-      double best = -1;
-  #ifdef ALLVARS
-      for (std::uint8_t i = 0; i < x.size(); ++i) {
-#else
-      for (unsigned a = 0; a < 3; ++a) {
-        const std::uint8_t i = t.at[0][a];
-#endif
-        double weight = det_within(m.det) ? 0 : magnitude(slopes.det.d[i]);
-        for (unsigned k = 0; k < 6; ++k)
-          if (!cos_within(m.cos[k], bounds)) weight += magnitude(slopes.cos[k].d[i]);
-        if (weight * x[i].width() > best) best = weight * x[i].width(), split = i;
+      m.det = intersect(naive.det, m.det);
+      for (unsigned k = 0; k < 6; ++k) m.cos[k] = intersect(naive.cos[k], m.cos[k]);
+      // Both enclose the same values: disjoint enclosures would be a bug, not a proof.
+      bool empty = m.det.lo > m.det.hi;
+      for (const Interval& c : m.cos) empty = empty || c.lo > c.hi;
+      if (empty) {
+        ADD_FAILURE() << "the naive and affine enclosures are disjoint";
+        return false;
       }
-      return false;
     }
+    if (!within(m, bounds)) return false;
   }
   for (const Interval& c : m.cos) {
     stats.cos_lo = std::min(stats.cos_lo, c.lo);
@@ -386,10 +505,7 @@ bool certify(const Template& t, const std::vector<Interval>& x, const AngleBound
 }
 
 /// At most this many bisections of one template's apex region along any path.
-#ifndef MAXB
-#define MAXB 24
-#endif
-constexpr int kMaxBisections = MAXB;
+constexpr int kMaxBisections = 24;
 
 /// The six dihedral angles of a double tetrahedron, in degrees (for reports and samples).
 std::array<double, 6> dihedral_angles(const std::array<Frame3, 4>& t) {
@@ -410,15 +526,13 @@ std::string describe(const std::vector<Interval>& x) {
   return os.str();
 }
 
-/// Proves the template over the box x, bisecting an apex coordinate (certify's choice) while
-/// undecided.
+/// Proves the template over the box x, bisecting the apex's widest coordinate while undecided.
 /// False (with the reason in stats) when a path needs more than kMaxBisections.
 bool prove(const Template& t, const std::vector<Interval>& x, const AngleBounds& bounds, int depth,
            ProofStats& stats) {
   ++stats.boxes;
   stats.deepest = std::max(stats.deepest, depth);
-  std::uint8_t split = 0;
-  if (certify(t, x, bounds, stats, split)) return true;
+  if (certify(t, x, bounds, stats)) return true;
   if (depth == kMaxBisections) {
     std::array<Frame3, 4> centre;
     for (unsigned k = 0; k < 4; ++k)
@@ -432,6 +546,9 @@ bool prove(const Template& t, const std::vector<Interval>& x, const AngleBounds&
     stats.failure = os.str();
     return false;
   }
+  std::uint8_t split = t.at[0][0];
+  for (unsigned a = 1; a < 3; ++a)
+    if (x[t.at[0][a]].width() > x[split].width()) split = t.at[0][a];
   const double m = x[split].mid();
   std::vector<Interval> left = x, right = x;
   left[split].hi = m;
@@ -611,32 +728,26 @@ std::vector<Template> all_templates() {
   return out;
 }
 
-/// The whole proof for `bounds`; stops at the first template it cannot certify.
-ProofStats prove_all(const AngleBounds& bounds) {
+/// The proof for `bounds` over every `stride`-th template (1: all); stops at the first
+/// template it cannot certify.
+ProofStats prove_all(const AngleBounds& bounds, std::size_t stride) {
   ProofStats stats;
-  for (const Template& t : all_templates()) {
+  const std::vector<Template> templates = all_templates();
+  for (std::size_t i = 0; i < templates.size(); i += stride) {
     ++stats.templates;
-#ifdef VERBOSE
-    auto b0 = stats.boxes; int d0 = stats.deepest; stats.deepest = 0;
-    auto t0 = std::chrono::steady_clock::now();
-#endif
-    if (!prove(t, t.vars, bounds, 0, stats)) break;
-#ifdef VERBOSE
-    std::cout << "template " << stats.templates << " boxes " << stats.boxes - b0 << " deepest " << stats.deepest << " " << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() << std::endl;
-    stats.deepest = std::max(stats.deepest, d0);
-#endif
+    if (!prove(templates[i], templates[i].vars, bounds, 0, stats)) break;
   }
   return stats;
 }
 
-/// Sampled (not proved) extremes of every template: grid vertices exact, a block's point on
-/// the lattice of step s/8 over its region (corners included), no rounding margins.
+/// Sampled (not proved) extremes: grid vertices exact, a block's point on the lattice of step
+/// `step` (in units of s) over its region, corners included, no rounding margins.
 struct Sampled {
   double min = 180, max = 0;
   Frame3 min_apex{}, max_apex{};
 };
 
-Sampled sample_extremes() {
+Sampled sample_extremes(int per_half_side) {
   Sampled s;
   auto see = [&](const std::array<Frame3, 4>& t) {
     for (double a : dihedral_angles(t)) {
@@ -647,16 +758,43 @@ Sampled sample_extremes() {
   for (const auto& t : kuhn_tetrahedra()) see(t);
   for (const auto& t : leaf_family().triangles) see({Frame3{0, 0, 0}, t[0], t[1], t[2]});
   const Family blocks = block_family();
-  for (int i = -4; i <= 4; ++i)
-    for (int j = -4; j <= 4; ++j)
-      for (int k = -4; k <= 4; ++k)
-        for (const auto& t : blocks.triangles) see({Frame3{i / 8.0, j / 8.0, k / 8.0}, t[0], t[1], t[2]});
+  const double step = 0.5 / per_half_side;
+  for (int i = -per_half_side; i <= per_half_side; ++i)
+    for (int j = -per_half_side; j <= per_half_side; ++j)
+      for (int k = -per_half_side; k <= per_half_side; ++k)
+        for (const auto& t : blocks.triangles) see({Frame3{i * step, j * step, k * step}, t[0], t[1], t[2]});
   return s;
 }
+
+/// Under AddressSanitizer (CI's -O0 job) the proof visits every fourth template only; the
+/// full proof is the build without it.
+constexpr std::size_t kTemplateStride = test_support::kSanitized ? 4 : 1;
+
+/// 6 Kuhn + 6 faces × 18 + 24 faces × 18: a face's distinct triangles are the 8 of its
+/// quarters, the 2 of its diagonal, and the fans' 4 whole-edge and 8 half-edge triangles, 4
+/// of which are quarter triangles.
+constexpr std::size_t kTriangleKinds = 18;
+constexpr std::size_t kTemplates = 6 + 6 * kTriangleKinds + 24 * kTriangleKinds;
 
 // ------------------------------------------------------------------------------- the tests
 
 bool contains(const Interval& i, const mpq_class& v) { return mpq_class(i.lo) <= v && v <= mpq_class(i.hi); }
+
+TEST(OctreeMeshBoundInterval, OutwardStepIsNextafter) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> mant(-1, 1);
+  std::uniform_int_distribution<int> exp(-1074, 1023);
+  for (int i = 0; i < 100000; ++i) {
+    const double x = std::ldexp(mant(rng), exp(rng));
+    ASSERT_EQ(down(x), std::nextafter(x, -kInf)) << x;
+    ASSERT_EQ(up(x), std::nextafter(x, kInf)) << x;
+  }
+  for (double x : {0.0, -0.0, std::numeric_limits<double>::denorm_min(), -std::numeric_limits<double>::max(),
+                   std::numeric_limits<double>::max()}) {
+    EXPECT_EQ(down(x), std::nextafter(x, -kInf)) << x;
+    EXPECT_EQ(up(x), std::nextafter(x, kInf)) << x;
+  }
+}
 
 TEST(OctreeMeshBoundInterval, EnclosesExactResults) {
   std::mt19937_64 rng(20240611);
@@ -675,7 +813,9 @@ TEST(OctreeMeshBoundInterval, EnclosesExactResults) {
     EXPECT_TRUE(contains(a - b, qa - qb));
     EXPECT_TRUE(contains(a * b, qa * qb));
     EXPECT_TRUE(contains(square(a), qa * qa));
-    if (b.lo > 0 || b.hi < 0) EXPECT_TRUE(contains(a / b, qa / qb));
+    if (b.lo > 0 || b.hi < 0) {
+      EXPECT_TRUE(contains(a / b, qa / qb));
+    }
     const mpq_class e = (qa * qb - qa) * (qa * qb - qa) + qb * qb;  // nested: (a·b − a)² + b·b
     EXPECT_TRUE(contains(square(a * b - a) + b * b, e));
     // √: lo² ≤ x ≤ hi², exactly.
@@ -695,9 +835,40 @@ TEST(OctreeMeshBoundInterval, EnclosesExactResults) {
   EXPECT_EQ(w.hi, kInf);
 }
 
-TEST(OctreeMeshBoundInterval, MeanValueFormEnclosesSamples) {
-  // Random tetrahedra near the regular corner, boxes of random widths; the mean-value form
-  // alone (not intersected with the naive enclosure) must contain every sampled value.
+TEST(OctreeMeshBoundInterval, AffineFormsEncloseExactResults) {
+  // Three variables over random intervals; a polynomial and 1/√ of a positive one, as affine
+  // forms; at random members, the exact values (GMP) lie in the forms' ranges.
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> coord(-2, 2), width(0, 0.5), unit(0, 1);
+  for (int trial = 0; trial < 500; ++trial) {
+    std::vector<Interval> box(3);
+    for (Interval& i : box) {
+      const double c = coord(rng), w = width(rng);
+      i = Interval{c - w, c + w};
+    }
+    std::array<Affine, 3> v;
+    for (std::size_t i = 0; i < 3; ++i) v[i] = variable(i, 3, box[i]);
+    const Affine poly = v[0] * v[1] - square(v[2]) + v[0] * v[0] * v[2];
+    const Affine positive = square(v[0]) + square(v[1] - v[2]) + constant(4, 3);
+    const Affine root = inv_sqrt(positive);
+    const Interval pr = poly.range(), rr = root.range();
+    ASSERT_TRUE(std::isfinite(pr.lo) && std::isfinite(pr.hi) && rr.lo > 0 && std::isfinite(rr.hi));
+    for (int s = 0; s < 20; ++s) {
+      mpq_class q[3];
+      for (std::size_t i = 0; i < 3; ++i)
+        q[i] = mpq_class(std::min(box[i].hi, box[i].lo + unit(rng) * box[i].width()));
+      EXPECT_TRUE(contains(pr, q[0] * q[1] - q[2] * q[2] + q[0] * q[0] * q[2])) << trial;
+      const mpq_class x = q[0] * q[0] + (q[1] - q[2]) * (q[1] - q[2]) + 4;
+      // lo ≤ 1/√x ≤ hi ⇔ lo²·x ≤ 1 ≤ hi²·x (lo > 0).
+      EXPECT_LE(mpq_class(rr.lo) * mpq_class(rr.lo) * x, 1) << trial;
+      EXPECT_GE(mpq_class(rr.hi) * mpq_class(rr.hi) * x, 1) << trial;
+    }
+  }
+}
+
+TEST(OctreeMeshBoundInterval, AffineMeasuresEncloseSamples) {
+  // Random tetrahedra near the regular corner, boxes of random widths; the affine enclosure
+  // alone (not intersected with the naive one) must contain every sampled value.
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> jitter(-0.2, 0.2), unit(0, 1), radius(1e-4, 5e-2);
   const Frame3 base[4] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
@@ -710,11 +881,11 @@ TEST(OctreeMeshBoundInterval, MeanValueFormEnclosesSamples) {
       b.grid_corner(k, {base[k][0] + jitter(rng), base[k][1] + jitter(rng), base[k][2] + jitter(rng)}, r / 4);
     const Template t = b.done();
     Measures<Interval> m;
-    ASSERT_TRUE(enclose_mean_value(t, t.vars, m));
+    ASSERT_TRUE(enclose_affine(t, t.vars, m));
     for (int s = 0; s < 20; ++s) {
       std::vector<Interval> x(t.vars.size());
       for (std::size_t i = 0; i < x.size(); ++i)
-        x[i] = Interval::point(t.vars[i].lo + unit(rng) * t.vars[i].width());
+        x[i] = Interval::point(std::min(t.vars[i].hi, t.vars[i].lo + unit(rng) * t.vars[i].width()));
       Measures<Interval> at;
       ASSERT_TRUE(enclose_naive(t, x, at));  // a point box: a tight enclosure of the value
       EXPECT_LE(m.det.lo, at.det.hi);
@@ -733,16 +904,25 @@ TEST(OctreeMeshBoundInterval, CertifiesTheRegularCorner) {
   TemplateBuilder b;
   for (unsigned k = 0; k < 4; ++k) b.grid_corner(k, c[k], 0);
   const Template t = b.done();
+  Measures<Interval> naive, affine;
+  ASSERT_TRUE(enclose_naive(t, t.vars, naive));
+  ASSERT_TRUE(enclose_affine(t, t.vars, affine));
+  for (const Measures<Interval>& m : {naive, affine}) {
+    EXPECT_TRUE(m.det.lo <= 1 && 1 <= m.det.hi);  // det(e_x, e_y, e_z)
+    for (unsigned k = 0; k < 6; ++k) {
+      const double want = kEdges[k][0] == 0 ? 0 : 1 / std::sqrt(3.0);  // apex edges: 90°
+      EXPECT_NEAR(m.cos[k].mid(), want, 1e-12) << k;
+    }
+  }
   ProofStats stats;
-  std::uint8_t split = 0;
-  EXPECT_TRUE(certify(t, t.vars, AngleBounds(54, 91), stats, split));
+  EXPECT_TRUE(certify(t, t.vars, AngleBounds(54, 91), stats));
   EXPECT_NEAR(stats.min_angle_deg(), 54.7356, 1e-3);
   EXPECT_NEAR(stats.max_angle_deg(), 90.0, 1e-3);
-  EXPECT_FALSE(certify(t, t.vars, AngleBounds(55, 91), stats, split));   // 54.7° < 55°
-  EXPECT_FALSE(certify(t, t.vars, AngleBounds(54, 89.9), stats, split));  // 90° > 89.9°
+  EXPECT_FALSE(certify(t, t.vars, AngleBounds(55, 91), stats));   // 54.7° < 55°
+  EXPECT_FALSE(certify(t, t.vars, AngleBounds(54, 89.9), stats));  // 90° > 89.9°
   Template flipped = t;  // corners 1 and 2 swapped: negative, refused
   std::swap(flipped.at[1], flipped.at[2]);
-  EXPECT_FALSE(certify(flipped, flipped.vars, AngleBounds(1, 179), stats, split));
+  EXPECT_FALSE(certify(flipped, flipped.vars, AngleBounds(1, 179), stats));
 }
 
 TEST(OctreeMeshBound, EnumerationMatchesTetrahedralizeLeaf) {
@@ -759,7 +939,6 @@ TEST(OctreeMeshBound, EnumerationMatchesTetrahedralizeLeaf) {
       std::vector<Tetrahedron> got, want;
       detail::tetrahedralize_leaf(grid, cell, mask, got);
       if ((mask & detail::kFaceEdgeNeighbours) == 0) {
-        want = {};
         detail::tetrahedralize_leaf(grid, cell, 0, want);  // Kuhn's six, certified as such
         ASSERT_EQ(want.size(), 6u);
       } else {
@@ -824,45 +1003,46 @@ TEST(OctreeMeshBound, EnumerationMatchesTetrahedralizeBlock) {
 }
 
 TEST(OctreeMeshBound, EnumerationCounts) {
-  // 2^9 assignments per face; the distinct triangles per face are 8 quarters, 2 halves and
-  // the fans' 12 (4 whole edges, 8 half edges): 22.
   const Family leaf = leaf_family(), block = block_family();
   EXPECT_EQ(leaf.assignments, 6u * 512);
   EXPECT_EQ(block.assignments, 24u * 512);
-  EXPECT_EQ(leaf.triangles.size(), 6u * 22);
-  EXPECT_EQ(block.triangles.size(), 24u * 22);
-  EXPECT_EQ(all_templates().size(), 6u + 6 * 22 + 24 * 22);
+  EXPECT_EQ(leaf.triangles.size(), 6 * kTriangleKinds);
+  EXPECT_EQ(block.triangles.size(), 24 * kTriangleKinds);
+  EXPECT_EQ(all_templates().size(), kTemplates);
+  RecordProperty("block_assignments", std::to_string(block.assignments));
+  RecordProperty("block_triangles_emitted", std::to_string(block.emitted));
 }
 
 TEST(OctreeMeshBound, ProvesTheStatedBounds) {
   const auto start = std::chrono::steady_clock::now();
-  const ProofStats stats = prove_all(AngleBounds(kOctreeMinDihedral, kOctreeMaxDihedral));
+  const ProofStats stats = prove_all(AngleBounds(kOctreeMinDihedral, kOctreeMaxDihedral), kTemplateStride);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   ASSERT_FALSE(stats.failed) << stats.failure;
-  EXPECT_EQ(stats.templates, 6u + 6 * 22 + 24 * 22);
-  std::cout << "[proof] every dihedral in [" << kOctreeMinDihedral << ", " << kOctreeMaxDihedral
-            << "] degrees: " << stats.templates << " templates, " << stats.boxes << " boxes ("
-            << stats.mean_value_boxes << " by the mean-value form), deepest path " << stats.deepest
-            << " bisections, " << seconds << " s; the accepted boxes bracket the angles in ["
-            << stats.min_angle_deg() << ", " << stats.max_angle_deg() << "]\n";
+  EXPECT_EQ(stats.templates, (kTemplates + kTemplateStride - 1) / kTemplateStride);
+  std::cout << "[proof] every dihedral angle in [" << kOctreeMinDihedral << ", " << kOctreeMaxDihedral
+            << "] degrees: " << stats.templates << " of " << kTemplates << " templates, " << stats.boxes
+            << " boxes (" << stats.affine_boxes << " affine), deepest path " << stats.deepest << " bisections, "
+            << seconds << " s; the accepted boxes bracket the angles in [" << stats.min_angle_deg() << ", "
+            << stats.max_angle_deg() << "]\n";
   RecordProperty("certified_bracket_min_deg", std::to_string(stats.min_angle_deg()));
   RecordProperty("certified_bracket_max_deg", std::to_string(stats.max_angle_deg()));
 }
 
 TEST(OctreeMeshBound, RefusesFalseBounds) {
-  // The sampled extremes (13.16°, 164.21°) violate these: the proof must fail, not pass.
-  const ProofStats min14 = prove_all(AngleBounds(14.0, kOctreeMaxDihedral));
-  EXPECT_TRUE(min14.failed);
-  const ProofStats max160 = prove_all(AngleBounds(kOctreeMinDihedral, 160.0));
-  EXPECT_TRUE(max160.failed);
-  std::cout << "[proof] refused 14 degrees: " << min14.failure.substr(0, 200) << "...\n";
+  // The sampled extremes (13.16°, 164.21°) violate these: the proof must fail on them.
+  for (const AngleBounds& wrong : {AngleBounds(14.0, kOctreeMaxDihedral), AngleBounds(kOctreeMinDihedral, 160.0)}) {
+    const ProofStats stats = prove_all(wrong, 1);
+    EXPECT_TRUE(stats.failed) << "proved the false bounds [" << wrong.min_deg << ", " << wrong.max_deg << "]";
+  }
 }
 
 TEST(OctreeMeshBound, SampledExtremes) {
-  const Sampled s = sample_extremes();
+  // Not a proof: the extremes the proof's bounds must contain, for the docs. The block's
+  // extremes lie at the corners of the point region, which every lattice holds.
+  const Sampled s = sample_extremes(test_support::kSanitized ? 1 : 4);
   std::cout << "[sampled] dihedral angles in [" << s.min << ", " << s.max << "] degrees; min at apex ("
-            << s.min_apex[0] << ", " << s.min_apex[1] << ", " << s.min_apex[2] << "), max at apex (" << s.max_apex[0]
-            << ", " << s.max_apex[1] << ", " << s.max_apex[2] << ") (units of s from v)\n";
+            << s.min_apex[0] << ", " << s.min_apex[1] << ", " << s.min_apex[2] << "), max at apex ("
+            << s.max_apex[0] << ", " << s.max_apex[1] << ", " << s.max_apex[2] << ") in units of s from v\n";
   RecordProperty("sampled_min_deg", std::to_string(s.min));
   RecordProperty("sampled_max_deg", std::to_string(s.max));
   EXPECT_GE(s.min, kOctreeMinDihedral);

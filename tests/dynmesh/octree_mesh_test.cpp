@@ -185,6 +185,26 @@ TEST(DynamicOctreeMesh, BadInputChangesNothing) {
   rejected(Kind::Absent, [&] { dyn.apply(batch); });
 }
 
+TEST(OctreeMesh, DyadicBoxesStopWhereTheProofsMarginEnds) {
+  // A pair 6 grid units apart in a dyadic box: with blocks at level 51 the rounded x − o put
+  // a point s/8 outside its region and gave a dihedral angle of 12.995°. The mesh now refuses
+  // spreads beyond level 42 in a dyadic box, where the proof's margin covers the rounding.
+  const Box<3> box{{-0.5, -0.5, -0.5}, 1.0};
+  const double a = 0x1.333333333332bp-2;
+  const std::vector<Point<3>> pts = {{a, a, a}, {a + 6 * 0x1p-52, a, a}};
+  try {
+    DynamicOctreeMesh dyn(box, pts);
+    ADD_FAILURE() << "the pair was meshed";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.kind(), Kind::Resolution) << e.what();
+  }
+  EXPECT_THROW(OctreeMesh(box, pts), InputError);
+  // At the deepest level allowed the bound holds.
+  const std::vector<Point<3>> near = {{a, a, a}, {a + 0x1p-41, a, a}};
+  const OctreeMesh m(box, near);
+  EXPECT_TRUE(good_mesh(m.mesh(), box, near));
+}
+
 TEST(OctreeMesh, RefinedTreeCheckerCatchesAMissingBlockCell) {
   const Box<3> box{{0.0, 0.0, 0.0}, 1.0};
   const std::vector<Point<3>> pts = {{0.3, 0.3, 0.3}, {0.7, 0.6, 0.65}};

@@ -1,8 +1,8 @@
 // dynmesh/octree_mesh.hpp — the octree's tetrahedral mesh of a 3D point set, static twin.
 //
-// Purpose: the plain static computation of the 3D `quadtree` postprocess (docs/DESIGN.md,
-// "The octree mesh"): from the points, the octree T*; from T*, the refined tree T' in which
-// each point owns a block of 2x2x2 same-size leaves around the grid vertex nearest to it;
+// Purpose: the plain static computation of the 3D `quadtree` postprocess
+// (docs/OCTREE_MESH.md): from the points, the octree T*; from T*, the refined tree T' in
+// which each point owns a block of 2x2x2 same-size leaves around the grid vertex nearest to it;
 // from T', a tetrahedral mesh of the closed box in which every input point is a vertex, the
 // tetrahedra tile the box with no hanging vertex, and every dihedral angle lies in
 // [kOctreeMinDihedral, kOctreeMaxDihedral]. It is the oracle of the self-adjusting mesh

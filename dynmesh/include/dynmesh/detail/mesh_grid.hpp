@@ -8,12 +8,12 @@
 // Coordinates: the grid vertex g (0..2^52 per axis) is o + g·(L·2^−52) in IEEE double, one
 // multiplication and one addition; g = 0 gives o and g = 2^52 gives fl(o + L).
 // Resolution: grid vertices are exact when the box is dyadic (L a power of two, o a multiple
-// of L·2^−52 with |o| ≤ L). Otherwise they round, and the mesh needs its deepest cells to span
-// many ulps: resolution_level() is the deepest level R at which the vertices two levels deeper
+// of L·2^−52 with |o| ≤ L; then R is kExactLimit). Otherwise they round, and the mesh needs its
+// deepest cells to span many ulps: resolution_level() is the deepest level R at which the vertices two levels deeper
 // are 2^12 ulps apart, and a point is rejected (Resolution) when another point lies in its
 // level-R neighbourhood or when it lies within one level-R cell of a box side it is not on.
 // Then every leaf of the refined trees has level ≤ R + 1.
-// Invariants: coord(a, g) is monotone in g; resolution_level(b) ≤ 50.
+// Invariants: coord(a, g) is monotone in g; resolution_level(b) ≤ kExactLimit ≤ 50.
 // Complexity: O(d) per call; check_mesh_resolution O(3^d).
 // Paper: none (the arithmetic of this project's meshes).
 #pragma once
@@ -56,14 +56,20 @@ struct BasicMeshGrid {
     bool exact = std::exp2(std::ilogb(b.side)) == b.side;
     for (unsigned a = 0; a < d && exact; ++a)
       exact = std::fmod(b.origin[a], unit) == 0.0 && std::fabs(b.origin[a]) <= b.side;
-    if (exact) return kMaxLevel - 2;
+    if (exact) return kExactLimit;
     double m = 0;
     for (unsigned a = 0; a < d; ++a)
       m = std::fmax(m, std::fmax(std::fabs(b.origin[a]), std::fabs(b.origin[a] + b.side)));
     // L·2^−(R+2) ≥ 2^12·ulp(m), ulp(m) = 2^(ilogb(m) − 52).
     const int r = std::ilogb(b.side) - std::ilogb(m) + 52 - 12 - 2;
-    return r > kMaxLevel - 2 ? kMaxLevel - 2 : r;
+    return r > kExactLimit ? kExactLimit : r;
   }
+
+  /// R in a dyadic box. A point's located position may be off by a quarter grid unit (the
+  /// rounded x − o), which the octree mesh's proved bound allows for (a margin of 2^−10 of a
+  /// block's side, docs/OCTREE_MESH.md) while its blocks, of level ≤ R + 1, are at least 2^8
+  /// grid units wide: R ≤ 42 in 3D keeps them 2^9 wide. The 2D mesh has no such margin.
+  static constexpr int kExactLimit = d == 3 ? 42 : kMaxLevel - 2;
 };
 
 /// The rejection rules of the header comment for inserting p (located at q). `present(c)`
