@@ -16,7 +16,16 @@
 # docs/data/mesh_* and docs/figures/mesh_* (hpu: hpu_*); the spread sweep stops at 2^36,
 # the deepest a mesh of derived-box coordinates resolves (mesh_resolution_level).
 #
-# Usage: bash bench/stability_experiments.sh [--quick] [--postprocess quadtree|hpu]
+# With `--postprocess quadtree --dim 3` they measure the octree's tetrahedral mesh
+# (DynamicOctreeMesh), into docs/data/mesh3d_* and docs/figures/mesh3d_*, on a smaller plan
+# (an update costs more, and each run's final check builds a from-scratch OctreeMesh, whose
+# tetrahedra, about 1,450 a uniform point at 96 bytes each, set the peak: 4.6 GB for
+# uniform 16000, 7.5 GB for the largest run at 16000): 100 updates a run; the spread sweep
+# `shrinking` at n = 2000 with L/s = 2^5 ... 2^30; uniform and clusters at n = 1000, 4000,
+# 16000 (and 64000 and 10^5 with MESH3D_LARGE=1, for a machine with the memory: 20 to 30 GB
+# at 64000); size at L/s = 2^20, n = 1000 ... 16000.
+#
+# Usage: bash bench/stability_experiments.sh [--quick] [--postprocess quadtree|hpu] [--dim 3]
 # It first brings build/release's `dynmesh` up to date with the sources (the Release build
 # of `bash dev.sh run`), so the figures are those of the tree checked out. DYNMESH=PATH runs
 # that binary instead, as it is. Either way the binary and its age go to stderr.
@@ -39,18 +48,32 @@ FIG=docs/figures
 mkdir -p "$DATA" "$FIG"
 QUICK=0
 PP=none
+DIM=2
 while (($#)); do
   case $1 in
     --quick) QUICK=1 ;;
     --postprocess) PP=${2:?--postprocess needs a value}; shift ;;
-    *) echo "usage: $0 [--quick] [--postprocess quadtree|hpu]" >&2; exit 2 ;;
+    --dim) DIM=${2:?--dim needs a value}; shift ;;
+    *) echo "usage: $0 [--quick] [--postprocess quadtree|hpu] [--dim 3]" >&2; exit 2 ;;
   esac
   shift
 done
+[[ $DIM == 2 || ($DIM == 3 && $PP == quadtree) ]] ||
+  { echo "$0: --dim 3 measures the octree mesh (--postprocess quadtree)" >&2; exit 2; }
 U=400
 ((QUICK)) && U=60
+# The plan: spread sweep (n, exponents), distributions (which, sizes), size series (sizes).
+SPREAD_N=4096 SPREAD_KS="8 12 16 20 24 28 32 36 40" DISTS="uniform clusters spiral"
+DIST_NS="1000 4000 16000 64000" SIZE_NS="1000 10000 100000" QUICK_MOD=8
 if [[ $PP == none ]]; then
   P=stability_ FP= DIMS="2 3" KMAX=40 PPARGS=() WHAT="the quadtree"
+elif [[ $PP == quadtree && $DIM == 3 ]]; then
+  P=mesh3d_stability_ FP=mesh3d_ DIMS=3 KMAX=30 PPARGS=(--postprocess "$PP") WHAT="the octree mesh"
+  U=100
+  ((QUICK)) && U=30
+  SPREAD_N=2000 SPREAD_KS="5 10 15 20 25 30" QUICK_MOD=10 DISTS="uniform clusters" SIZE_NS="1000 4000 16000"
+  DIST_NS="1000 4000 16000"
+  [[ ${MESH3D_LARGE:-0} == 1 ]] && DIST_NS+=" 64000 100000"
 elif [[ $PP == quadtree ]]; then
   P=mesh_stability_ FP=mesh_ DIMS=2 KMAX=36 PPARGS=(--postprocess "$PP") WHAT="the $PP mesh"
 else
@@ -76,24 +99,24 @@ run() {
 
 # 1. Trace distance against the spread, at fixed n.
 for dim in $DIMS; do
-  for k in 8 12 16 20 24 28 32 36 40; do
+  for k in $SPREAD_KS; do
     ((k > KMAX)) && continue
-    ((QUICK)) && ((k % 8 != 0)) && continue
-    run --dim $dim --dist shrinking --n 4096 --spread $((2 ** k)) --updates $U --seed 1 --csv "$SPREAD_CSV"
+    ((QUICK)) && ((k % QUICK_MOD != 0)) && continue
+    run --dim $dim --dist shrinking --n $SPREAD_N --spread $((2 ** k)) --updates $U --seed 1 --csv "$SPREAD_CSV"
   done
 done
 
 # 2. The other distributions: their spread comes with n.
-for dist in uniform clusters spiral; do
-  for n in 1000 4000 16000 64000; do
+for dist in $DISTS; do
+  for n in $DIST_NS; do
     ((QUICK)) && ((n > 4000)) && continue
-    run --dim 2 --dist $dist --n $n --updates $U --seed 1 --csv "$DIST_CSV"
+    run --dim $DIM --dist $dist --n $n --updates $U --seed 1 --csv "$DIST_CSV"
   done
 done
 
 # 3. No dependence on n at a fixed spread.
 for dim in $DIMS; do
-  for n in 1000 10000 100000; do
+  for n in $SIZE_NS; do
     ((QUICK)) && ((n > 10000)) && continue
     run --dim $dim --dist shrinking --n $n --spread $((2 ** 20)) --updates $U --seed 1 --csv "$SIZE_CSV"
   done
@@ -119,6 +142,29 @@ for f in "$SPREAD_CSV" "$DIST_CSV"; do
 done
 
 echo
+echo "### Per run: trace distance and update time (spread sweep, then the distributions)"
+echo
+echo "| dist | dim | n | log2(L/s) first update | updates | mean distance | median distance | max distance | mean update (µs) | median update (µs) |"
+echo "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+for f in "$SPREAD_CSV" "$DIST_CSV"; do
+  # A run is a block of rows with one (dist, dim, n) after a change of the spread's start.
+  awk -F, 'function flush(   i, j, x, m, md, mt) {
+      if (!k) return
+      m = k
+      for (i = 2; i <= m; i++) { x = d[i]; j = i - 1; while (j > 0 && d[j] > x) { d[j + 1] = d[j]; j-- } d[j + 1] = x }
+      for (i = 2; i <= m; i++) { x = t[i]; j = i - 1; while (j > 0 && t[j] > x) { t[j + 1] = t[j]; j-- } t[j + 1] = x }
+      md = m % 2 ? d[(m + 1) / 2] : (d[m / 2] + d[m / 2 + 1]) / 2
+      mt = m % 2 ? t[(m + 1) / 2] : (t[m / 2] + t[m / 2 + 1]) / 2
+      printf "| %s | %s | %s | %.2f | %d | %.1f | %.1f | %d | %.1f | %.1f |\n", key1, key2, key3, s0, m, sd / m, md, d[m], st / m * 1e6, mt * 1e6
+      k = 0; sd = 0; st = 0 }
+    FNR == 1 { flush(); next }
+    { key = $1 "," $2 "," $3
+      if (key != last || k >= '"$U"') { flush(); last = key; key1 = $1; key2 = $2; key3 = $3; s0 = $4 }
+      k++; d[k] = $6 + 0; t[k] = $7 + 0; sd += $6; st += $7 }
+    END { flush() }' "$f"
+done
+
+echo
 echo "### Mean trace distance and update time against n (shrinking, L/s = 2^20)"
 echo
 echo "| dim | n | updates | mean trace distance | mean update (µs) | median update (µs) |"
@@ -134,8 +180,8 @@ awk -F, 'FNR > 1 { k = $2 "," $3; n[k]++; td[k] += $6; t[k] += $7; v[k] = v[k] "
 # ---------------------------------------------------------------- pictures
 # Per-run means (series, log2 spread, distance) for the spread plot; size means per dim.
 grep -v '^shrinking' "$RUNS" > "$DATA/${FP}spread_means.dat" || true
-# The spread sweep's runs are the shrinking runs at n = 4096.
-awk '$1 ~ /^shrinking/ && $4 == 4096' "$RUNS" >> "$DATA/${FP}spread_means.dat"
+# The spread sweep's runs are the shrinking runs at n = SPREAD_N.
+awk -v n=$SPREAD_N '$1 ~ /^shrinking/ && $4 == n' "$RUNS" >> "$DATA/${FP}spread_means.dat"
 sort -k1,1 -k2,2n -o "$DATA/${FP}spread_means.dat" "$DATA/${FP}spread_means.dat"
 awk -F, 'FNR > 1 { k = $2 "d," $3; n[k]++; s[k] += $7; td[k] += $6 }
   END { for (k in n) { split(k, p, ","); print p[1], p[2], s[k] / n[k] * 1e6, td[k] / n[k] } }' "$SIZE_CSV" |
@@ -158,8 +204,8 @@ if command -v gnuplot >/dev/null; then
     done
     # The mesh's figure also shows the tree alone (from a tree run of this script), dashed.
     if [[ -n $FP && -s $DATA/spread_means.dat ]]; then
-      printf ", '< grep \"^shrinking-2d \" %s' using 2:3 with linespoints dt 2 title 'shrinking-2d, tree alone'" \
-        "$DATA/spread_means.dat"
+      printf ", '< grep \"^shrinking-%sd \" %s' using 2:3 with linespoints dt 2 title 'shrinking-%sd, tree alone'" \
+        "$DIM" "$DATA/spread_means.dat" "$DIM"
     fi
     echo
   } > "$DATA/${FP}spread.gp"
