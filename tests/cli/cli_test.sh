@@ -664,7 +664,7 @@ GNUPLOT
     dev fuzz 7
     grep -q '^cmake -S .* -B build/fuzz .*-DCMAKE_CXX_COMPILER=clang++ .*-DDYNMESH_FUZZ=ON -DDYNMESH_FUZZ_SECONDS=7 ' \
       calls.log || fail "fuzz: configure: $(cat calls.log)"
-    grep -qx 'cmake --build build/fuzz -j 1 --target fuzz_point_readers fuzz_edit_reader fuzz_dynamic_quadtree fuzz_dynamic_mesh fuzz_hpu_mesh' \
+    grep -qx 'cmake --build build/fuzz -j 1 --target fuzz_point_readers fuzz_edit_reader fuzz_dynamic_quadtree fuzz_dynamic_mesh fuzz_hpu_mesh fuzz_octree_mesh' \
       calls.log || fail "fuzz builds more or less than the fuzz targets: $(cat calls.log)"
     grep -q "^ctest --test-dir build/fuzz -L ^fuzz\$ " calls.log || fail "fuzz runs no ctest: $(cat calls.log)"
     PATH="$PWD/fake:$PATH" bash stub/dev.sh fuzz 1.5 >out.txt 2>err.txt && fail "fuzz accepted 1.5 seconds"
