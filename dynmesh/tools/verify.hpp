@@ -34,8 +34,6 @@
 #include "dynmesh/octree_mesh.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
 #include "dynmesh/static_quadtree.hpp"
-#include "dynmesh/tet_mesh_check.hpp"
-#include "dynmesh/tet_mesh_io.hpp"
 
 namespace dynmesh::tool {
 
@@ -60,6 +58,22 @@ struct Verification {
   std::string problem;          // why not, one line (empty when ok)
   double static_seconds = 0.0;  // time of the static from-scratch build
 };
+
+/// Runs `check` (invariant checkers); false, with the one-line reason in v.problem, when one
+/// of the library's or the runtime's checkers throws.
+template <class Check>
+bool invariants_hold(Verification& v, Check&& check) {
+  try {
+    check();
+  } catch (const dynmesh::InvariantError& e) {
+    v.problem = "invariant check failed: " + one_line(e.what());
+    return false;
+  } catch (const sac::InvariantError& e) {
+    v.problem = "runtime invariant check failed: " + one_line(e.what());
+    return false;
+  }
+  return true;
+}
 
 template <std::size_t d>
 Verification verify(const DynamicQuadtree<d>& tree) {
@@ -93,16 +107,11 @@ Verification verify(const DynamicQuadtree<d>& tree) {
                 line_at(dynamic_text, pos) + "' vs '" + line_at(static_text, pos) + "')";
     return v;
   }
-  try {
-    require_valid_tree<d>(tree.positions(), leaves);
-    tree.check_invariants();
-  } catch (const dynmesh::InvariantError& e) {
-    v.problem = "invariant check failed: " + one_line(e.what());
+  if (!invariants_hold(v, [&] {
+        require_valid_tree<d>(tree.positions(), leaves);
+        tree.check_invariants();
+      }))
     return v;
-  } catch (const sac::InvariantError& e) {
-    v.problem = "runtime invariant check failed: " + one_line(e.what());
-    return v;
-  }
   v.ok = true;
   return v;
 }
@@ -116,15 +125,7 @@ inline Verification verify(const DynamicMesh& dm, double min_angle_deg) {
   std::vector<Point<2>> pts;
   for (const auto& entry : dm.points()) pts.push_back(entry.second);
   const Mesh mesh = dm.mesh();
-  try {
-    dm.check_invariants();
-  } catch (const dynmesh::InvariantError& e) {
-    v.problem = "invariant check failed: " + one_line(e.what());
-    return v;
-  } catch (const sac::InvariantError& e) {
-    v.problem = "runtime invariant check failed: " + one_line(e.what());
-    return v;
-  }
+  if (!invariants_hold(v, [&] { dm.check_invariants(); })) return v;
   const bool hpu = dm.options().postprocess == Postprocess::Hpu;
   MeshCheckOptions check_options;
   check_options.min_angle_deg = min_angle_deg;
@@ -147,31 +148,20 @@ inline Verification verify(const DynamicMesh& dm, double min_angle_deg) {
   return v;
 }
 
-/// The 3D counterpart: the engine's and the mesh's invariants, require_valid_tet_mesh with
-/// the octree mesh's dihedral bounds on the final mesh, then the static twin OctreeMesh on
-/// the final points must give the same `.node` and `.ele` texts; static_seconds is its time.
+/// The 3D counterpart: the engine's and the mesh's invariants (DynamicOctreeMesh's checker
+/// includes require_valid_tet_mesh with the proved dihedral bounds), then the static twin
+/// OctreeMesh on the final points must give the same canonical mesh (hence the same `.node`
+/// and `.ele`); static_seconds is its time.
 inline Verification verify(const DynamicOctreeMesh& dm) {
   Verification v;
   std::vector<Point<3>> pts;
   for (const auto& entry : dm.points()) pts.push_back(entry.second);
+  if (!invariants_hold(v, [&] { dm.check_invariants(); })) return v;
   const TetMesh mesh = dm.mesh();
-  try {
-    dm.check_invariants();
-    TetMeshCheckOptions options;
-    options.min_dihedral_deg = kOctreeMinDihedral;
-    options.max_dihedral_deg = kOctreeMaxDihedral;
-    require_valid_tet_mesh(mesh, dm.box(), pts, options);
-  } catch (const dynmesh::InvariantError& e) {
-    v.problem = "invariant check failed: " + one_line(e.what());
-    return v;
-  } catch (const sac::InvariantError& e) {
-    v.problem = "runtime invariant check failed: " + one_line(e.what());
-    return v;
-  }
   const auto t0 = std::chrono::steady_clock::now();
   const TetMesh fresh = OctreeMesh(dm.box(), pts).mesh();
   v.static_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  if (format_node(fresh, dm.box()) != format_node(mesh, dm.box()) || format_ele(fresh) != format_ele(mesh)) {
+  if (fresh != mesh) {
     v.problem = "the dynamic mesh differs from a from-scratch mesh of the final " + std::to_string(pts.size()) +
                 " points (" + std::to_string(mesh.num_tetrahedra()) + " vs " +
                 std::to_string(fresh.num_tetrahedra()) + " tetrahedra)";

@@ -403,4 +403,29 @@ class Differential {
   std::size_t work_ = 0;         // sizes compared so far
 };
 
+/// The change feed's contract over a run, for a mesh's Traits::compare: empty after the
+/// construction; after an update, the simplices before it less its removed plus its added are
+/// the simplices after it; without an update, nothing changed.
+template <class Simplex>
+class FeedReplay {
+ public:
+  template <class Change>
+  void step(const std::vector<Simplex>& now, const Change& change, bool updated) {
+    if (first_) {
+      check(change.removed.empty() && change.added.empty(), "the feed is not empty after construction");
+    } else if (updated) {
+      std::vector<Simplex> replay = previous_;
+      check(apply_change(replay, change) && replay == now, "the change feed does not replay the update");
+    } else {
+      check(now == previous_, "the mesh changed without an update");
+    }
+    first_ = false;
+    previous_ = now;
+  }
+
+ private:
+  bool first_ = true;
+  std::vector<Simplex> previous_;
+};
+
 }  // namespace dynmesh_fuzz

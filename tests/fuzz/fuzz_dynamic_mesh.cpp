@@ -90,18 +90,7 @@ struct MeshTraits {
     options.delaunay = P == Postprocess::Hpu;
     const MeshReport report = check_mesh(mesh, dyn.box(), points, options);
     if (!report.ok()) fail("check_mesh: " + report.summary());
-    // The change feed.
-    const MeshChange& change = dyn.last_change();
-    if (first_) {
-      check(change.removed.empty() && change.added.empty(), "the feed is not empty after construction");
-    } else if (updated) {
-      std::vector<Triangle> replay = previous_;
-      check(apply_change(replay, change) && replay == triangles, "the change feed does not replay the update");
-    } else {
-      check(triangles == previous_, "the mesh changed without an update");
-    }
-    first_ = false;
-    previous_ = triangles;
+    feed_.step(triangles, dyn.last_change(), updated);
     return triangles.size();
   }
 
@@ -115,8 +104,7 @@ struct MeshTraits {
   }
 
  private:
-  bool first_ = true;
-  std::vector<Triangle> previous_;
+  FeedReplay<Triangle> feed_;
 };
 
 }  // namespace

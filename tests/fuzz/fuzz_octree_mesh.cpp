@@ -67,17 +67,7 @@ struct OctreeMeshTraits {
     options.max_dihedral_deg = kOctreeMaxDihedral;
     const TetMeshReport report = check_tet_mesh(mesh, dyn.box(), points, options);
     if (!report.ok()) fail("check_tet_mesh: " + report.summary());
-    const TetMeshChange& change = dyn.last_change();
-    if (first_) {
-      check(change.removed.empty() && change.added.empty(), "the feed is not empty after construction");
-    } else if (updated) {
-      std::vector<Tetrahedron> replay = previous_;
-      check(apply_change(replay, change) && replay == tets, "the change feed does not replay the update");
-    } else {
-      check(tets == previous_, "the mesh changed without an update");
-    }
-    first_ = false;
-    previous_ = tets;
+    feed_.step(tets, dyn.last_change(), updated);
     return tets.size();
   }
 
@@ -91,8 +81,7 @@ struct OctreeMeshTraits {
   }
 
  private:
-  bool first_ = true;
-  std::vector<Tetrahedron> previous_;
+  FeedReplay<Tetrahedron> feed_;
 };
 
 }  // namespace

@@ -262,17 +262,8 @@ inline void tetrahedralize_leaf(const OctreeGrid& grid, const CellId<3>& cell, s
 /// `mask`: the block's neighbourhood split mask.
 inline void tetrahedralize_block(const OctreeGrid& grid, const CellId<3>& owner, unsigned corner, const Point<3>& p,
                                  std::uint64_t mask, std::vector<Tetrahedron>& out) {
-  const std::uint64_t n = cells_per_axis(owner.level);
-  for (unsigned b = 0; b < 8; ++b) {
-    CellId<3> x = owner;
-    bool inside = true;
-    for (unsigned a = 0; a < 3; ++a) {
-      const std::uint64_t v = owner.index[a] + ((corner >> a) & 1u);
-      const unsigned ba = (b >> a) & 1u;
-      if (v + ba == 0 || v + ba - 1 >= n) inside = false;
-      x.index[a] = v + ba - 1;
-    }
-    if (!inside) continue;
+  for_each_block_cell(BlockTarget{owner, corner}, [&](const CellId<3>& x, std::uint8_t mark) {
+    const unsigned b = block_position(mark);
     // x's position in the mask's frame is 1 + b per axis.
     auto split = [mask, b](int dx, int dy, int dz) {
       const int x0 = 1 + static_cast<int>(b & 1u) + dx, y0 = 1 + static_cast<int>((b >> 1) & 1u) + dy,
@@ -286,7 +277,7 @@ inline void tetrahedralize_block(const OctreeGrid& grid, const CellId<3>& owner,
                                [&](const GridPoint3& g0, const GridPoint3& g1, const GridPoint3& g2) {
                                  out.push_back(canonical_tetrahedron(p, grid.vertex(g0), grid.vertex(g1), grid.vertex(g2)));
                                });
-  }
+  });
 }
 
 /// The level-t cell of the block frame's (x, y, z) (0..3 per axis), if it lies in the box.
