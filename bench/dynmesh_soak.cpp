@@ -17,8 +17,8 @@
 // is compared with the static oracle built from scratch on the present points (leaves()
 // exactly) and check_invariants() runs; each failure counts as a mismatch. After the last
 // check the tree is destroyed and a fresh DynamicQuadtree is built on the final points:
-// its live events and record bytes must equal the soaked tree's (DESIGN.md: "the live trace
-// is the same size as a from-scratch run's"). Any mismatch makes the exit status 1.
+// its live events and record bytes must equal the soaked tree's (docs/DESIGN.md, "The correctness
+// contract": the live trace is the size of a from-scratch run's). Any mismatch makes the exit status 1.
 //
 // compact() is not called: the tree compacts its cell directory itself whenever the
 // directory has doubled since the last compaction, and a user would not call it. With

@@ -12,7 +12,7 @@
 // Invariants: verify() does not modify the tree.
 // Complexity: one static build and one check_tree on the final points, plus
 // check_invariants(): O(n lg n + |T*| lg |T*|) expected, plus the size of the trace.
-// Paper: DESIGN.md "Correctness contract" (after propagate(), outputs equal a from-scratch
+// Paper: none; docs/DESIGN.md, "The correctness contract" (after propagate(), outputs equal a from-scratch
 // run on the current input).
 #pragma once
 

@@ -42,7 +42,7 @@
 // deep, whose checks cost a hundred times more), so every input runs fast.
 // Complexity: per operation at most one static build (none when the set is unchanged) and
 // one check_invariants, O(n lg n + |T|).
-// Paper: none (the contracts are DESIGN.md's).
+// Paper: none (the contracts are docs/DESIGN.md's).
 #pragma once
 
 #include "fuzz_support.hpp"

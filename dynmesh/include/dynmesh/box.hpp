@@ -1,8 +1,8 @@
 // dynmesh/box.hpp — the domain box and exact point location.
 //
 // Purpose: the box [o, o+L)^d that the quadtree subdivides, the rule that derives it from the
-// initial points (FORMATS.md "The domain box"), and the exact location rule of DESIGN.md
-// ("The quadtree contract"):
+// initial points (docs/FORMATS.md, "The domain box"), and the exact location rule of
+// docs/DESIGN.md, "The quadtree contract":
 //     q = floor((x − o) · (2^52 / L))   per coordinate, in IEEE double exactly as written:
 //     one division 2^52 / L (a power of two over L), one subtraction, one multiplication,
 //     one floor. A point is inside the box iff every q lies in [0, 2^52).

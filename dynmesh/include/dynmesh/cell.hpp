@@ -1,6 +1,6 @@
 // dynmesh/cell.hpp — quadtree/octree cells on the exact 2^52 grid.
 //
-// Purpose: the cell of DESIGN.md "The quadtree contract": a cell at level l (0..52) with
+// Purpose: the cell of docs/DESIGN.md, "The quadtree contract": a cell at level l (0..52) with
 // integer index i (each coordinate in [0, 2^l)) covers [o + i·L/2^l, o + (i+1)·L/2^l)^d.
 // In integer positions (point.hpp) it covers the q with q >> (52 − l) == i, that is the
 // half-open block [i·2^(52−l), (i+1)·2^(52−l)) per axis. Everything here is integer
@@ -31,18 +31,9 @@
 #include <string>
 
 #include "dynmesh/point.hpp"
+#include "sac/splitmix64.hpp"
 
 namespace dynmesh {
-
-namespace detail {
-/// The splitmix64 finaliser, for cell hashes; stated here (as sac::mix64 states it) so that
-/// the geometry headers stand alone, without sac-runtime.
-constexpr std::uint64_t mix64(std::uint64_t x) noexcept {
-  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-}  // namespace detail
 
 template <std::size_t d>
   requires SupportedDim<d>
@@ -62,8 +53,8 @@ struct CellId {
   /// The `.hash()` member sac::Hash looks for, so that a cell can key a keyed allocation
   /// or a memoized call (duck-typed: this header needs nothing from sac/).
   constexpr std::size_t hash() const noexcept {
-    std::uint64_t h = detail::mix64(static_cast<std::uint64_t>(level) + 0x9e3779b97f4a7c15ULL);
-    for (std::size_t k = 0; k < d; ++k) h = detail::mix64(h ^ index[k]);
+    std::uint64_t h = sac::mix64(static_cast<std::uint64_t>(level) + sac::kGoldenGamma);
+    for (std::size_t k = 0; k < d; ++k) h = sac::mix64(h ^ index[k]);
     return static_cast<std::size_t>(h);
   }
 
@@ -259,11 +250,11 @@ constexpr CellList<d, kChildren<d>> coarser_touching(const CellId<d>& c) {
 struct CellHash {
   template <std::size_t d>
   std::size_t operator()(const CellId<d>& c) const noexcept {
-    std::uint64_t h = 0x9e3779b97f4a7c15ULL * static_cast<std::uint64_t>(c.level + 1);
+    std::uint64_t h = sac::kGoldenGamma * static_cast<std::uint64_t>(c.level + 1);
     for (std::size_t a = 0; a < d; ++a) h = mix(h ^ (c.index[a] + 0x632be59bd9b4e019ULL * static_cast<std::uint64_t>(a + 1)));
     return static_cast<std::size_t>(h);
   }
-  static constexpr std::uint64_t mix(std::uint64_t x) noexcept { return detail::mix64(x); }
+  static constexpr std::uint64_t mix(std::uint64_t x) noexcept { return sac::mix64(x); }
 };
 
 /// "level:(i,j[,k])", for messages.

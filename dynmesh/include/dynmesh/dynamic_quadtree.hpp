@@ -5,8 +5,8 @@
 // ordinary static code on sac-runtime (dynmesh/src/quadtree/quadtree_refine.hpp); this class owns the
 // engine, the input point list and the cell directory, runs the program once, and after
 // each insert / erase / batch calls propagate(), which leaves exactly the tree a
-// from-scratch run on the current point set would build (DESIGN.md, "The quadtree
-// contract"), in O(lg L/s) trace distance per single-point update.
+// from-scratch run on the current point set would build (docs/DESIGN.md, "The
+// quadtree contract"), in O(lg L/s) trace distance per single-point update.
 //
 // Invariants (check_invariants()):
 //   * the engine's own invariants (order list, queue, trace, tables);

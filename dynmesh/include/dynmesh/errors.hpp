@@ -1,7 +1,7 @@
 // dynmesh/errors.hpp — the exceptions dynmesh throws.
 //
 // Purpose: bad input gets a clear error that names what is wrong and, when the input came
-// from a file, the file and the line (DESIGN.md "Testing": malformed files, NaN or infinite
+// from a file, the file and the line (docs/DESIGN.md, "Bad input": malformed files, NaN or infinite
 // coordinates, duplicate points, points outside the box, deleting an absent point, spread
 // beyond the resolution). Library bugs found by the invariant checkers are a different
 // thing and get InvariantError.
@@ -17,7 +17,7 @@
 //   InvariantError – a check_invariants() found a broken contract (a bug, not bad input).
 //
 // Invariants: what() always contains file and line when they are known. Complexity: n/a.
-// Paper: none (DESIGN.md "Testing": bad input gets a clear error, the state stays as it was).
+// Paper: none (docs/DESIGN.md, "Bad input": bad input gets a clear error, the state stays as it was).
 #pragma once
 
 #include <cstddef>

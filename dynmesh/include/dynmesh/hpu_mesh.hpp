@@ -9,7 +9,7 @@
 // (src/hpu/hpu_cells_program.hpp).
 //
 // The algorithm is the seed's Figure 5 on loose pairs, with the choices it leaves open made
-// as follows (ρ = 1/(2 sin θ), k = √(ρ² − 1/4) = 1/(2 tan θ); DESIGN.md, "DynHPU"):
+// as follows (ρ = 1/(2 sin θ), k = √(ρ² − 1/4) = 1/(2 tan θ); docs/DESIGN.md, "DynHPU"):
 //   1. Vertices: the box's corners, the points, and the midpoints that splitting encroached
 //      box edges adds (an edge's diametral disc holds its halves', and a point strictly
 //      inside one projects strictly inside the edge, so these form one path down the

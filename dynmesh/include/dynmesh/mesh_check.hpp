@@ -1,6 +1,6 @@
 // dynmesh/mesh_check.hpp — the checker of the 2D mesh contract.
 //
-// Purpose: decides whether a Mesh satisfies DESIGN.md "The mesh contract (2D)" for a domain
+// Purpose: decides whether a Mesh satisfies docs/DESIGN.md, "The mesh contract (2D)" for a domain
 // box and an input point set, and says what is wrong when it does not. Every mesher's tests
 // run it, and a caller may run it after every update (require_valid_mesh throws).
 // The closed domain is B = [o1, fl(o1+L)] x [o2, fl(o2+L)] (fl: the IEEE double sum).
@@ -35,7 +35,7 @@
 // vertices along a Z-order curve; the vertices in an edge's bounding box lie in one run of
 // that order, scanned when short and otherwise searched in a bounding-volume tree pruned by
 // the edge's box and line: O(log t) per edge for graded meshes.
-// Paper: none (the contract is DESIGN.md's; the exact predicates are Shewchuk's via CGAL).
+// Paper: none (the contract is docs/DESIGN.md's; the exact predicates are Shewchuk's via CGAL).
 #pragma once
 
 #include <array>

@@ -2,7 +2,7 @@
 //
 // Purpose: the two representations of a point that every dynmesh component shares.
 //   Point<d>    – the coordinates as read (IEEE double), d = 2 or 3.
-//   Position<d> – the integer position q of DESIGN.md "The quadtree contract": per axis
+//   Position<d> – the integer position q of docs/DESIGN.md, "The quadtree contract": per axis
 //                 q = floor((x − o) · (2^52 / L)) in [0, 2^52), computed by locate() in
 //                 box.hpp. Every decision of the quadtree (which cell holds a point, whether
 //                 two points are duplicates) is made on q alone, so all implementations

@@ -107,7 +107,7 @@ inline int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, con
 
 /// The circles through p and q form a pencil; its member with centre m + h·J(q − p) (m the
 /// midpoint, J the +90° turn) is the ccw-leaf of pq for h = k and the circle of the apex
-/// for h = ρ + k (DESIGN.md, DynHPU). Returns the sign of (x−p)·(x−q) − 2h·orient(p, q, x),
+/// for h = ρ + k (docs/DESIGN.md, "DynHPU"). Returns the sign of (x−p)·(x−q) − 2h·orient(p, q, x),
 /// which is −1 exactly when x lies strictly inside that circle, 0 on it, +1 outside. Exact
 /// for finite p, q, x and h.
 inline int pencil(const Point<2>& p, const Point<2>& q, double h, const Point<2>& x) noexcept {

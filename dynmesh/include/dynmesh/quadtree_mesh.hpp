@@ -1,7 +1,7 @@
 // dynmesh/quadtree_mesh.hpp — the quadtree mesh (Bern, Eppstein & Gilbert), static twin.
 //
-// Purpose: the plain static computation of the `quadtree` postprocess of DESIGN.md ("The
-// quadtree postprocess"): from the points, T*; from T*, the refined tree T'; from T', a
+// Purpose: the plain static computation of the `quadtree` postprocess (docs/DESIGN.md,
+// "The quadtree mesh"): from the points, T*; from T*, the refined tree T'; from T', a
 // triangulation of the domain box in which every point is a vertex and no angle is below
 // kQuadtreeMinAngle. It is the oracle of the self-adjusting mesh (DynamicMesh with
 // Postprocess::Quadtree computes the same triangles bit for bit) and the baseline of its

@@ -1,6 +1,6 @@
 // dynmesh/static_quadtree.hpp — the plain static quadtree/octree T* and the tree checker.
 //
-// Purpose: the oracle of DESIGN.md "The quadtree contract". From a set of located points it
+// Purpose: the oracle of docs/DESIGN.md, "The quadtree contract". From a set of located points it
 // computes T*, the least set of split cells such that
 //   (1) every crowded cell is split (a cell is crowded when it contains two or more points,
 //       or exactly one point while its 3^d neighbourhood N(c) contains another);
@@ -20,7 +20,7 @@
 //   * A crowded level-52 cell cannot be split: InputError(Resolution) ("spread beyond the
 //     resolution of 2^52"). Equal positions: InputError(Duplicate).
 // QuadTreeRefine (the paper's Figure 2, which the self-adjusting version follows) computes the
-// same set (DESIGN.md); this file follows the definition instead, so the two are independent.
+// same set (docs/DESIGN.md, "A stable quadtree program"); this file follows the definition instead, so the two are independent.
 //
 // check_tree(points, leaves) verifies any leaf set (this oracle's, the dynamic tree's, one
 // read from a `.cells` file) against the contract, and reports every broken rule:

@@ -24,7 +24,7 @@
 // for grading: ill-graded cells are sparse, and a queue built by destination passing
 // re-joins its old trace only at the next appender, which can be thousands of entries on.
 //
-// How it is made stable (DESIGN.md, "Writing it on the runtime so that it is stable"):
+// How it is made stable (docs/DESIGN.md, "A stable quadtree program"):
 //   * cells are named by CellId and found in a directory of slots outside the trace; a slot
 //     holds two versioned modifiables, `split` (0 until SPLIT writes 1) and `pts` (the head
 //     of the cell's point list), both defaulting to "nothing" (Engine::init_default), so a

@@ -78,7 +78,7 @@ class MortonIndex {
     return it != sorted_.end() && contains(c, *it);
   }
 
-  /// DESIGN.md: c holds two or more points, or exactly one while N(c) holds another.
+  /// docs/DESIGN.md, "The quadtree contract": c holds two or more points, or exactly one while N(c) holds another.
   bool crowded(const CellId<d>& c) const {
     const std::size_t k = count(c);
     if (k != 1) return k >= 2;

@@ -4,7 +4,7 @@
 // integers, enums, pointers, floating point (by bit pattern), std::pair, std::tuple, and any
 // type with a `std::size_t hash() const` member (sac::Fn closures have one).
 // Hash values only choose buckets; matches are decided by operator==, and among equal keys
-// by trace time, so results never depend on pointer values (see DESIGN.md, determinism).
+// by trace time, so results never depend on pointer values (docs/DESIGN.md, "Determinism").
 // Invariants: a == b implies Hash(a) == Hash(b). Complexity: O(size of the key).
 #pragma once
 
@@ -16,20 +16,12 @@
 #include <type_traits>
 #include <utility>
 
+#include "sac/splitmix64.hpp"
+
 namespace sac {
 
-constexpr std::uint64_t mix64(std::uint64_t x) noexcept {
-  // splitmix64 finaliser
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  x ^= x >> 31;
-  return x;
-}
-
 inline std::uint64_t hash_combine(std::uint64_t seed, std::uint64_t h) {
-  return mix64(seed ^ (h + 0x9e3779b97f4a7c15ULL + (seed << 6) + (seed >> 2)));
+  return mix64(seed ^ (h + kGoldenGamma + (seed << 6) + (seed >> 2)));
 }
 
 template <class K, class = void>

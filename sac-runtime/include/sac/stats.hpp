@@ -2,7 +2,7 @@
 //
 // Purpose: what change propagation did, for tests ("a single insertion re-executes O(1)
 // reads") and for the stability experiments (trace distance per update).
-// Trace distance of a propagation = events created + events undone during it (DESIGN.md).
+// Trace distance of a propagation = events created + events undone during it (docs/DESIGN.md, "Trace distance").
 // An event is one trace record: a read, a write, an allocation or a memo entry.
 // Invariants: live_events == events created - events undone (over the engine's life).
 // Complexity: all O(1) to read.

@@ -2,14 +2,14 @@
 // static twin (QuadtreeMesh) and the self-adjusting program (DynamicMesh), so that the two
 // compute the same triangles bit for bit.
 //
-// Purpose. The quadtree postprocess of DESIGN.md, with this project's closure rule:
+// Purpose. The quadtree postprocess (docs/DESIGN.md, "The quadtree mesh"), with this project's closure rule:
 //   * Target of a point p. Let l be the level of p's leaf in T*. p's leaf in T' is c_t, the
 //     cell of level t holding p, where t is the least level > l at which the corner of c_t
 //     nearest to p (ties: lowest corner number) may move onto p: it lies on no side of the
 //     box that p is not on. (A box corner moves only onto a point equal to it.)
 //   * Closure T' of T*: split every level-(t−1) cell touching c_t (these are the parents of
 //     c_t's 3x3 block), for every point, then split whatever grading then forces (a level
-//     m−1 cell touching a split level-m cell). This is DESIGN.md's "always one level
+//     m−1 cell touching a split level-m cell). This is the "always one level
 //     deeper" variant of (C3)/(EQ): c_t's block of 3x3 same-size leaves exists by
 //     construction, and nothing splits inside it: T* has no split cell there (the block lies
 //     in p's T* neighbourhood, which holds no other point, and T* is graded around p's
@@ -24,7 +24,7 @@
 //     largest smallest angle among {diagonal 0-2, diagonal 1-3, fan from the centre, fan
 //     from the centroid of the four corners} (with midpoints: the two fans), ties to the
 //     first. Valid means every triangle strictly counter-clockwise (exact orient2d).
-// Bound: no angle below arctan(1/3) = 18.43° (DESIGN.md's enumeration; the checker verifies
+// Bound: no angle below arctan(1/3) = 18.43° (the enumeration of docs/DESIGN.md, "The quadtree mesh"; the checker verifies
 // kQuadtreeMinAngle = 18.4° on every output).
 // Coordinates and resolution: detail/mesh_grid.hpp (the grid vertices in double; points the
 // mesh cannot resolve are rejected, so every leaf of T' has level ≤ R + 1).

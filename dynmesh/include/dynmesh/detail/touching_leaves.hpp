@@ -12,7 +12,7 @@
 // of its leaves. A leaf may be visited more than once (through several nb); callers dedupe.
 // Complexity: O(3^d + number of split cells inside split neighbours that touch a), which is
 // O(3^d·2^d) in a graded tree; plus O(depth) for each coarse neighbour.
-// Paper: none (tree navigation; DESIGN.md, "The quadtree contract", for touching).
+// Paper: none (tree navigation; docs/DESIGN.md, "The quadtree contract", for touching).
 #pragma once
 
 #include <vector>
