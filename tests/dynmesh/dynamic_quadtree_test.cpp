@@ -32,6 +32,7 @@
 #include "dynmesh/io.hpp"
 #include "dynmesh/static_quadtree.hpp"
 #include "quadtree/dynamic_quadtree_state.hpp"  // dynmesh/src: the private state, for the hook below
+#include "sac/splitmix64.hpp"
 
 namespace dynmesh {
 
@@ -191,7 +192,7 @@ Scenario<d> make_scenario(Distribution dist, std::size_t pool_size, std::uint64_
                           double fraction) {
   Scenario<d> s;
   s.pool = generate<d>(dist, pool_size, seed, spread);
-  Rng rng(seed * 0x9e3779b97f4a7c15ULL + 17);
+  Rng rng(seed * sac::kGoldenGamma + 17);
   s.initial = random_subset(s.pool, fraction, rng);
   const auto init = pick_points(s.pool, s.initial);
   s.box = derive_box<d>(init);

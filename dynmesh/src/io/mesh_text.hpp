@@ -27,16 +27,11 @@
 #include "dynmesh/box.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
+#include "io/number_text.hpp"
 
 namespace dynmesh::detail {
 
 inline void append_line_end(std::string& out) { out += '\n'; }
-
-inline void append_number(std::string& out, std::size_t n) {
-  char buf[24];
-  const auto r = std::to_chars(buf, buf + sizeof buf, n);
-  out.append(buf, r.ptr);
-}
 
 inline void append_exact(std::string& out, double x) { out += format_exact(x); }
 

@@ -130,8 +130,8 @@ struct QKey {
   bool operator==(const QKey&) const = default;
   std::size_t hash() const noexcept {
     std::uint64_t h = k[0];
-    for (std::size_t a = 1; a < d; ++a) h = mix64(h) ^ k[a];
-    return static_cast<std::size_t>(mix64(h));
+    for (std::size_t a = 1; a < d; ++a) h = sac::mix64(h) ^ k[a];
+    return static_cast<std::size_t>(sac::mix64(h));
   }
 };
 
