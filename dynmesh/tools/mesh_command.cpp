@@ -1,6 +1,6 @@
 // `dynmesh mesh`: mesh a point file in its box, apply an edit script dynamically, write the
-// final mesh as .node/.ele (and optionally the change feed, VTK, MSH, and in 2D SVG), docs/
-// FORMATS.md "dynmesh mesh (2D)" and "dynmesh mesh in 3D". The dimension is the points'
+// final mesh as .node/.ele (and optionally the change feed, VTK, MSH, and in 2D SVG):
+// docs/FORMATS.md, "`dynmesh mesh` (2D)" and "`dynmesh mesh` in 3D". The dimension is the points'
 // (--dim, a .node header, or the count of numbers on the first line of plain text:
 // initial_points.hpp points_shape).
 // 2D: `--postprocess hpu` (the default) is DynHPU's off-center Delaunay mesh: without --edits,

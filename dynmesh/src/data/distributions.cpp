@@ -228,8 +228,8 @@ std::vector<Point<d>> shrinking_points(std::size_t n, double spread, Rng& rng) {
 // 1.5 spacings apart. Why the curves are far apart for their spacing, at every n: K curves of
 // mean length ℓ̄ ≈ 0.25 spaced over an area A ≈ 0.6 are about A/(K·ℓ̄) apart, and the
 // spacing along them is K·ℓ̄/n, so the ratio is A·n/(K·ℓ̄)² ≈ 16·A/ℓ̄² ≈ 150 for K = √n/4;
-// the median distance from a point to the nearest other curve is some 30 to 150 spacings in
-// 2D (the curves cross here and there; measured for n = 10^2 to 10^4), more in 3D.
+// the median distance from a point to the nearest other curve is many spacings (the curves
+// cross here and there), more in 3D.
 //
 // No libm: cos θ and sin θ come from the rational parametrization of the circle,
 // ((1 − u²)/(1 + u²), 2u/(1 + u²)) for u in [0, 1) on each quarter turn, and the harmonics
