@@ -857,8 +857,8 @@ TEST(Predicates, PencilMixedMagnitudesAgreeWithTheCircleDefinition) {
 /// Far from the unit scale the inline filters overflow (or underflow) and cannot decide; the
 /// exact stage then rescales the call by a power of two and filters it again. Random cases
 /// scaled by 2^±960 must agree with GMP and reach exact arithmetic exactly as often as the
-/// same cases unscaled (the signs and the filters' decisions are scale-free); before the
-/// rescale, every scaled in-circle call and most others did.
+/// same cases unscaled (the signs and the filters' decisions are scale-free); without the
+/// rescale, every scaled in-circle call and most others would.
 TEST(Predicates, FarFromTheUnitScaleTheFiltersStillDecide) {
   constexpr std::uint64_t kSeed = 20261206;
   SCOPED_TRACE(seed_trace(kSeed));

@@ -11,9 +11,9 @@
 // Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
 // interval filter with an exact fallback. Before that, a call whose coordinates are so large
 // (or small) that the filter's products overflow (or underflow) is rescaled by a power of
-// two, exactly, and filtered again. CGAL's headers are confined to src/geometry/predicates.cpp.
+// two, exactly, and filtered again. No public header includes CGAL's: the library compiles them.
 // The inline stage decides nearly all calls on meshing input and saves the call and CGAL's
-// own filter setup (the predicates were a third of the hpu mesh's build time).
+// own filter setup (the predicates are a large part of a mesh's build).
 //
 // Invariants: the result is the sign of the exact real determinant of the double inputs,
 // for every finite input (including exactly degenerate and nearly degenerate ones).

@@ -234,18 +234,18 @@ struct Refine {
   static void regrade(sac::Engine& rt, Refine* program, const CellId<d>& c) {
     if (c.level == 0) return;
     // The closure holds c packed, with the mask that names u from c in spare index bits
-    // (8·d bytes, not 2·8·d): there are 11 (2D) to 31 (3D) of these reads per point.
+    // (8·d bytes, not 2·8·d): every point makes many of these reads.
     CellId<d> u;
     for (unsigned mask = 1; mask < static_cast<unsigned>(kChildren<d>); ++mask)
       if (coarser_touching_at(c, mask, u))
-        rt.read(program->slot(rt, u).split, [pm = pack_with_mask(c, mask)](sac::Engine& rt2, std::uint8_t s) {
+        rt.read(program->slot(rt, u).split, [packed = pack_with_mask(c, mask)](sac::Engine& rt2, std::uint8_t s) {
           if (s) return;
-          unsigned mk;
-          const CellId<d> cc = unpack_with_mask(pm, mk);
-          CellId<d> uc;
-          coarser_touching_at(cc, mk, uc);
-          split(rt2, ctx(rt2), uc, cc);
-          regrade(rt2, ctx(rt2), uc);
+          unsigned which;
+          const CellId<d> witness = unpack_with_mask(packed, which);
+          CellId<d> coarser;
+          coarser_touching_at(witness, which, coarser);
+          split(rt2, ctx(rt2), coarser, witness);
+          regrade(rt2, ctx(rt2), coarser);
         });
   }
 

@@ -20,9 +20,8 @@
 //   * p's T* level is found by reading the `split` values down p's path and testing only
 //     their T* bit (tree_split): postprocess writes land only on cells T* left unsplit and
 //     never set that bit, so the descent sees T* whatever the order of the points. (Reading
-//     the point lists instead, as an earlier version did, re-ran every descent through a
-//     cell whose list head changed: about one per level per deletion, each re-running its
-//     whole tail.)
+//     the point lists instead would re-run every descent through a cell whose list head
+//     changed: about one per level per deletion, each re-running its whole tail.)
 //   * T' is the least closure of the seeds, a set: the order in which the points add to it
 //     changes the trace, not the result. Each point's work is memoized on its list node,
 //     so an insertion or deletion re-runs only its own place() and what reads the cells it
