@@ -240,15 +240,15 @@ struct OctreeMeshProgram {
     if (nb.n == 0) return finish(rt, program, c, own, nb);  // the root has no neighbours
     const unsigned first = (nb.n + 1) / 2;
     rt.read_many(std::span<const Kids* const>(nb.mods.data(), first),
-                [program, c, own](sac::Engine& rt2, std::span<const std::uint64_t* const>) {
-                  const Near all = near_of(rt2, program, c, has_owner(own));
-                  const unsigned half = (all.n + 1) / 2;
-                  if (all.n == half) return finish(rt2, program, c, own, all);
-                  rt2.read_many(std::span<const Kids* const>(all.mods.data() + half, all.n - half),
-                              [program, c, own](sac::Engine& rt3, std::span<const std::uint64_t* const>) {
-                                finish(rt3, program, c, own, near_of(rt3, program, c, has_owner(own)));
-                              });
-                });
+                 [program, c, own](sac::Engine& rt2, std::span<const std::uint64_t* const>) {
+                   const Near all = near_of(rt2, program, c, has_owner(own));
+                   const unsigned half = (all.n + 1) / 2;
+                   if (all.n == half) return finish(rt2, program, c, own, all);
+                   rt2.read_many(std::span<const Kids* const>(all.mods.data() + half, all.n - half),
+                                 [program, c, own](sac::Engine& rt3, std::span<const std::uint64_t* const>) {
+                                   finish(rt3, program, c, own, near_of(rt3, program, c, has_owner(own)));
+                                 });
+                 });
   }
 
   /// Every neighbour's kids has been read by an enclosing event of this body: current().
