@@ -13,8 +13,8 @@
 // process run. Output: a table, or CSV with --csv:
 //   dim,dist,n,static_s,scratch_s,overhead,insert_us,delete_us,update_us,median_update_us,
 //   max_update_us,speedup,mean_distance,trace_bytes,bytes_per_point,verified
-// speedup = scratch_s / mean update time (the runtime's own from-scratch run, as the issue
-// asks); overhead = scratch_s / static_s.
+// speedup = scratch_s / mean update time (against the runtime's own from-scratch run, the
+// alternative an update replaces); overhead = scratch_s / static_s.
 // --breakdown: after each build, where trace_bytes() goes (DynamicQuadtree::
 // memory_breakdown()): count, bytes, bytes per point and share of the total for each record
 // kind, side structure and directory part, then what trace_bytes() leaves out. Lines start
@@ -172,8 +172,8 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Engines are built one after another: keep their freed chunks warm, as the figures in
-  // RESULTS.md were measured (sac/chunk_cache.hpp; a user's default is 64 MiB).
+  // Engines are built one after another: keep their freed chunks warm, so that every
+  // measurement starts alike (sac/chunk_cache.hpp; a user's default is 64 MiB).
   sac::set_chunk_cache_limit(std::size_t{1} << 30);
   CLI::App app{"dynmesh_bench: self-adjusting quadtree vs the static oracle"};
   int dim = 2;

@@ -1,4 +1,4 @@
-// dynmesh_memory_return — how much memory a destroyed engine gives back (issue 9 §1).
+// dynmesh_memory_return — how much memory a destroyed engine gives back.
 //
 // Builds a 2D DynamicQuadtree of python_uniform(n, 1) in the unit box, destroys it, and
 // prints the trace bytes, the resident set (/proc/self/statm) before, built and after, and

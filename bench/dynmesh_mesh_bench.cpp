@@ -306,8 +306,8 @@ void print_row(const Row& r, bool csv, int dim) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Engines are built one after another: keep their freed chunks warm, as the figures in
-  // RESULTS.md were measured (sac/chunk_cache.hpp; a user's default is 64 MiB).
+  // Engines are built one after another: keep their freed chunks warm, so that every
+  // measurement starts alike (sac/chunk_cache.hpp; a user's default is 64 MiB).
   sac::set_chunk_cache_limit(std::size_t{1} << 30);
   CLI::App app{"dynmesh_mesh_bench: self-adjusting meshes vs their static twins"};
   std::string dist_name = "uniform";

@@ -1,6 +1,6 @@
-// dynmesh_soak — a long run of single-point updates on DynamicQuadtree<2> or <3> (issue 10
-// §2, "A soak run"): does the tree stay equal to a from-scratch build, and does its memory
-// stay flat, after 10^6 updates? Figures in bench/RESULTS.md.
+// dynmesh_soak — a long run of single-point updates on DynamicQuadtree<2> or <3>: does the
+// tree stay equal to a from-scratch build, and does its memory stay flat, after 10^6
+// updates? Figures in bench/RESULTS.md.
 //
 // Method: n initial points of the first distribution in a fixed box [-0.5, 1.5)^d (every
 // generator below draws inside [0, 1]^d or close to it). Then --updates single-point updates
@@ -9,8 +9,8 @@
 // a pool point the tree rejects (outside the box, a duplicate, too close: InputError) is
 // skipped, the tree being unchanged. The pool's distribution cycles through --dists, one
 // --segment of updates each, so the point set turns over from one distribution to the next
-// (with the defaults a segment replaces all but about 0.2% of the points, and the cycle
-// runs twice, so 50% and 100% of the run end on the same distribution and clusters).
+// (with the defaults a segment replaces nearly all the points, and the cycle runs twice, so
+// the middle and the end of the run are on the same distribution and clusters).
 // Every distribution's pool is generated before the run, so the samples measure the tree.
 //
 // Every --check-every updates and at the end: RSS is sampled (VmRSS, VmHWM), then the tree

@@ -1,6 +1,6 @@
 // initial_points.hpp (private to the command) — the POINTS file of `quadtree` and `mesh` made
 // ready for the library: read, `--duplicates skip` applied, the box taken from --box or
-// derived (FORMATS.md "The domain box"), every point located; and the library's
+// derived (docs/FORMATS.md, "The domain box"), every point located; and the library's
 // construction errors re-labelled with the file's lines.
 //
 // Purpose: both commands take their initial points the same way, and a spread beyond the

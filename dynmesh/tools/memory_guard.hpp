@@ -1,6 +1,6 @@
 // dynmesh/tools/memory_guard.hpp — refuse a build that cannot fit in memory, before it starts.
 //
-// Purpose: a dynamic quadtree keeps its whole trace, some 15 KB per point in 2D, so a
+// Purpose: a dynamic quadtree keeps its whole trace, kilobytes per point, so a
 // few million points can exceed the machine; without a guard the run is killed by the OOM
 // killer (or fails with bad_alloc) minutes into the build. The commands estimate the peak
 // from the number of points the structure will hold (initial points plus those the edits
@@ -16,15 +16,13 @@
 //   * A build the guard lets go on is held to what it found: the soft RLIMIT_DATA is lowered
 //     to the current VmData plus the available amount (never raised). The estimate is per
 //     point, and some inputs cost more than any constant foresees (points along a line in
-//     3D: 39,657 B/point at 10^5, against the 20,500 estimated), so a build can still
+//     3D cost about twice the 3D estimate), so a build can still
 //     outgrow the machine; capped, it fails with std::bad_alloc, which the command reports
 //     with the guard's figures (out_of_memory_message), instead of thrashing or being
 //     killed, possibly with other processes, by the OOM killer. VmData follows the peak
-//     resident set closely here (the largest VmData and VmHWM of /proc/PID/status, sampled
-//     every 50 ms during `dynmesh quadtree FILE --cells o.cells --force` on the 10^5 points
-//     of generate(collinear, 3D) and of generate(uniform, 2D): 3,898,516 KiB against 3,872,568
-//     and 708,280 against 690,084), so the cap stops a build only within a few percent of
-//     not fitting.
+//     resident set closely here (compare the largest VmData and VmHWM of /proc/PID/status,
+//     sampled during `dynmesh quadtree FILE --cells o.cells --force`), so the cap stops a
+//     build only when it is close to not fitting.
 // Invariants: the guard throws only when the estimate exceeds a known available amount; when
 // nothing can be read (no /proc) it lets the run go on, uncapped. --force skips both.
 // Complexity: O(bytes of the point and edit files) for the line counts; O(1) otherwise.
@@ -57,55 +55,41 @@ struct MemoryCost {
   std::uint64_t check_bytes_per_point;  // the from-scratch rebuild of --check (and stability)
 };
 
-// Measured on x86-64 (-O2, glibc malloc) with uniform points written by python3
-// (random.random(), repr): peak RSS ("Maximum resident set size" of /usr/bin/time -v) at
-// n = 10^5, less that of a 10-point run (7 MB, the program itself), over n; then about 30%
-// added, because the cost per point grows slowly with n (2D, 10^6 points: 7,943,080 KiB,
-// 8,134 B/point) and clustered points cost about 5% more than uniform ones. Under
-// `ulimit -v` set to the estimate, the 10^5-point runs below complete. (Before issue 9:
-// 14,954 and 34,271 B/point, and 20,000 and 44,000 here; after its first levers 11,561 and
-// 23,887, and 15,500 and 31,000.)
-//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells          773,184 KiB: 7,841 B/point
-//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells --check  1,111,220 KiB: +3,461 B/point
+// How each cost is calibrated: on x86-64 (-O2, glibc malloc), the peak RSS ("Maximum
+// resident set size" of /usr/bin/time -v) of the command beside it, less that of a run on a
+// handful of points (the program itself), over n; then a margin added, because the cost per
+// point grows slowly with n and clustered points cost a little more than uniform ones. Under
+// `ulimit -v` set to the estimate, the calibration runs complete. The inputs are uniform
+// points written by python3 (random.random(), repr), n = 10^5 unless said otherwise.
+//   /usr/bin/time -v dynmesh quadtree u2_100000.txt --cells o.cells [--check]
 inline constexpr MemoryCost kQuadtree2dCost{10'500, 4'500};
-//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells          1,523,724 KiB: 15,526 B/point
-//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells --check  1,944,384 KiB: +4,308 B/point
+//   /usr/bin/time -v dynmesh quadtree u3_100000.txt --dim 3 --cells o.cells [--check]
 inline constexpr MemoryCost kOctree3dCost{20'500, 5'600};
-//   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o          7,050,276 KiB: 72,112 B/point
-//   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o --check  8,130,208 KiB: +11,057 B/point
+//   /usr/bin/time -v dynmesh mesh u2_100000.txt --postprocess quadtree -o o [--check]
 inline constexpr MemoryCost kQuadtreeMeshCost{92'000, 14'000};
-// The octree's tetrahedral mesh (DynamicOctreeMesh, `dynmesh mesh` in 3D), measured as above
-// at n = 5,000 (python3 random.Random(3), uniform in the unit cube; 100 deletions and their
-// reinsertions), less a 40-point run (15 MB); about 1,460 tetrahedra a point, which the peak
-// follows (the trace, the index mesh and its text), with 30% added. --check's own cost is the
-// static twin's tetrahedra held as coordinates and the checker's face lists.
-//   /usr/bin/time -v dynmesh mesh u5e3.xyz --edits u5e3.edits -o o            535,156 KiB: 106,400 B/point
-//   /usr/bin/time -v dynmesh mesh u5e3.xyz --edits u5e3.edits -o o --check  1,468,120 KiB: +191,622 B/point
+// The octree's tetrahedral mesh (DynamicOctreeMesh, `dynmesh mesh` in 3D), calibrated as
+// above on a smaller input (python3 random.Random(3), uniform in the unit cube, with
+// deletions and their reinsertions as edits): the peak follows the tetrahedra per point (the
+// trace, the index mesh and its text). --check's own cost is the static twin's tetrahedra
+// held as coordinates and the checker's face lists.
+//   /usr/bin/time -v dynmesh mesh u5e3.xyz --edits u5e3.edits -o o [--check]
 inline constexpr MemoryCost kOctreeMeshCost{135'000, 250'000};
 // The hpu meshes cost more per point as the angle bound rises (more Steiner points), and
 // far more on points along curves than on uniform ones: the mesh grades away from each dense
-// curve, so collinear and spiral points make 2 to 2.5 times the vertices (and trace) per
+// curve, so collinear and spiral points make several times the vertices (and trace) per
 // point. Counting lines cannot tell the inputs apart, and an estimate below the peak lets a
-// run be killed minutes in, so the guard takes the costliest input measured, at 20.7 and at
-// 30 degrees, interpolated linearly in the angle between them (the 20.7-degree figure below
-// it: smaller bounds make smaller meshes), with 25% added (hpu_mesh_cost, hpu_dynamic_cost).
-// Measured at n = 10^5 with generate(D, n, 1) (the generators of `dynmesh stability --dist`,
-// written with %.17g), less the program itself, as above; uniform points (unif1e5, python3
-// random.Random(1)) for comparison. --check's own cost is the largest measured on any input.
-//   The hpu mesh (HpuMesh, no trace), `dynmesh mesh P.txt -o o --min-angle A [--check]`:
-//     20.7 degrees: spiral 106,580 KiB (1,091 B/point; --check +442), collinear 99,676 KiB
-//       (1,021), unif1e5 62,984 KiB (589; +252)
-//     30 degrees: collinear 200,584 KiB (2,054; --check +817), spiral 176,644 KiB (1,809;
-//       +746), curves 166,920 KiB (1,709; +685), unif1e5 101,860 KiB (987; +468)
+// run be killed minutes in, so the guard takes the costliest input, at 20.7 and at 30
+// degrees, interpolated linearly in the angle between them (the 20.7-degree cost below it:
+// smaller bounds make smaller meshes), with a margin (hpu_mesh_cost, hpu_dynamic_cost).
+// Calibrated with generate(D, n, 1) for each distribution D (the generators of
+// `dynmesh stability --dist`, written with %.17g), less the program itself, as above;
+// --check's own cost is the largest on any input. A uniform input is therefore
+// overestimated severalfold: --force runs it.
+//   The hpu mesh (HpuMesh, no trace):
+//     dynmesh mesh P.txt -o o --min-angle A [--check]
 //   The self-adjusting hpu mesh (DynamicMesh, Postprocess::Hpu: the program on cells and its
-//   trace; --edits selects it), `dynmesh mesh P.txt --edits E -o o --min-angle A [--check]`
-//   with 10 edits:
-//     20.7 degrees: spiral 1,931,980 KiB (19,784 B/point; --check +5,231), collinear
-//       1,813,640 KiB (18,572), unif1e5 939,524 KiB (9,549; +2,820)
-//     30 degrees: collinear 3,518,984 KiB (36,034; --check +0), spiral 3,276,996 KiB (33,556;
-//       +9,923), unif1e5 1,448,392 KiB (14,760; +5,230)
-//   (The triangulation-based program before issue 20: 71,487 B/point at 30 degrees on
-//   unif1e5.) So a uniform input is estimated at 2.5 to 3 times its peak: --force runs it.
+//   trace; --edits selects it), with a few edits:
+//     dynmesh mesh P.txt --edits E -o o --min-angle A [--check]
 inline constexpr double kHpuCostAngleLow = 20.7, kHpuCostAngleHigh = 30.0;
 inline constexpr MemoryCost kHpuMeshCostLow{1'400, 600}, kHpuMeshCostHigh{2'600, 1'050};
 inline constexpr MemoryCost kHpuDynamicCostLow{25'000, 6'500}, kHpuDynamicCostHigh{45'000, 12'500};
@@ -125,7 +109,7 @@ inline MemoryCost hpu_mesh_cost(double angle_deg) { return hpu_cost_at(kHpuMeshC
 inline MemoryCost hpu_dynamic_cost(double angle_deg) {
   return hpu_cost_at(kHpuDynamicCostLow, kHpuDynamicCostHigh, angle_deg);
 }
-// The program before any point: 7-8 MB resident, more address space (libraries, a thread stack).
+// The program before any point: a few MB resident, more address space (libraries, a thread stack).
 inline constexpr std::uint64_t kFixedBytes = std::uint64_t{32} << 20;
 
 /// The estimated peak of a build holding `points` points (saturating, never wraps).

@@ -1,6 +1,6 @@
 // `dynmesh mesh`: mesh a point file in its box, apply an edit script dynamically, write the
-// final mesh as .node/.ele (and optionally the change feed, VTK, MSH, and in 2D SVG), docs/
-// FORMATS.md "dynmesh mesh (2D)" and "dynmesh mesh in 3D". The dimension is the points'
+// final mesh as .node/.ele (and optionally the change feed, VTK, MSH, and in 2D SVG):
+// docs/FORMATS.md, "`dynmesh mesh` (2D)" and "`dynmesh mesh` in 3D". The dimension is the points'
 // (--dim, a .node header, or the count of numbers on the first line of plain text:
 // initial_points.hpp points_shape).
 // 2D: `--postprocess hpu` (the default) is DynHPU's off-center Delaunay mesh: without --edits,
@@ -210,19 +210,19 @@ int run_dynamic(const MeshCommandOptions& o, Columns columns, const std::string&
       rethrow_construction_error<d>(e, initial, level >= 2 ? level : -1);
     }
   }
-  Structure& dm = *built;
+  Structure& dynamic = *built;
 
   const bool want_feed = !o.feed.empty();
   std::string feed = want_feed ? feed_header() : std::string();
   PropagationLog propagations;  // for --stats
-  apply_edits<d>(dm, script, o.batch, [&] {
-    propagations.record(dm.last_update(), dm.last_change());
-    if (want_feed) feed += format_feed_update(propagations.count(), dm.last_change());
+  apply_edits<d>(dynamic, script, o.batch, [&] {
+    propagations.record(dynamic.last_update(), dynamic.last_change());
+    if (want_feed) feed += format_feed_update(propagations.count(), dynamic.last_change());
   });
 
-  const auto mesh = dm.mesh();
+  const auto mesh = dynamic.mesh();
   std::vector<Point<d>> inputs;
-  for (const auto& entry : dm.points()) inputs.push_back(entry.second);
+  for (const auto& entry : dynamic.points()) inputs.push_back(entry.second);
 
   if (o.check) {
     // Everything is checked before any output is written: a failed check leaves old files.
@@ -230,7 +230,7 @@ int run_dynamic(const MeshCommandOptions& o, Columns columns, const std::string&
     {
       const Phase checking("checking against a from-scratch mesh of the " + std::to_string(inputs.size()) +
                            " final points");
-      v = check(dm);
+      v = check(dynamic);
     }
     if (!v.ok) throw InvariantError("--check failed: " + v.problem);
   }
@@ -254,7 +254,7 @@ int run_mesh(const MeshCommandOptions& o) {
     return run_dynamic<3, DynamicOctreeMesh>(
         o, shape.columns, "octree mesh",
         [](const Box<3>& box, std::span<const Point<3>> pts) { return DynamicOctreeMesh(box, pts); },
-        [](const DynamicOctreeMesh& dm) { return verify(dm); });
+        [](const DynamicOctreeMesh& dynamic) { return verify(dynamic); });
   }
   if (hpu && o.edits.empty()) return run_hpu_mesh(o, shape.columns);
   const double bound = angle_bound(o, hpu);
@@ -264,7 +264,7 @@ int run_mesh(const MeshCommandOptions& o) {
   return run_dynamic<2, DynamicMesh>(
       o, shape.columns, hpu ? "hpu mesh" : "quadtree mesh",
       [&mesh_options](const Box<2>& box, std::span<const Point<2>> pts) { return DynamicMesh(box, pts, mesh_options); },
-      [bound](const DynamicMesh& dm) { return verify(dm, bound); });
+      [bound](const DynamicMesh& dynamic) { return verify(dynamic, bound); });
 }
 
 }  // namespace dynmesh::tool

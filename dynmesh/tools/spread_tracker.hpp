@@ -1,8 +1,8 @@
 // dynmesh/tools/spread_tracker.hpp — log2(L/s) of a changing point set, exact after every
 // update (private to the tool).
 //
-// Purpose: `stability` reports the spread of the point set after each update (FORMATS.md asks
-// for the spread "at that time"), for the updates UpdateDriver makes and for those of an
+// Purpose: `stability` reports the spread of the point set after each update
+// (docs/FORMATS.md, "`dynmesh stability`", asks for the spread "at that time"), for the updates UpdateDriver makes and for those of an
 // edit file alike, without rerunning a closest-pair computation per update:
 //   * insertion of p: s ← min(s, distance from p to its nearest present point);
 //   * deletion of p: s can only change if p is an end of a closest pair, i.e. if p's

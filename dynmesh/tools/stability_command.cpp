@@ -1,5 +1,5 @@
-// `dynmesh stability`: the trace-distance experiment of docs/FORMATS.md, on a distribution
-// or on the user's own data. With `--dist`, builds the tree on N points of a distribution,
+// `dynmesh stability`: the trace-distance experiment of docs/FORMATS.md, "`dynmesh
+// stability`", on a distribution or on the user's own data. With `--dist`, builds the tree on N points of a distribution,
 // then measures U single-point updates (alternating deletions of a present point and
 // insertions of a new point of the same distribution, one propagation each). With
 // `--points POINTS --edits FILE`, builds on POINTS (read, boxed and located as `quadtree` and
@@ -7,7 +7,7 @@
 // Either way it appends one CSV row per update. With `--postprocess quadtree` or `hpu` (2D)
 // the structure is a DynamicMesh, and with `--postprocess quadtree` in 3D a DynamicOctreeMesh:
 // QuadTreeRefine and the mesh run in one trace, so each row's trace_distance and seconds are
-// the whole update, tree and mesh (FORMATS.md).
+// the whole update, tree and mesh (docs/FORMATS.md, "`dynmesh stability`").
 //
 // The N initial points and the insertion pool come from one call generate(dist, N + U, seed,
 // spread): the generators return their points in a seeded random order, so the first N are

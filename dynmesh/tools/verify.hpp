@@ -120,23 +120,23 @@ Verification verify(const DynamicQuadtree<d>& tree) {
 /// and the mesh's invariants, check_mesh with `min_angle_deg` on the final mesh (hpu:
 /// Delaunay too), then the static twin (HpuMesh or QuadtreeMesh) on the final points must
 /// give the same canonical mesh; static_seconds is the twin's time.
-inline Verification verify(const DynamicMesh& dm, double min_angle_deg) {
+inline Verification verify(const DynamicMesh& dynamic, double min_angle_deg) {
   Verification v;
   std::vector<Point<2>> pts;
-  for (const auto& entry : dm.points()) pts.push_back(entry.second);
-  const Mesh mesh = dm.mesh();
-  if (!invariants_hold(v, [&] { dm.check_invariants(); })) return v;
-  const bool hpu = dm.options().postprocess == Postprocess::Hpu;
+  for (const auto& entry : dynamic.points()) pts.push_back(entry.second);
+  const Mesh mesh = dynamic.mesh();
+  if (!invariants_hold(v, [&] { dynamic.check_invariants(); })) return v;
+  const bool hpu = dynamic.options().postprocess == Postprocess::Hpu;
   MeshCheckOptions check_options;
   check_options.min_angle_deg = min_angle_deg;
   check_options.delaunay = hpu;
-  const MeshReport report = check_mesh(mesh, dm.box(), pts, check_options);
+  const MeshReport report = check_mesh(mesh, dynamic.box(), pts, check_options);
   if (!report.ok()) {
     v.problem = "mesh check failed: " + one_line(report.summary());
     return v;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const Mesh fresh = hpu ? HpuMesh(dm.box(), pts, dm.options().min_angle).mesh() : QuadtreeMesh(dm.box(), pts).mesh();
+  const Mesh fresh = hpu ? HpuMesh(dynamic.box(), pts, dynamic.options().min_angle).mesh() : QuadtreeMesh(dynamic.box(), pts).mesh();
   v.static_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (fresh != mesh) {
     v.problem = "the dynamic mesh differs from a from-scratch mesh of the final " + std::to_string(pts.size()) +
@@ -152,14 +152,14 @@ inline Verification verify(const DynamicMesh& dm, double min_angle_deg) {
 /// includes require_valid_tet_mesh with the proved dihedral bounds), then the static twin
 /// OctreeMesh on the final points must give the same canonical mesh (hence the same `.node`
 /// and `.ele`); static_seconds is its time.
-inline Verification verify(const DynamicOctreeMesh& dm) {
+inline Verification verify(const DynamicOctreeMesh& dynamic) {
   Verification v;
   std::vector<Point<3>> pts;
-  for (const auto& entry : dm.points()) pts.push_back(entry.second);
-  if (!invariants_hold(v, [&] { dm.check_invariants(); })) return v;
-  const TetMesh mesh = dm.mesh();
+  for (const auto& entry : dynamic.points()) pts.push_back(entry.second);
+  if (!invariants_hold(v, [&] { dynamic.check_invariants(); })) return v;
+  const TetMesh mesh = dynamic.mesh();
   const auto t0 = std::chrono::steady_clock::now();
-  const TetMesh fresh = OctreeMesh(dm.box(), pts).mesh();
+  const TetMesh fresh = OctreeMesh(dynamic.box(), pts).mesh();
   v.static_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (fresh != mesh) {
     v.problem = "the dynamic mesh differs from a from-scratch mesh of the final " + std::to_string(pts.size()) +

@@ -1,7 +1,7 @@
 // Tests of hpu/hpu_geometry.hpp's formulas that compute in frames scaled by a power of two
 // (geometry/powers_of_two.hpp, tested in powers_of_two_test.cpp) against the same formulas
-// written with std::ldexp and std::ilogb (their form before the helpers): the twin and the
-// program must keep every bit.
+// written plainly with std::ldexp and std::ilogb: the twin and the program must keep every
+// bit.
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -17,7 +17,7 @@ namespace {
 
 constexpr std::uint64_t kSeed = 20261128;
 
-// The formulas in their form before the helpers, as the oracle.
+// The formulas written plainly, as the oracle.
 int edge_class_ldexp(const Point<2>& a, const Point<2>& b) {
   const double dx = b[0] - a[0], dy = b[1] - a[1];
   const int e = std::ilogb(std::max(std::abs(dx), std::abs(dy)));

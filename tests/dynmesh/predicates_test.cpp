@@ -626,7 +626,7 @@ TEST(Predicates, MixedMagnitudesAgreeWithGmp) {
 // --- orient3d ----------------------------------------------------------------------------
 
 TEST(Predicates, Orient3dConvention) {
-  // The unit tetrahedron is positive (FORMATS.md's orientation); an odd permutation flips it,
+  // The unit tetrahedron is positive (the orientation of docs/FORMATS.md, "`dynmesh mesh` in 3D"); an odd permutation flips it,
   // an even one (a rotation of three corners) keeps it.
   const Point<3> o{0, 0, 0}, x{1, 0, 0}, y{0, 1, 0}, z{0, 0, 1};
   EXPECT_EQ(dynmesh::orient3d(o, x, y, z), 1);
@@ -857,8 +857,8 @@ TEST(Predicates, PencilMixedMagnitudesAgreeWithTheCircleDefinition) {
 /// Far from the unit scale the inline filters overflow (or underflow) and cannot decide; the
 /// exact stage then rescales the call by a power of two and filters it again. Random cases
 /// scaled by 2^±960 must agree with GMP and reach exact arithmetic exactly as often as the
-/// same cases unscaled (the signs and the filters' decisions are scale-free); before the
-/// rescale, every scaled in-circle call and most others did.
+/// same cases unscaled (the signs and the filters' decisions are scale-free); without the
+/// rescale, every scaled in-circle call and most others would.
 TEST(Predicates, FarFromTheUnitScaleTheFiltersStillDecide) {
   constexpr std::uint64_t kSeed = 20261206;
   SCOPED_TRACE(seed_trace(kSeed));
@@ -929,9 +929,8 @@ TEST(Predicates, FarFromTheUnitScaleTheFiltersStillDecide) {
 }
 
 /// The filters' own arithmetic stays in the normal range on meshing input: a subnormal
-/// result costs a microcode assist on x86, and the in-circle filter's room for underflow
-/// once made one on every call (70% of the filter's time; bench/RESULTS.md, "The in-circle
-/// filter's subnormal room"). IEEE 754 raises the underflow flag for an inexact subnormal
+/// result costs a microcode assist on x86, and a subnormal room for underflow in the
+/// in-circle filter would make one on every call. IEEE 754 raises the underflow flag for an inexact subnormal
 /// result, so a clean flag after many calls says no call computed one.
 TEST(Predicates, FiltersComputeNoSubnormalOnMeshingInput) {
   constexpr std::uint64_t kSeed = 20261130;

@@ -5,7 +5,7 @@
 // Purpose: one driver for DynamicQuadtree<2>, <3> (fuzz_dynamic_quadtree) and DynamicMesh
 // (fuzz_dynamic_mesh). The driver keeps the expected state itself: the present points with
 // their ids, in input-list order, and the next id. It predicts each operation's outcome from
-// the contract alone (dynamic_quadtree.hpp, FORMATS.md): an insertion is refused with
+// the contract alone (dynamic_quadtree.hpp, docs/FORMATS.md): an insertion is refused with
 // NotFinite, OutsideBox, or whatever kind the static twin refuses the set with the point
 // added; an erasure is refused with NotFinite, OutsideBox or Absent unless a present point
 // equals the coordinates (or has the id); a batch applies its edits in order against the
@@ -42,7 +42,7 @@
 // deep, whose checks cost a hundred times more), so every input runs fast.
 // Complexity: per operation at most one static build (none when the set is unchanged) and
 // one check_invariants, O(n lg n + |T|).
-// Paper: none (the contracts are docs/DESIGN.md's).
+// Paper: none (the contracts: docs/DESIGN.md, "The quadtree contract" and "The mesh contract (2D)").
 #pragma once
 
 #include "fuzz_support.hpp"

@@ -67,7 +67,7 @@ void validate_box(const Box<d>& box) {
   }
 }
 
-/// FORMATS.md "The domain box", in IEEE double exactly as written:
+/// docs/FORMATS.md, "The domain box", in IEEE double exactly as written:
 ///   w = max over axes of (max − min); if w == 0 then w = 1;
 ///   o_axis = (min + max) / 2 − 1.5 · w;  L = 3 · w.
 /// Throws InputError(Empty) on no points, InputError(NotFinite) on a NaN or infinite

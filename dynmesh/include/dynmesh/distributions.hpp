@@ -1,7 +1,7 @@
 // dynmesh/distributions.hpp — deterministic point generators and the spread of a point set.
 //
 // Purpose: the point distributions of the tests, the stability experiments (`dynmesh
-// stability --dist NAME`, FORMATS.md) and the benchmarks, reproducible from a seed:
+// stability --dist NAME`, docs/FORMATS.md) and the benchmarks, reproducible from a seed:
 //   uniform    – uniform in [0, 1)^d.
 //   clusters   – Gaussian clusters of several radii (8 clusters, standard deviations from
 //                1e-1 down to 1e-4 geometrically, centres uniform in [0.2, 0.8]^d).
@@ -128,7 +128,7 @@ std::vector<Point<2>> python_uniform(std::size_t n, std::uint32_t seed = 1);
 template <std::size_t d>
 double closest_pair_distance(std::span<const Point<d>> points);
 
-/// log2(L / s) with L the box side and s the closest pair distance (FORMATS.md,
+/// log2(L / s) with L the box side and s the closest pair distance (docs/FORMATS.md,
 /// `dynmesh stability`): +infinity when s = 0, −infinity for fewer than two points.
 template <std::size_t d>
 double log2_spread(const Box<d>& box, std::span<const Point<d>> points);

@@ -2,9 +2,9 @@
 // point insertions and deletions by self-adjusting computation.
 //
 // Purpose: the public dynamic API. QuadTreeRefine (Acar & Hudson, Figure 2) is written as
-// ordinary static code on sac-runtime (dynmesh/src/quadtree/quadtree_refine.hpp); this class owns the
-// engine, the input point list and the cell directory, runs the program once, and after
-// each insert / erase / batch calls propagate(), which leaves exactly the tree a
+// ordinary static code on sac-runtime, inside the library; this class owns the engine, the
+// input point list and the cell directory, runs the program once, and after each insert /
+// erase / batch calls propagate(), which leaves exactly the tree a
 // from-scratch run on the current point set would build (docs/DESIGN.md, "The
 // quadtree contract"), in O(lg L/s) trace distance per single-point update.
 //

@@ -1,6 +1,6 @@
 // dynmesh/io.hpp — reading point files and edit scripts, writing and reading `.cells`.
 //
-// Purpose: the file formats of FORMATS.md, exactly:
+// Purpose: the file formats of docs/FORMATS.md, exactly:
 //   * `.node` (Triangle 2D / TetGen 3D): header `<#vertices> <dim> <#attributes> <#markers>`
 //     (trailing header fields may be omitted as Triangle allows: dim defaults to the
 //     requested d, the others to 0), then `<vertex#> <x> <y> [<z>] [attributes] [marker]`.
@@ -125,7 +125,7 @@ struct PointFileShape {
   Columns columns = Columns::AtLeast;
 };
 
-/// The dimension rule of docs/FORMATS.md ("Input points"), for a path read by extension as
+/// The dimension rule of docs/FORMATS.md, "Input points", for a path read by extension as
 /// read_points_file reads it. `dim` is the dimension asked for (the commands' --dim), 0 when
 /// none was. Given, it is the dimension, with Columns::AtLeast (a `.node` or `.poly` header
 /// that announces another is reported when the file is read). Otherwise a `.node` or `.poly`

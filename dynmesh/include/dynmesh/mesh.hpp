@@ -1,10 +1,10 @@
 // dynmesh/mesh.hpp — 2D triangle meshes: triangles named by their corners, the canonical
-// mesh of FORMATS.md, and the change feed of one update.
+// mesh of docs/FORMATS.md, and the change feed of one update.
 //
 // Purpose: the value types every mesher (static or self-adjusting, quadtree or off-center)
 // produces and every consumer (writers, checker, tests, the command) reads.
 //   Triangle   – three corners by coordinates, counter-clockwise, rotated so that the
-//                corner with the smallest (x, y) comes first (FORMATS.md, the feed's rule).
+//                corner with the smallest (x, y) comes first (docs/FORMATS.md, "`dynmesh mesh` (2D)", the feed's rule).
 //                Ordered lexicographically on the six coordinates.
 //   Mesh       – the canonical form: vertices sorted by (x, y) (0-based here, written from
 //                1), triangles as vertex-index triples, each starting at its smallest index
@@ -15,7 +15,7 @@
 // only on the set of triangles, not on their order; triangles_of(make_mesh(ts)) == sorted ts
 // (for distinct ts).
 // Complexity: make_mesh O(t log t); the rest O(1) per triangle.
-// Paper: none (formats: FORMATS.md "dynmesh mesh"; Triangle's .node/.ele).
+// Paper: none (formats: docs/FORMATS.md, "`dynmesh mesh` (2D)"; Triangle's .node/.ele).
 #pragma once
 
 #include <array>

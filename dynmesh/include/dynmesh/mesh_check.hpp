@@ -35,7 +35,7 @@
 // vertices along a Z-order curve; the vertices in an edge's bounding box lie in one run of
 // that order, scanned when short and otherwise searched in a bounding-volume tree pruned by
 // the edge's box and line: O(log t) per edge for graded meshes.
-// Paper: none (the contract is docs/DESIGN.md's; the exact predicates are Shewchuk's via CGAL).
+// Paper: none (the contract: docs/DESIGN.md, "The mesh contract (2D)"; the exact predicates are Shewchuk's via CGAL).
 #pragma once
 
 #include <array>

@@ -1,6 +1,6 @@
 // dynmesh/mesh_io.hpp — the text forms of a 2D mesh: files, feed, picture and statistics.
 //
-// Purpose: everything `dynmesh mesh` writes (FORMATS.md "dynmesh mesh (2D)"), as pure
+// Purpose: everything `dynmesh mesh` writes (docs/FORMATS.md, "`dynmesh mesh` (2D)"), as pure
 // functions from values to strings; the caller writes files (aside, then renamed).
 //   .node / .ele  Triangle's formats, numbered from 1 in the canonical order of a Mesh;
 //                 coordinates %.17g (they round-trip exactly); node marker 1 on the box

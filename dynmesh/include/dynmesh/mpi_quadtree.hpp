@@ -57,7 +57,7 @@
 namespace dynmesh {
 
 struct MpiQuadtreeOptions {
-  /// l0; negative: chosen from the input (docs/DISTRIBUTED.md "Choosing l0").
+  /// l0; negative: chosen from the input (docs/DISTRIBUTED.md, "Partition").
   int partition_level = -1;
   /// Repartition after an apply() when the largest rank owns more than this times the mean
   /// number of points (and at least 64 more); 0 never repartitions.

@@ -11,9 +11,9 @@
 // Exact_predicates_inexact_constructions_kernel (LGPL, Debian's libcgal-dev): an
 // interval filter with an exact fallback. Before that, a call whose coordinates are so large
 // (or small) that the filter's products overflow (or underflow) is rescaled by a power of
-// two, exactly, and filtered again. CGAL's headers are confined to src/geometry/predicates.cpp.
+// two, exactly, and filtered again. No public header includes CGAL's: the library compiles them.
 // The inline stage decides nearly all calls on meshing input and saves the call and CGAL's
-// own filter setup (the predicates were a third of the hpu mesh's build time).
+// own filter setup (the predicates are a large part of a mesh's build).
 //
 // Invariants: the result is the sign of the exact real determinant of the double inputs,
 // for every finite input (including exactly degenerate and nearly degenerate ones).
@@ -62,7 +62,7 @@ inline int orient2d(const Point<2>& a, const Point<2>& b, const Point<2>& c) noe
   const double right = acy * bcx;
   const double det = left - right;
   const double permanent = std::fabs(left) + std::fabs(right);
-  // No range test (8% of the hpu program's instructions went to them): the absolute term
+  // No range test (a hot path: the tests would cost more than the filter): the absolute term
   // covers products that underflow (each off by at most 2^-1075), and a difference or a
   // product that overflows makes the permanent infinite or the determinant NaN, so that
   // neither comparison holds.
@@ -95,9 +95,8 @@ inline int incircle(const Point<2>& a, const Point<2>& b, const Point<2>& c, con
   // difference, so they add up to less than 30·2^-1075·(M² + 1); (M² + 1)·2^-1000 is far
   // above that. An overflow makes the permanent or the room infinite, or the determinant
   // NaN, and then neither comparison holds. The room's factor is a normal number: with a
-  // subnormal one (2^-1065, until 2026-11-30) every call multiplied into the subnormal
-  // range, which x86 does in microcode, and that one multiply was 70% of the filter's
-  // time (bench/RESULTS.md, "The in-circle filter's subnormal room").
+  // subnormal one every call would multiply into the subnormal range, which x86 does in
+  // microcode, slowly.
   const double m = std::max({std::fabs(adx), std::fabs(ady), std::fabs(bdx), std::fabs(bdy), std::fabs(cdx), std::fabs(cdy)});
   const double bound = detail::kIncircleBound * permanent + (m * m + 1) * detail::kUnderflowRoom;
   if (det > bound) return 1;
@@ -131,7 +130,8 @@ inline int pencil(const Point<2>& p, const Point<2>& q, double h, const Point<2>
 /// Sign of det[b − a, c − a, d − a]: +1 when a, b, c, d are positively oriented (d on the
 /// side of the plane abc from which a, b, c turn counter-clockwise; the unit tetrahedron
 /// (0,0,0), (1,0,0), (0,1,0), (0,0,1) is positive), −1 negatively, 0 coplanar. This is
-/// FORMATS.md's orientation of a tetrahedron, and the opposite of Shewchuk's orient3d sign.
+/// the orientation of a tetrahedron in docs/FORMATS.md, "`dynmesh mesh` in 3D", and the
+/// opposite of Shewchuk's orient3d sign.
 /// Inputs must be finite.
 inline int orient3d(const Point<3>& a, const Point<3>& b, const Point<3>& c, const Point<3>& d) noexcept {
   // Shewchuk's evaluation, relative to d: his determinant is det[a − d, b − d, c − d], which

@@ -18,7 +18,7 @@
 // twelve even permutations of a positive quadruple to one value; make_tet_mesh depends only
 // on the set of tetrahedra; tetrahedra_of(make_tet_mesh(ts)) == sorted ts (distinct ts).
 // Complexity: make_tet_mesh O(t log t); the rest O(1) per tetrahedron.
-// Paper: none (the formats are TetGen's .node/.ele; docs/FORMATS.md, "dynmesh mesh in 3D").
+// Paper: none (the formats are TetGen's .node/.ele; docs/FORMATS.md, "`dynmesh mesh` in 3D").
 #pragma once
 
 #include <array>

@@ -1,7 +1,7 @@
 // dynmesh/tet_mesh_check.hpp — the checker of the 3D (tetrahedral) mesh contract.
 //
 // Purpose: decides whether a TetMesh meshes a domain box for an input point set as
-// FORMATS.md "`dynmesh mesh` in 3D" states (the eight corners and every input point are
+// docs/FORMATS.md, "`dynmesh mesh` in 3D", states (the eight corners and every input point are
 // vertices, positively oriented tetrahedra tile the box with no hanging vertex, canonical
 // order), and says what is wrong when it does not. Every 3D mesher's tests run it, and a
 // caller may run it after every update (require_valid_tet_mesh throws). The 3D counterpart
@@ -38,7 +38,7 @@
 // max_problems messages (in check order) and counts every defect found.
 // Complexity: O((t + p) log(t + n)) for t tetrahedra, n vertices and p input points: the 4t
 // oriented faces are sorted once, and corners and inputs are found by binary search.
-// Paper: none (the contract is FORMATS.md's; orient3d is Shewchuk's via CGAL).
+// Paper: none (the contract is docs/FORMATS.md, "`dynmesh mesh` in 3D"; orient3d is Shewchuk's via CGAL).
 #pragma once
 
 #include <array>

@@ -1,7 +1,7 @@
 // dynmesh/tet_mesh_io.hpp — the text forms of a 3D (tetrahedral) mesh: files, feed and
 // statistics.
 //
-// Purpose: everything `dynmesh mesh` writes in 3D (FORMATS.md "`dynmesh mesh` in 3D"), as
+// Purpose: everything `dynmesh mesh` writes in 3D (docs/FORMATS.md, "`dynmesh mesh` in 3D"), as
 // pure functions from values to strings, overloads of mesh_io.hpp's 2D writers; the caller
 // writes files (aside, then renamed).
 //   .node / .ele  TetGen's formats, numbered from 1 in the canonical order of a TetMesh;

@@ -145,14 +145,14 @@ class PointLookup {
 /// Canonical: each vertex strictly after the previous one under `less` ("(x, y)" order in
 /// 2D, "(x, y, z)" in 3D, named by `order`). Returns whether they all are.
 template <class Defect, std::size_t d, class Recorder, class Less>
-bool check_vertex_order(const std::vector<Point<d>>& vs, Less less, std::string_view order, Recorder& record) {
+bool check_vertex_order(const std::vector<Point<d>>& vertices, Less less, std::string_view order, Recorder& record) {
   bool sorted = true;
-  for (std::size_t i = 1; i < vs.size(); ++i) {
-    if (less(vs[i - 1], vs[i])) continue;
+  for (std::size_t i = 1; i < vertices.size(); ++i) {
+    if (less(vertices[i - 1], vertices[i])) continue;
     sorted = false;
     record.add(Defect::Canonical, [&] {
-      return "vertices " + std::to_string(i - 1) + " " + to_string(vs[i - 1]) + " and " + std::to_string(i) + " " +
-             to_string(vs[i]) + " are not in strictly increasing " + std::string(order) + " order";
+      return "vertices " + std::to_string(i - 1) + " " + to_string(vertices[i - 1]) + " and " + std::to_string(i) + " " +
+             to_string(vertices[i]) + " are not in strictly increasing " + std::string(order) + " order";
     });
   }
   return sorted;
@@ -161,10 +161,10 @@ bool check_vertex_order(const std::vector<Point<d>>& vs, Less less, std::string_
 /// OutsideBox for every vertex outside the closed box, MissingCorner for every corner of it
 /// that is not a vertex. `describe_vertex(i)` names vertex i in messages.
 template <class Defect, std::size_t d, class Recorder, class Less, class DescribeVertex>
-void check_box(const std::vector<Point<d>>& vs, const ClosedBox<d>& domain, const PointLookup<d, Less>& lookup,
+void check_box(const std::vector<Point<d>>& vertices, const ClosedBox<d>& domain, const PointLookup<d, Less>& lookup,
                Recorder& record, DescribeVertex&& describe_vertex) {
-  for (std::size_t i = 0; i < vs.size(); ++i)
-    if (!domain.contains(vs[i]))
+  for (std::size_t i = 0; i < vertices.size(); ++i)
+    if (!domain.contains(vertices[i]))
       record.add(Defect::OutsideBox, [&] { return describe_vertex(i) + " is outside the box"; });
   for (const Point<d>& c : domain.corners())
     if (!lookup.contains(c))

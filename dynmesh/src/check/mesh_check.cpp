@@ -7,6 +7,7 @@
 #include <numbers>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "check/check_support.hpp"
 #include "dynmesh/errors.hpp"
@@ -341,27 +342,29 @@ double corner_angle_deg(const Point<2>& at, const Point<2>& p, const Point<2>& q
   return std::atan2(std::abs(cross), dot) * (180.0 / std::numbers::pi);
 }
 
-MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point<2>> inputs,
-                      const MeshCheckOptions& options, std::size_t max_problems) {
-  MeshReport report;
-  Recorder record(report, max_problems);
-  const Domain domain(box);
+namespace {
+
+/// Lengths in units of 2^k with 2^k <= L < 2^(k+1) (exact scaling), so that neither the
+/// box's area nor a triangle's overflows or underflows in a box of extreme size.
+struct SideScale {
+  int exponent = 0;
+  explicit SideScale(const Box<2>& box) : exponent(std::isfinite(box.side) && box.side > 0 ? std::ilogb(box.side) : 0) {}
+  double operator()(double length) const { return std::ldexp(length, -exponent); }
+};
+
+/// What the triangle pass learns for the later passes.
+struct TriangleScan {
+  std::vector<char> well_formed;  // indices in range and distinct
+  std::vector<char> ccw;          // strictly counter-clockwise
+  detail::CompensatedSum twice_area;  // in units of SideScale squared
+};
+
+/// Per triangle: indices, canonical rotation and order, orientation, area, angles.
+TriangleScan check_triangles(const Mesh& mesh, const SideScale& scaled, const MeshCheckOptions& options,
+                             MeshReport& report, Recorder& record) {
   const std::size_t nv = mesh.num_vertices(), nt = mesh.num_triangles();
-  const auto& vs = mesh.vertices;
-
-  // Canonical vertex order. Lookups below need a sorted list; a broken mesh gets a copy.
-  const bool vertices_sorted = detail::check_vertex_order<MeshDefect>(vs, &xy_less, "(x, y)", record);
-  const detail::PointLookup<2, decltype(&xy_less)> lookup(vs, vertices_sorted, &xy_less);
-  detail::check_box<MeshDefect>(vs, domain, lookup, record,
-                                [&](std::size_t i) { return describe_vertex(mesh, static_cast<Index>(i)); });
-
-  // Per triangle: indices, canonical rotation and order, orientation, area, angles. Areas are
-  // in units of 2^(2k) with 2^k <= L < 2^(k+1) (exact scaling), so that neither the box's
-  // nor a triangle's overflows or underflows in a box of extreme size.
-  const int side_exponent = std::isfinite(box.side) && box.side > 0 ? std::ilogb(box.side) : 0;
-  auto scaled = [&](double length) { return std::ldexp(length, -side_exponent); };
-  std::vector<char> well_formed(nt, 0), ccw(nt, 0);
-  detail::CompensatedSum area;
+  const auto& vertices = mesh.vertices;
+  TriangleScan scan{std::vector<char>(nt, 0), std::vector<char>(nt, 0), {}};
   double min_angle = std::numeric_limits<double>::infinity(), max_angle = 0;
   for (std::size_t t = 0; t < nt; ++t) {
     const Tri& tri = mesh.triangles[t];
@@ -372,14 +375,14 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
                  [&] { return describe_triangle(mesh, t) + " names a missing vertex or one twice"; });
       continue;
     }
-    well_formed[t] = 1;
+    scan.well_formed[t] = 1;
     if (!(tri[0] < tri[1] && tri[0] < tri[2]))
       record.add(MeshDefect::Canonical,
                  [&] { return describe_triangle(mesh, t) + " does not start at its smallest index"; });
-    const Point<2>&a = vs[tri[0]], &b = vs[tri[1]], &c = vs[tri[2]];
+    const Point<2>&a = vertices[tri[0]], &b = vertices[tri[1]], &c = vertices[tri[2]];
     const int turn = orient2d(a, b, c);
     if (turn > 0) {
-      ccw[t] = 1;
+      scan.ccw[t] = 1;
     } else {
       record.add(MeshDefect::Orientation, [&] {
         return describe_triangle(mesh, t) + (turn < 0 ? " is clockwise" : " is degenerate (collinear corners)");
@@ -387,7 +390,7 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
     }
     const double twice =
         scaled(b[0] - a[0]) * scaled(c[1] - a[1]) - scaled(b[1] - a[1]) * scaled(c[0] - a[0]);
-    area.add(twice);
+    scan.twice_area.add(twice);
 
     const double angles[3] = {corner_angle_deg(a, b, c), corner_angle_deg(b, c, a), corner_angle_deg(c, a, b)};
     const double lo = std::min({angles[0], angles[1], angles[2]}), hi = std::max({angles[0], angles[1], angles[2]});
@@ -403,19 +406,29 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
     report.min_angle_deg = min_angle;
     report.max_angle_deg = max_angle;
   }
+  return scan;
+}
 
+/// The triangles' area is the box's.
+void check_area(const Domain& domain, const SideScale& scaled, const TriangleScan& scan, Recorder& record) {
   const double box_area = scaled(domain.hi[0] - domain.lo[0]) * scaled(domain.hi[1] - domain.lo[1]);
-  const double mesh_area = area.value() / 2;
+  const double mesh_area = scan.twice_area.value() / 2;
   if (!(std::abs(mesh_area - box_area) <= 1e-9 * box_area))
     record.add(MeshDefect::Area, [&] {
-      const std::string unit = side_exponent == 0 ? "" : " (in units of 2^" + std::to_string(2 * side_exponent) + ")";
+      const std::string unit = scaled.exponent == 0 ? "" : " (in units of 2^" + std::to_string(2 * scaled.exponent) + ")";
       return "the triangles' area " + format_exact(mesh_area) + " differs from the box's " + format_exact(box_area) +
              unit;
     });
+}
 
-  // Edges: matched in opposite directions inside, on a side of the box when used once.
-  const EdgeTable edges = build_edges(mesh, well_formed);
-  std::vector<std::pair<Index, Index>> undirected;  // each edge once, for VertexInEdge
+/// Edges: matched in opposite directions inside, on a side of the box when used once; every
+/// vertex on one; Delaunay across each interior edge if asked. Returns each edge once.
+std::vector<std::pair<Index, Index>> check_edges(const Mesh& mesh, const Domain& domain, const TriangleScan& scan,
+                                                 const MeshCheckOptions& options, Recorder& record) {
+  const std::size_t nv = mesh.num_vertices();
+  const auto& vertices = mesh.vertices;
+  const EdgeTable edges = build_edges(mesh, scan.well_formed);
+  std::vector<std::pair<Index, Index>> undirected;
   undirected.reserve(edges.out.size() / 2 + nv);
   for (Index u = 0; u < nv; ++u) {
     const auto row = edges.from(u);
@@ -427,8 +440,8 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
       const Index v = row[k].to, t = row[k].tri;
       if (k > 0 && row[k - 1].to == v) {
         record.add(MeshDefect::EdgeTwice, [&] {
-          return "edge " + std::to_string(u) + " -> " + std::to_string(v) + " " + to_string(vs[u]) + " -> " +
-                 to_string(vs[v]) + " is used by triangles " + std::to_string(row[k - 1].tri) + " and " +
+          return "edge " + std::to_string(u) + " -> " + std::to_string(v) + " " + to_string(vertices[u]) + " -> " +
+                 to_string(vertices[v]) + " is used by triangles " + std::to_string(row[k - 1].tri) + " and " +
                  std::to_string(t);
         });
         continue;
@@ -438,10 +451,10 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
       const std::size_t reverse = back.first;
       const Index across = back.second;
       if (reverse == 0) {
-        if (!domain.on_one_side(std::array{vs[u], vs[v]}))
+        if (!domain.on_one_side(std::array{vertices[u], vertices[v]}))
           record.add(MeshDefect::OpenEdge, [&] {
-            return "edge " + std::to_string(u) + " -> " + std::to_string(v) + " " + to_string(vs[u]) + " -> " +
-                   to_string(vs[v]) + " of triangle " + std::to_string(t) +
+            return "edge " + std::to_string(u) + " -> " + std::to_string(v) + " " + to_string(vertices[u]) + " -> " +
+                   to_string(vertices[v]) + " of triangle " + std::to_string(t) +
                    " has no neighbour and is not on the box boundary";
           });
         undirected.emplace_back(u, v);
@@ -449,9 +462,9 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
       }
       if (u > v) continue;  // interior edges are handled once, from their smaller end
       undirected.emplace_back(u, v);
-      if (options.delaunay && ccw[t] && ccw[across]) {
+      if (options.delaunay && scan.ccw[t] && scan.ccw[across]) {
         const Index apex = opposite(mesh.triangles[t], u, v), far = opposite(mesh.triangles[across], u, v);
-        if (incircle(vs[u], vs[v], vs[apex], vs[far]) > 0)
+        if (incircle(vertices[u], vertices[v], vertices[apex], vertices[far]) > 0)
           record.add(MeshDefect::NotDelaunay, [&] {
             return describe_vertex(mesh, far) + " of triangle " + std::to_string(across) +
                    " is strictly inside the circumcircle of triangle " + std::to_string(t) + " across edge " +
@@ -460,12 +473,17 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
       }
     }
   }
+  return undirected;
+}
 
-  // No vertex strictly inside an edge (edges with a non-finite end are reported elsewhere).
+/// No vertex strictly inside an edge (edges with a non-finite end are reported elsewhere).
+void check_vertices_off_edges(const Mesh& mesh, const Domain& domain,
+                              const std::vector<std::pair<Index, Index>>& undirected, Recorder& record) {
+  const auto& vertices = mesh.vertices;
   const VertexTree tree(mesh, domain);
   for (const auto& edge : undirected) {
     const Index u = edge.first, v = edge.second;
-    const Point<2>&a = vs[u], &b = vs[v];
+    const Point<2>&a = vertices[u], &b = vertices[v];
     if (!std::isfinite(a[0]) || !std::isfinite(a[1]) || !std::isfinite(b[0]) || !std::isfinite(b[1])) continue;
     tree.vertices_inside(mesh, u, v, [&](Index w) {
       record.add(MeshDefect::VertexInEdge, [&] {
@@ -474,7 +492,27 @@ MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point
       });
     });
   }
+}
 
+}  // namespace
+
+MeshReport check_mesh(const Mesh& mesh, const Box<2>& box, std::span<const Point<2>> inputs,
+                      const MeshCheckOptions& options, std::size_t max_problems) {
+  MeshReport report;
+  Recorder record(report, max_problems);
+  const Domain domain(box);
+  const SideScale scaled(box);
+
+  // Canonical vertex order. Lookups below need a sorted list; a broken mesh gets a copy.
+  const bool vertices_sorted = detail::check_vertex_order<MeshDefect>(mesh.vertices, &xy_less, "(x, y)", record);
+  const detail::PointLookup<2, decltype(&xy_less)> lookup(mesh.vertices, vertices_sorted, &xy_less);
+  detail::check_box<MeshDefect>(mesh.vertices, domain, lookup, record,
+                                [&](std::size_t i) { return describe_vertex(mesh, static_cast<Index>(i)); });
+
+  const TriangleScan scan = check_triangles(mesh, scaled, options, report, record);
+  check_area(domain, scaled, scan, record);
+  const std::vector<std::pair<Index, Index>> undirected = check_edges(mesh, domain, scan, options, record);
+  check_vertices_off_edges(mesh, domain, undirected, record);
   detail::check_inputs<MeshDefect>(inputs, lookup, record);
   return report;
 }

@@ -145,8 +145,8 @@ Face oriented_face(Index a, Index b, Index c, Index tet) noexcept {
 }
 
 std::string describe_face(const TetMesh& mesh, const Face& f) {
-  const auto& [a, x, y] = f.vertices;
-  const Index b = f.flipped ? y : x, c = f.flipped ? x : y;  // back to its orientation
+  const auto& [a, low, high] = f.vertices;
+  const Index b = f.flipped ? high : low, c = f.flipped ? low : high;  // back to its orientation
   return "face [" + std::to_string(a) + " " + std::to_string(b) + " " + std::to_string(c) + "] " +
          to_string(mesh.vertices[a]) + " " + to_string(mesh.vertices[b]) + " " + to_string(mesh.vertices[c]);
 }

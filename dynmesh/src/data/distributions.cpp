@@ -13,6 +13,8 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "sac/splitmix64.hpp"
+
 namespace dynmesh {
 
 std::uint64_t Rng::below(std::uint64_t n) {
@@ -226,8 +228,8 @@ std::vector<Point<d>> shrinking_points(std::size_t n, double spread, Rng& rng) {
 // 1.5 spacings apart. Why the curves are far apart for their spacing, at every n: K curves of
 // mean length ℓ̄ ≈ 0.25 spaced over an area A ≈ 0.6 are about A/(K·ℓ̄) apart, and the
 // spacing along them is K·ℓ̄/n, so the ratio is A·n/(K·ℓ̄)² ≈ 16·A/ℓ̄² ≈ 150 for K = √n/4;
-// the median distance from a point to the nearest other curve is some 30 to 150 spacings in
-// 2D (the curves cross here and there; measured for n = 10^2 to 10^4), more in 3D.
+// the median distance from a point to the nearest other curve is many spacings (the curves
+// cross here and there), more in 3D.
 //
 // No libm: cos θ and sin θ come from the rational parametrization of the circle,
 // ((1 − u²)/(1 + u²), 2u/(1 + u²)) for u in [0, 1) on each quarter turn, and the harmonics
@@ -462,12 +464,14 @@ std::vector<Point<d>> collinear_points(std::size_t n, Rng& rng) {
   return pts;
 }
 
+/// Boost's hash_combine over the coordinates' std::hash (not splitmix64: no finaliser). It
+/// must stay bit-stable: it orders the buckets of the set that drops repeated points.
 template <std::size_t d>
 struct PointBitsHash {
   std::size_t operator()(const Point<d>& p) const noexcept {
     std::uint64_t h = 0x243f6a8885a308d3ULL;
     for (std::size_t a = 0; a < d; ++a) {
-      h ^= std::hash<double>{}(p[a]) + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+      h ^= std::hash<double>{}(p[a]) + sac::kGoldenGamma + (h << 6) + (h >> 2);
     }
     return static_cast<std::size_t>(h);
   }
@@ -509,16 +513,8 @@ std::vector<Point<d>> boundary_points(std::size_t n, Rng& rng) {
 template <std::size_t d>
 struct KeyHash {
   std::size_t operator()(const std::array<std::int64_t, d>& k) const noexcept {
-    std::uint64_t h = 0x9e3779b97f4a7c15ULL;
-    for (std::size_t a = 0; a < d; ++a) {
-      std::uint64_t x = h ^ static_cast<std::uint64_t>(k[a]);
-      x ^= x >> 30;
-      x *= 0xbf58476d1ce4e5b9ULL;
-      x ^= x >> 27;
-      x *= 0x94d049bb133111ebULL;
-      x ^= x >> 31;
-      h = x;
-    }
+    std::uint64_t h = sac::kGoldenGamma;
+    for (std::size_t a = 0; a < d; ++a) h = sac::mix64(h ^ static_cast<std::uint64_t>(k[a]));
     return static_cast<std::size_t>(h);
   }
 };

@@ -21,6 +21,7 @@
 #include <utility>
 
 #include "dynmesh/errors.hpp"
+#include "io/number_text.hpp"
 
 namespace dynmesh {
 namespace {
@@ -236,12 +237,6 @@ std::ifstream open_input(const std::string& path) {
     throw InputError(Kind::Io, std::string("cannot open file: ") + (err ? std::strerror(err) : "unknown reason"), path);
   }
   return in;
-}
-
-void append_int(std::string& s, std::uint64_t v) {
-  char buf[24];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  s.append(buf, r.ptr);
 }
 
 template <std::size_t d>
@@ -862,7 +857,7 @@ std::string format_cells(const Box<d>& box, std::span<const Leaf<d>> leaves) {
   std::vector<Leaf<d>> sorted(leaves.begin(), leaves.end());
   std::sort(sorted.begin(), sorted.end(), [](const Leaf<d>& a, const Leaf<d>& b) { return a.cell < b.cell; });
   std::string s = "# dynmesh cells v1\n# dim ";
-  append_int(s, d);
+  detail::append_number(s, d);
   s += "\n# box";
   for (std::size_t a = 0; a < d; ++a) {
     s += ' ';
@@ -873,13 +868,13 @@ std::string format_cells(const Box<d>& box, std::span<const Leaf<d>> leaves) {
   s += '\n';
   s.reserve(s.size() + sorted.size() * (8 + 14 * d));
   for (const Leaf<d>& leaf : sorted) {
-    append_int(s, static_cast<std::uint64_t>(leaf.cell.level));
+    detail::append_number(s, static_cast<std::size_t>(leaf.cell.level));
     for (std::size_t a = 0; a < d; ++a) {
       s += ' ';
-      append_int(s, leaf.cell.index[a]);
+      detail::append_number(s, leaf.cell.index[a]);
     }
     s += ' ';
-    append_int(s, leaf.npoints);
+    detail::append_number(s, leaf.npoints);
     s += '\n';
   }
   return s;

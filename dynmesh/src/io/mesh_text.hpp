@@ -4,8 +4,8 @@
 // Purpose: a triangle mesh and a tetrahedral mesh are written and read alike: a vertex list
 // and a list of k-vertex cells, numbered from 1 in the .node/.ele, .msh files and from 0 in
 // .vtk; a feed line per simplex; the -V style statistics' rows and histogram. Writing them
-// once keeps the two dimensions' files identical in form (FORMATS.md, "`dynmesh mesh`" in 2D
-// and in 3D) and their number formatting the same (%.17g, C locale).
+// once keeps the two dimensions' files identical in form (docs/FORMATS.md, "`dynmesh mesh` (2D)"
+// and "`dynmesh mesh` in 3D") and their number formatting the same (%.17g, C locale).
 // Invariants: every line ends in '\n'; coordinates go through format_exact, so they
 // round-trip; read_node_ele_text(node_text(v, box), ele_text(c)) gives back v and c.
 // Complexity: linear in the vertices and cells, and in the text for the reader.
@@ -27,16 +27,11 @@
 #include "dynmesh/box.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
+#include "io/number_text.hpp"
 
 namespace dynmesh::detail {
 
 inline void append_line_end(std::string& out) { out += '\n'; }
-
-inline void append_number(std::string& out, std::size_t n) {
-  char buf[24];
-  const auto r = std::to_chars(buf, buf + sizeof buf, n);
-  out.append(buf, r.ptr);
-}
 
 inline void append_exact(std::string& out, double x) { out += format_exact(x); }
 

@@ -8,8 +8,8 @@
 //                picks p's target, splits what it needs with split() and marks its cells
 //   split(c):    unless c is split: c.split := kRefineSplit; split each coarser cell touching
 //                c (grading)
-//   mark(x, m):  unless x is split: x.split := m, a leaf's mark (low two bits 0), read by the
-//                walk that makes x's simplices
+//   mark(c, m):  unless c is split: c.split := m, a leaf's mark (low two bits 0), read by the
+//                walk that makes c's simplices
 // Why it is stable and order independent: the postprocess writes land only on cells T* left
 // unsplit and never set the T* bit, so a descent sees T* whatever the order of the points;
 // T' is the least closure of the seeds, a set, so the order in which points add to it changes
@@ -36,32 +36,32 @@ template <std::size_t d, class Program>
 struct PointPlacement {
   using Node = PNode<d>;
 
-  static void place(sac::Engine& r, Node* n, Program* cx) {
+  static void place(sac::Engine& rt, Node* n, Program* program) {
     if (!n) return;
-    r.memo(sac::fn<&descend>(cx, n, 0));
-    r.memo_read(n->next, sac::fn<&place>(cx));
+    rt.memo(sac::fn<&descend>(program, n, 0));
+    rt.memo_read(n->next, sac::fn<&place>(program));
   }
 
-  static void descend(sac::Engine& r, Program* cx, Node* n, int l) {
-    if (l >= kMaxLevel) return Program::settle(r, cx, n, kMaxLevel);
-    r.read(cx->slot(r, cell_of(n->q, l)).split, [cx, n, l](sac::Engine& e, std::uint8_t v) {
-      if (tree_split(v)) descend(e, cx, n, l + 1);
-      else Program::settle(e, cx, n, l);
+  static void descend(sac::Engine& rt, Program* program, Node* n, int l) {
+    if (l >= kMaxLevel) return Program::settle(rt, program, n, kMaxLevel);
+    rt.read(program->slot(rt, cell_of(n->q, l)).split, [program, n, l](sac::Engine& rt2, std::uint8_t v) {
+      if (tree_split(v)) descend(rt2, program, n, l + 1);
+      else Program::settle(rt2, program, n, l);
     });
   }
 
-  static void split(sac::Engine& r, Program* cx, const CellId<d>& c) {
-    r.read(cx->slot(r, c).split, [cx, c](sac::Engine& e, std::uint8_t v) {
+  static void split(sac::Engine& rt, Program* program, const CellId<d>& c) {
+    rt.read(program->slot(rt, c).split, [program, c](sac::Engine& rt2, std::uint8_t v) {
       if (any_split(v)) return;
-      e.write(cx->slot(e, c).split, kRefineSplit);
-      if (c.level > 0) for_each_coarser_touching(c, [&](const CellId<d>& u) { split(e, cx, u); });
+      rt2.write(program->slot(rt2, c).split, kRefineSplit);
+      if (c.level > 0) for_each_coarser_touching(c, [&](const CellId<d>& u) { split(rt2, program, u); });
     });
   }
 
-  static void mark(sac::Engine& r, Program* cx, const CellId<d>& x, std::uint8_t value) {
-    r.read(cx->slot(r, x).split, [cx, x, value](sac::Engine& e, std::uint8_t v) {
+  static void mark(sac::Engine& rt, Program* program, const CellId<d>& c, std::uint8_t value) {
+    rt.read(program->slot(rt, c).split, [program, c, value](sac::Engine& rt2, std::uint8_t v) {
       // A split value here would break the closure's rule; the checkers report it.
-      if (!any_split(v)) e.write(cx->slot(e, x).split, value);
+      if (!any_split(v)) rt2.write(program->slot(rt2, c).split, value);
     });
   }
 };

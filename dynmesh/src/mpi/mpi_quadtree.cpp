@@ -138,17 +138,17 @@ struct MpiState {
     std::int64_t block = 1;
     for (std::size_t a = 0; a < d; ++a) block *= side;
     for (std::int64_t code = 0; code < block; ++code) {
-      CellId<d> x;
-      x.level = l0;
+      CellId<d> ring_cell;
+      ring_cell.level = l0;
       bool inside = true;
       std::int64_t rest = code;
       for (std::size_t a = 0; a < d; ++a) {
         const std::int64_t i = static_cast<std::int64_t>(c.index[a]) + rest % side - w;
         rest /= side;
         inside = inside && i >= 0 && i < n;
-        x.index[a] = static_cast<std::uint64_t>(i);
+        ring_cell.index[a] = static_cast<std::uint64_t>(i);
       }
-      if (inside) f(morton(x));
+      if (inside) f(morton(ring_cell));
     }
   }
 
@@ -156,7 +156,7 @@ struct MpiState {
   /// into `out` (reused by the caller: no allocation per edit once it has grown).
   void holders(std::uint64_t m, std::vector<int>& out) const {
     out.clear();
-    for_each_in_ring(m, options.ghost_ring, [&](std::uint64_t x) { out.push_back(owner(x)); });
+    for_each_in_ring(m, options.ghost_ring, [&](std::uint64_t near) { out.push_back(owner(near)); });
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
   }
@@ -173,14 +173,14 @@ struct MpiState {
       starts[r] = m;
     }
     role.assign(nroots, 0);
-    for (std::uint64_t x = starts[rank]; x < starts[rank + 1]; ++x) {
-      role[x] = 1;
-      for_each_in_ring(x, options.ghost_ring, [&](std::uint64_t y) {
-        if (role[y] == 0) role[y] = 2;
+    for (std::uint64_t own = starts[rank]; own < starts[rank + 1]; ++own) {
+      role[own] = 1;
+      for_each_in_ring(own, options.ghost_ring, [&](std::uint64_t near) {
+        if (role[near] == 0) role[near] = 2;
       });
     }
     // A cell met before its own turn came was marked ghost: owned ones win.
-    for (std::uint64_t x = starts[rank]; x < starts[rank + 1]; ++x) role[x] = 1;
+    for (std::uint64_t own = starts[rank]; own < starts[rank + 1]; ++own) role[own] = 1;
   }
 
   /// Builds this rank's tree on the routed points; errors name global indices.
@@ -486,8 +486,8 @@ void MpiQuadtree<d>::apply(std::span<const Edit<d>> edits) {
   std::vector<std::uint64_t> touched;
   for (const Routed<d>& r : in) {
     const std::uint64_t m = s.root_of(dynmesh::locate(s.box, r.point));
-    s.for_each_in_ring(m, 1, [&](std::uint64_t x) {
-      if (s.owns(x)) touched.push_back(x);
+    s.for_each_in_ring(m, 1, [&](std::uint64_t near) {
+      if (s.owns(near)) touched.push_back(near);
     });
   }
   std::sort(touched.begin(), touched.end());

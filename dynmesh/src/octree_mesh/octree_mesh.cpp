@@ -55,9 +55,9 @@ OctreeMesh::OctreeMesh(const Box<3>& box, std::span<const Point<3>> points)
   };
   CellTable<3, Mark> marks(qs.size() * 8);
   for (std::size_t i = 0; i < qs.size(); ++i)
-    detail::for_each_block_cell(targets[i], [&](const CellId<3>& x, std::uint8_t v) {
-      if (!marks.try_emplace(x, Mark{v, static_cast<std::uint32_t>(i)}).second)
-        throw InvariantError("dynmesh: cell " + to_string(x) + " lies in two points' blocks");
+    detail::for_each_block_cell(targets[i], [&](const CellId<3>& cell, std::uint8_t v) {
+      if (!marks.try_emplace(cell, Mark{v, static_cast<std::uint32_t>(i)}).second)
+        throw InvariantError("dynmesh: cell " + to_string(cell) + " lies in two points' blocks");
     });
 
   auto is_split = [&](const CellId<3>& c) { return split.contains(c); };
@@ -109,11 +109,11 @@ void require_refined_tree(std::span<const Leaf<3>> leaves, std::span<const Posit
     unsigned corner = 0;
     if (t < kMaxLevel)
       for (unsigned a = 0; a < 3; ++a) corner |= static_cast<unsigned>((q[a] >> (kMaxLevel - t - 1)) & 1u) << a;
-    detail::for_each_block_cell(detail::BlockTarget{owner, corner}, [&](const CellId<3>& x, std::uint8_t mark) {
-      const std::uint32_t* k = leaf_set.find(x);
-      if (!k) throw InvariantError("dynmesh: block cell " + to_string(x) + " of point leaf " + to_string(owner) + " is not a leaf");
+    detail::for_each_block_cell(detail::BlockTarget{owner, corner}, [&](const CellId<3>& cell, std::uint8_t mark) {
+      const std::uint32_t* k = leaf_set.find(cell);
+      if (!k) throw InvariantError("dynmesh: block cell " + to_string(cell) + " of point leaf " + to_string(owner) + " is not a leaf");
       if (!detail::is_block_owner(mark) && *k != 0)
-        throw InvariantError("dynmesh: block cell " + to_string(x) + " of point leaf " + to_string(owner) + " holds a point");
+        throw InvariantError("dynmesh: block cell " + to_string(cell) + " of point leaf " + to_string(owner) + " holds a point");
     });
   }
 }

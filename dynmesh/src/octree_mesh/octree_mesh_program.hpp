@@ -108,12 +108,12 @@ constexpr std::uint8_t kid(std::uint64_t kids, unsigned w) noexcept {
 inline OctreeGroupShape group_shape(const CellId<3>& c, const std::array<std::uint64_t, 27>& near,
                                     const Point<3>& point) {
   // Is the level-(c.level + 1) cell x split? Its parent is c or one of c's neighbours.
-  auto split = [&](const CellId<3>& x) {
-    const CellId<3> p = parent(x);
+  auto split = [&](const CellId<3>& cell) {
+    const CellId<3> p = parent(cell);
     int off[3];
     for (unsigned a = 0; a < 3; ++a) off[a] = static_cast<int>(p.index[a] - c.index[a]);
     unsigned w = 0;
-    for (unsigned a = 0; a < 3; ++a) w |= static_cast<unsigned>(x.index[a] & 1u) << a;
+    for (unsigned a = 0; a < 3; ++a) w |= static_cast<unsigned>(cell.index[a] & 1u) << a;
     return any_split(kid(near[leaf_bit(off[0], off[1], off[2])], w));
   };
   OctreeGroupShape s;
@@ -147,64 +147,64 @@ struct OctreeMeshProgram {
 
   using Placement = PointPlacement<3, OctreeMeshProgram>;
 
-  Slot<3>& slot(sac::Engine& r, const CellId<3>& c) { return dir->get(r, c); }
+  Slot<3>& slot(sac::Engine& rt, const CellId<3>& c) { return dir->get(rt, c); }
   const OctreeGrid& grid() const { return log->grid; }
 
-  static void main(sac::Engine& r, OctreeMeshProgram* cx) {
-    r.memo_read(*cx->input, sac::fn<&Placement::place>(cx));
-    r.memo(sac::fn<&gather_root>(cx));
-    r.memo(sac::fn<&emit_root>(cx));
+  static void main(sac::Engine& rt, OctreeMeshProgram* program) {
+    rt.memo_read(*program->input, sac::fn<&Placement::place>(program));
+    rt.memo(sac::fn<&gather_root>(program));
+    rt.memo(sac::fn<&emit_root>(program));
   }
 
   // ------------------------------------------------------------------ the points
-  static void settle(sac::Engine& r, OctreeMeshProgram* cx, Node* n, int tree_level) {
+  static void settle(sac::Engine& rt, OctreeMeshProgram* program, Node* n, int tree_level) {
     const auto* in = static_cast<const InputNode<3>*>(n);
-    const BlockTarget t = block_target(cx->grid(), n->q, in->point, tree_level);
-    for_each_block_parent(t, [&](const CellId<3>& u) { Placement::split(r, cx, u); });
-    for_each_block_cell(t, [&](const CellId<3>& x, std::uint8_t mark) { Placement::mark(r, cx, x, mark); });
-    r.write(cx->slot(r, t.owner).pts, n);
+    const BlockTarget t = block_target(program->grid(), n->q, in->point, tree_level);
+    for_each_block_parent(t, [&](const CellId<3>& u) { Placement::split(rt, program, u); });
+    for_each_block_cell(t, [&](const CellId<3>& cell, std::uint8_t mark) { Placement::mark(rt, program, cell, mark); });
+    rt.write(program->slot(rt, t.owner).pts, n);
   }
 
   // ------------------------------------------------------------------ first walk: the kids
-  static void gather_root(sac::Engine& r, OctreeMeshProgram* cx) {
-    r.read(cx->slot(r, CellId<3>::root()).split, [cx](sac::Engine& e, std::uint8_t v) {
-      if (any_split(v)) e.memo(sac::fn<&gather>(cx, CellId<3>::root()));
+  static void gather_root(sac::Engine& rt, OctreeMeshProgram* program) {
+    rt.read(program->slot(rt, CellId<3>::root()).split, [program](sac::Engine& rt2, std::uint8_t v) {
+      if (any_split(v)) rt2.memo(sac::fn<&gather>(program, CellId<3>::root()));
     });
   }
 
-  static void gather(sac::Engine& r, OctreeMeshProgram* cx, CellId<3> c) {
+  static void gather(sac::Engine& rt, OctreeMeshProgram* program, CellId<3> c) {
     std::array<const sac::Mod<std::uint8_t>*, 8> kids;
-    for (unsigned w = 0; w < 8; ++w) kids[w] = &cx->slot(r, child(c, w)).split;
-    r.read_many(std::span<const sac::Mod<std::uint8_t>* const>(kids), [cx, c](sac::Engine& e, std::span<const std::uint8_t* const> v) {
+    for (unsigned w = 0; w < 8; ++w) kids[w] = &program->slot(rt, child(c, w)).split;
+    rt.read_many(std::span<const sac::Mod<std::uint8_t>* const>(kids), [program, c](sac::Engine& rt2, std::span<const std::uint8_t* const> v) {
       std::uint64_t word = 0;
       for (unsigned w = 0; w < 8; ++w) word |= std::uint64_t{*v[w]} << (8 * w);
-      e.write(cx->slot(e, c).kids, word);
+      rt2.write(program->slot(rt2, c).kids, word);
       for (unsigned w = 0; w < 8; ++w)
-        if (any_split(*v[w])) e.memo(sac::fn<&gather>(cx, child(c, w)));
+        if (any_split(*v[w])) rt2.memo(sac::fn<&gather>(program, child(c, w)));
     });
   }
 
   // ------------------------------------------------------------------ second walk: the blocks
-  static void emit_root(sac::Engine& r, OctreeMeshProgram* cx) {
-    r.read(cx->slot(r, CellId<3>::root()).split, [cx](sac::Engine& e, std::uint8_t v) {
+  static void emit_root(sac::Engine& rt, OctreeMeshProgram* program) {
+    rt.read(program->slot(rt, CellId<3>::root()).split, [program](sac::Engine& rt2, std::uint8_t v) {
       if (any_split(v)) {
-        e.memo(sac::fn<&emit>(cx, CellId<3>::root()));
+        rt2.memo(sac::fn<&emit>(program, CellId<3>::root()));
       } else {
         OctreeGroupShape s;
         s.root_leaf = true;
-        e.make<OctreeBlock>(cx->log, s);
+        rt2.make<OctreeBlock>(program->log, s);
       }
     });
   }
 
-  static void emit(sac::Engine& r, OctreeMeshProgram* cx, CellId<3> c) {
-    r.read(cx->slot(r, c).kids, [cx, c](sac::Engine& e, std::uint64_t own) {
+  static void emit(sac::Engine& rt, OctreeMeshProgram* program, CellId<3> c) {
+    rt.read(program->slot(rt, c).kids, [program, c](sac::Engine& rt2, std::uint64_t own) {
       bool leaves = false;
       for (unsigned w = 0; w < 8; ++w) {
-        if (any_split(kid(own, w))) e.memo(sac::fn<&emit>(cx, child(c, w)));
+        if (any_split(kid(own, w))) rt2.memo(sac::fn<&emit>(program, child(c, w)));
         else leaves = true;
       }
-      if (leaves) group(e, cx, c, own);
+      if (leaves) group(rt2, program, c, own);
     });
   }
 
@@ -217,14 +217,14 @@ struct OctreeMeshProgram {
     std::array<std::uint8_t, 26> bit{};
     unsigned n = 0;
   };
-  static Near near_of(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c, bool corners) {
+  static Near near_of(sac::Engine& rt, OctreeMeshProgram* program, const CellId<3>& c, bool corners) {
     Near out;
     for_each_neighbour(c, [&](const CellId<3>& nb) {
       int off[3];
       for (unsigned a = 0; a < 3; ++a) off[a] = static_cast<int>(nb.index[a] - c.index[a]);
       if (!corners && off[0] != 0 && off[1] != 0 && off[2] != 0) return;
       out.bit[out.n] = static_cast<std::uint8_t>(leaf_bit(off[0], off[1], off[2]));
-      out.mods[out.n++] = &cx->slot(r, nb).kids;
+      out.mods[out.n++] = &program->slot(rt, nb).kids;
     });
     return out;
   }
@@ -235,37 +235,37 @@ struct OctreeMeshProgram {
   }
 
   /// Two events of at most 13 (Engine::read_many reads 16 at most).
-  static void group(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c, std::uint64_t own) {
-    const Near nb = near_of(r, cx, c, has_owner(own));
-    if (nb.n == 0) return finish(r, cx, c, own, nb);  // the root has no neighbours
+  static void group(sac::Engine& rt, OctreeMeshProgram* program, const CellId<3>& c, std::uint64_t own) {
+    const Near nb = near_of(rt, program, c, has_owner(own));
+    if (nb.n == 0) return finish(rt, program, c, own, nb);  // the root has no neighbours
     const unsigned first = (nb.n + 1) / 2;
-    r.read_many(std::span<const Kids* const>(nb.mods.data(), first),
-                [cx, c, own](sac::Engine& e, std::span<const std::uint64_t* const>) {
-                  const Near all = near_of(e, cx, c, has_owner(own));
-                  const unsigned half = (all.n + 1) / 2;
-                  if (all.n == half) return finish(e, cx, c, own, all);
-                  e.read_many(std::span<const Kids* const>(all.mods.data() + half, all.n - half),
-                              [cx, c, own](sac::Engine& e2, std::span<const std::uint64_t* const>) {
-                                finish(e2, cx, c, own, near_of(e2, cx, c, has_owner(own)));
-                              });
-                });
+    rt.read_many(std::span<const Kids* const>(nb.mods.data(), first),
+                 [program, c, own](sac::Engine& rt2, std::span<const std::uint64_t* const>) {
+                   const Near all = near_of(rt2, program, c, has_owner(own));
+                   const unsigned half = (all.n + 1) / 2;
+                   if (all.n == half) return finish(rt2, program, c, own, all);
+                   rt2.read_many(std::span<const Kids* const>(all.mods.data() + half, all.n - half),
+                                 [program, c, own](sac::Engine& rt3, std::span<const std::uint64_t* const>) {
+                                   finish(rt3, program, c, own, near_of(rt3, program, c, has_owner(own)));
+                                 });
+                 });
   }
 
   /// Every neighbour's kids has been read by an enclosing event of this body: current().
-  static void finish(sac::Engine& r, OctreeMeshProgram* cx, const CellId<3>& c, std::uint64_t own, const Near& nb) {
+  static void finish(sac::Engine& rt, OctreeMeshProgram* program, const CellId<3>& c, std::uint64_t own, const Near& nb) {
     std::array<std::uint64_t, 27> near{};
     near[leaf_bit(0, 0, 0)] = own;
-    for (unsigned i = 0; i < nb.n; ++i) near[nb.bit[i]] = r.current(*nb.mods[i]);
+    for (unsigned i = 0; i < nb.n; ++i) near[nb.bit[i]] = rt.current(*nb.mods[i]);
     int owner = -1;
     for (unsigned w = 0; w < 8; ++w)
       if (is_block_owner(kid(own, w))) owner = static_cast<int>(w);
     if (owner < 0) {
-      r.make<OctreeBlock>(cx->log, group_shape(c, near, Point<3>{}));
+      rt.make<OctreeBlock>(program->log, group_shape(c, near, Point<3>{}));
       return;
     }
-    r.read(cx->slot(r, child(c, static_cast<unsigned>(owner))).pts, [cx, c, near](sac::Engine& e, Node* p) {
+    rt.read(program->slot(rt, child(c, static_cast<unsigned>(owner))).pts, [program, c, near](sac::Engine& rt2, Node* p) {
       if (!p) throw InvariantError("dynmesh: a block owner without its point");
-      e.make<OctreeBlock>(cx->log, group_shape(c, near, static_cast<const InputNode<3>*>(p)->point));
+      rt2.make<OctreeBlock>(program->log, group_shape(c, near, static_cast<const InputNode<3>*>(p)->point));
     });
   }
 };

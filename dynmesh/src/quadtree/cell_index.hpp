@@ -5,7 +5,7 @@
 // key and a pointer (8·d + 8 in a CellTable<d, T*>), and the key is not held twice. An
 // entry's top 16 bits, which no user-space pointer uses on x86-64 or AArch64, hold a tag
 // hashed from its key, so probing reads an object only when the tag matches; that lets the
-// table fill to 3/4 (at 1/2 the 3D directory's table was 10% of the trace). Linear probing,
+// table fill to 3/4 (a sparser table is a visible part of the trace). Linear probing,
 // power-of-two capacity, backward-shift deletion, CellTable's locality-preserving home slots
 // (cell_home).
 // Invariants (check_invariants()): every entry is found by probing from its own key's home

@@ -163,7 +163,7 @@ std::vector<Leaf<d>> DynamicQuadtree<d>::leaves_in(const CellId<d>& c) const {
   std::vector<Leaf<d>> out;
   if (!valid(c) || !(s_->is_split(c) || s_->is_leaf(c))) return out;  // inside a leaf
   s_->for_each_leaf(
-      [&](const CellId<d>& x, const detail::PNode<d>* p) { out.push_back(Leaf<d>{x, detail::count_points(p)}); }, c);
+      [&](const CellId<d>& cell, const detail::PNode<d>* p) { out.push_back(Leaf<d>{cell, detail::count_points(p)}); }, c);
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -200,7 +200,7 @@ std::vector<CellId<d>> DynamicQuadtree<d>::neighbours(const CellId<d>& leaf) con
   if (!s.is_leaf(leaf)) throw std::invalid_argument("neighbours: " + to_string(leaf) + " is not a leaf");
   std::vector<CellId<d>> out, stack;
   detail::for_each_touching_leaf<d>(
-      leaf, [&](const CellId<d>& x) { return s.is_split(x); }, [](const CellId<d>&) { return true; },
+      leaf, [&](const CellId<d>& cell) { return s.is_split(cell); }, [](const CellId<d>&) { return true; },
       [&](const CellId<d>& l) { out.push_back(l); },
       [&](const CellId<d>& l, const CellId<d>&) { out.push_back(l); }, stack);
   std::sort(out.begin(), out.end());

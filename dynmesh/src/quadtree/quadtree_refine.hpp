@@ -130,8 +130,8 @@ struct QKey {
   bool operator==(const QKey&) const = default;
   std::size_t hash() const noexcept {
     std::uint64_t h = k[0];
-    for (std::size_t a = 1; a < d; ++a) h = mix64(h) ^ k[a];
-    return static_cast<std::size_t>(mix64(h));
+    for (std::size_t a = 1; a < d; ++a) h = sac::mix64(h) ^ k[a];
+    return static_cast<std::size_t>(sac::mix64(h));
   }
 };
 
@@ -163,7 +163,7 @@ struct Refine {
   Dir* dir;
   List* input;  // the root's list: the input points
 
-  Slot<d>& slot(sac::Engine& r, const CellId<d>& c) { return dir->get(r, c); }
+  Slot<d>& slot(sac::Engine& rt, const CellId<d>& c) { return dir->get(rt, c); }
 
   /// Where SPLIT sends each child's points.
   struct Dests {
@@ -186,66 +186,66 @@ struct Refine {
 
   /// The program's context (Engine::set_context, which the owner calls before run()):
   /// closures do not carry it.
-  static Refine* ctx(sac::Engine& r) { return r.context<Refine>(); }
+  static Refine* ctx(sac::Engine& rt) { return rt.context<Refine>(); }
 
-  static void main(sac::Engine& r) {
-    Refine* cx = ctx(r);
+  static void main(sac::Engine& rt) {
+    Refine* program = ctx(rt);
     // The root is crowded when it holds two points (its neighbourhood is itself).
-    Crowded* c0 = r.alloc<Crowded>(0);
-    r.read(*cx->input, [c0](sac::Engine& x, Node* a) {
-      if (!a) return x.write(*c0, nullptr);
-      x.read(a->next, [c0](sac::Engine& y, Node* b) {
-        if (!b) return y.write(*c0, nullptr);
+    Crowded* c0 = rt.alloc<Crowded>(0);
+    rt.read(*program->input, [c0](sac::Engine& rt2, Node* a) {
+      if (!a) return rt2.write(*c0, nullptr);
+      rt2.read(a->next, [c0](sac::Engine& rt3, Node* b) {
+        if (!b) return rt3.write(*c0, nullptr);
         const QKey<d> key(CellId<d>::root(), true);
-        QNode<d>* root = y.alloc<QNode<d>>(key, key);
-        y.write(root->next, nullptr);
-        y.write(*c0, root);
+        QNode<d>* root = rt3.alloc<QNode<d>>(key, key);
+        rt3.write(root->next, nullptr);
+        rt3.write(*c0, root);
       });
     });
-    r.memo(sac::fn<&refine>(0, c0));
+    rt.memo(sac::fn<&refine>(0, c0));
   }
 
   /// The crowded round of class l (with the grading splits it causes), then class l+1.
-  static void refine(sac::Engine& r, int l, Crowded* cl) {
-    r.read(*cl, [l, cl](sac::Engine& x, QNode<d>* head) {
+  static void refine(sac::Engine& rt, int l, Crowded* cl) {
+    rt.read(*cl, [l, cl](sac::Engine& rt2, QNode<d>* head) {
       if (!head) return;  // no crowded cell left: the tree is done
-      Crowded* next = x.alloc<Crowded>(l + 1);
-      x.memo_read(*cl, sac::fn<&split_crowded>());
-      x.memo_read(*cl, sac::fn<&classify>(next));
-      x.memo(sac::fn<&refine>(l + 1, next));
+      Crowded* next = rt2.alloc<Crowded>(l + 1);
+      rt2.memo_read(*cl, sac::fn<&split_crowded>());
+      rt2.memo_read(*cl, sac::fn<&classify>(next));
+      rt2.memo(sac::fn<&refine>(l + 1, next));
     });
   }
 
   /// Step of the first walk over C_l: SPLIT the entry's cell, then the grading splits that
   /// it forces.
-  static void split_crowded(sac::Engine& r, QNode<d>* e) {
+  static void split_crowded(sac::Engine& rt, QNode<d>* e) {
     if (!e) return;
-    Refine* cx = ctx(r);
+    Refine* program = ctx(rt);
     const CellId<d> c = e->cell();
-    split(r, cx, c, c);
-    regrade(r, cx, c);
-    r.memo_read(e->next, sac::fn<&split_crowded>());
+    split(rt, program, c, c);
+    regrade(rt, program, c);
+    rt.memo_read(e->next, sac::fn<&split_crowded>());
   }
 
   /// After c split, every leaf one class larger that touches c is ill-graded: split it (c
   /// witnesses it) and, in turn, what that split forces. A leaf that an earlier witness
   /// already split is skipped. c's parent, the first cell touching c, is split (c is a
   /// cell of the tree), so it is not read.
-  static void regrade(sac::Engine& r, Refine* cx, const CellId<d>& c) {
+  static void regrade(sac::Engine& rt, Refine* program, const CellId<d>& c) {
     if (c.level == 0) return;
     // The closure holds c packed, with the mask that names u from c in spare index bits
-    // (8·d bytes, not 2·8·d): there are 11 (2D) to 31 (3D) of these reads per point.
+    // (8·d bytes, not 2·8·d): every point makes many of these reads.
     CellId<d> u;
     for (unsigned mask = 1; mask < static_cast<unsigned>(kChildren<d>); ++mask)
       if (coarser_touching_at(c, mask, u))
-        r.read(cx->slot(r, u).split, [pm = pack_with_mask(c, mask)](sac::Engine& x, std::uint8_t s) {
+        rt.read(program->slot(rt, u).split, [packed = pack_with_mask(c, mask)](sac::Engine& rt2, std::uint8_t s) {
           if (s) return;
-          unsigned mk;
-          const CellId<d> cc = unpack_with_mask(pm, mk);
-          CellId<d> uc;
-          coarser_touching_at(cc, mk, uc);
-          split(x, ctx(x), uc, cc);
-          regrade(x, ctx(x), uc);
+          unsigned which;
+          const CellId<d> witness = unpack_with_mask(packed, which);
+          CellId<d> coarser;
+          coarser_touching_at(witness, which, coarser);
+          split(rt2, ctx(rt2), coarser, witness);
+          regrade(rt2, ctx(rt2), coarser);
         });
   }
 
@@ -268,14 +268,14 @@ struct Refine {
   /// itself for a crowded cell) is part of the memo key: when a grading split moves to an
   /// earlier witness, matching the old partition far ahead in the trace would discard all
   /// the trace in between (a memo hit undoes everything up to the entry it reuses).
-  static void split(sac::Engine& r, Refine* cx, const CellId<d>& c, const CellId<d>& witness) {
-    Slot<d>& cell = cx->slot(r, c);
-    r.write(cell.split, kTreeSplit);
+  static void split(sac::Engine& rt, Refine* program, const CellId<d>& c, const CellId<d>& witness) {
+    Slot<d>& cell = program->slot(rt, c);
+    rt.write(cell.split, kTreeSplit);
     Dests to;
     for (unsigned w = 0; w < static_cast<unsigned>(kChildren<d>); ++w)
-      to.to[w] = &cx->slot(r, child(c, w)).pts;
-    List& points = c.level == 0 ? *cx->input : cell.pts;
-    r.memo_read(points, sac::fn<&partition>(partition_key(witness, c.level + 1), to));
+      to.to[w] = &program->slot(rt, child(c, w)).pts;
+    List& points = c.level == 0 ? *program->input : cell.pts;
+    rt.memo_read(points, sac::fn<&partition>(partition_key(witness, c.level + 1), to));
   }
 
   /// A partition step's memo key besides its list cell and destinations: the child level
@@ -289,19 +289,18 @@ struct Refine {
   static int key_level(std::uint64_t key) { return static_cast<int>(key & 63u); }
 
   /// One step of the partition (`key`: partition_key()).
-  static void partition(sac::Engine& r, Node* p, std::uint64_t key, Dests to) {
+  static void partition(sac::Engine& rt, Node* p, std::uint64_t key, Dests to) {
     // The lists end without a write: every destination is a slot's `pts` or a node's
     // `next`, written at most once in a consistent trace and defaulting to null
     // (Engine::init_default), so "null from here on" is what the default already says. A
-    // read that sees the default gets a base version then. The 2^d end-of-list writes were
-    // 45% of the 2D versions and 69% of the 3D ones; a third (2D) and half (3D) of them were
-    // never read.
+    // read that sees the default gets a base version then. Writing the 2^d list ends would
+    // make most of the versions, and many of them would never be read.
     if (!p) return;
     const unsigned w = child_code(p->q, key_level(key));
-    Node* copy = ctx(r)->dir->below(r, p);
-    r.write(*to.to[w], copy);
+    Node* copy = ctx(rt)->dir->below(rt, p);
+    rt.write(*to.to[w], copy);
     to.to[w] = &copy->next;
-    r.memo_read(p->next, sac::fn<&partition>(key, to));
+    rt.memo_read(p->next, sac::fn<&partition>(key, to));
   }
 
   /// Step of the second walk over C_l, after all its splits: queue the crowded children of
@@ -317,14 +316,14 @@ struct Refine {
   ///   * c holds one point: only the child holding it can be crowded, and its siblings are
   ///     empty, so only the rest of N(k) is scanned.
   /// So no test scans a neighbourhood to learn what its parent's entry already says.
-  static void classify(sac::Engine& r, QNode<d>* e, Crowded* out) {
-    if (!e) return r.write(*out, nullptr);
-    if (e->two()) test_child(r, ctx(r), e, 0, out);
-    else test_lone(r, ctx(r), e, out);
+  static void classify(sac::Engine& rt, QNode<d>* e, Crowded* out) {
+    if (!e) return rt.write(*out, nullptr);
+    if (e->two()) test_child(rt, ctx(rt), e, 0, out);
+    else test_lone(rt, ctx(rt), e, out);
   }
   /// The walk's next step, once e's children are tested.
-  static void next_entry(sac::Engine& r, QNode<d>* e, Crowded* out) {
-    r.memo_read(e->next, sac::fn<&classify>(out));
+  static void next_entry(sac::Engine& rt, QNode<d>* e, Crowded* out) {
+    rt.memo_read(e->next, sac::fn<&classify>(out));
   }
 
   /// An entry with the child number and scan position of a test, in one word: a crowding
@@ -345,24 +344,24 @@ struct Refine {
 
   /// The tests of e's children (e->two()), one after another: each continues with the
   /// queue's new tail.
-  static void test_child(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, Crowded* out) {
-    if (w == static_cast<unsigned>(kChildren<d>)) return next_entry(r, e, out);
-    r.read(cx->slot(r, child(e->cell(), w)).pts, [at = At(e, w), out](sac::Engine& x, Node* a) {
-      if (!a) return test_child(x, ctx(x), at.e(), at.w() + 1, out);  // empty: not crowded
-      x.read(a->next, [at, out](sac::Engine& y, Node* b) {
-        queue_crowded(y, ctx(y), at.e(), at.w(), b != nullptr, out);
+  static void test_child(sac::Engine& rt, Refine* program, QNode<d>* e, unsigned w, Crowded* out) {
+    if (w == static_cast<unsigned>(kChildren<d>)) return next_entry(rt, e, out);
+    rt.read(program->slot(rt, child(e->cell(), w)).pts, [at = At(e, w), out](sac::Engine& rt2, Node* a) {
+      if (!a) return test_child(rt2, ctx(rt2), at.e(), at.w() + 1, out);  // empty: not crowded
+      rt2.read(a->next, [at, out](sac::Engine& rt3, Node* b) {
+        queue_crowded(rt3, ctx(rt3), at.e(), at.w(), b != nullptr, out);
       });
     });
   }
 
   /// e's cell holds one point (!e->two(); never the root): the child holding it is crowded
   /// when a cell of its neighbourhood outside the parent holds a point.
-  static void test_lone(sac::Engine& r, Refine* cx, QNode<d>* e, Crowded* out) {
-    r.read(cx->slot(r, e->cell()).pts, [e, out](sac::Engine& x, Node* p) {
+  static void test_lone(sac::Engine& rt, Refine* program, QNode<d>* e, Crowded* out) {
+    rt.read(program->slot(rt, e->cell()).pts, [e, out](sac::Engine& rt2, Node* p) {
       // Null only while an update is half propagated: the entry's own test re-runs first.
-      if (!p) return next_entry(x, e, out);
+      if (!p) return next_entry(rt2, e, out);
       const unsigned w = child_code(p->q, e->cell().level + 1);
-      scan_neighbourhood(x, ctx(x), e, w, kChildren<d> - 1, out);  // siblings are empty
+      scan_neighbourhood(rt2, ctx(rt2), e, w, kChildren<d> - 1, out);  // siblings are empty
     });
   }
 
@@ -407,27 +406,27 @@ struct Refine {
     return true;
   }
 
-  static void scan_neighbourhood(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, int i,
+  static void scan_neighbourhood(sac::Engine& rt, Refine* program, QNode<d>* e, unsigned w, int i,
                                  Crowded* out) {
     const CellId<d> k = child(e->cell(), w);
     CellId<d> nb;
     while (i < kAround && !offset_cell(k, kScanOrder[w][static_cast<std::size_t>(i)], nb)) ++i;
-    if (i >= kAround) return next_entry(r, e, out);
-    r.read(cx->slot(r, nb).pts, [at = At(e, w, i), out](sac::Engine& x, Node* p) {
-      if (p) return queue_crowded(x, ctx(x), at.e(), at.w(), false, out);
-      scan_neighbourhood(x, ctx(x), at.e(), at.w(), at.i() + 1, out);
+    if (i >= kAround) return next_entry(rt, e, out);
+    rt.read(program->slot(rt, nb).pts, [at = At(e, w, i), out](sac::Engine& rt2, Node* p) {
+      if (p) return queue_crowded(rt2, ctx(rt2), at.e(), at.w(), false, out);
+      scan_neighbourhood(rt2, ctx(rt2), at.e(), at.w(), at.i() + 1, out);
     });
   }
 
   /// Queues child w of e's cell, holding two or more points (`two`) or one; then the rest
   /// of e's children (none after a lone point's child).
-  static void queue_crowded(sac::Engine& r, Refine* cx, QNode<d>* e, unsigned w, bool two, Crowded* out) {
+  static void queue_crowded(sac::Engine& rt, Refine* program, QNode<d>* e, unsigned w, bool two, Crowded* out) {
     const CellId<d> k = child(e->cell(), w);
     const QKey<d> key(k, two);
-    QNode<d>* q = r.alloc<QNode<d>>(key, key);
-    r.write(*out, q);
-    if (e->two()) test_child(r, cx, e, w + 1, &q->next);
-    else next_entry(r, e, &q->next);
+    QNode<d>* q = rt.alloc<QNode<d>>(key, key);
+    rt.write(*out, q);
+    if (e->two()) test_child(rt, program, e, w + 1, &q->next);
+    else next_entry(rt, e, &q->next);
   }
 };
 

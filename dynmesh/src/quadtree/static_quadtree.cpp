@@ -9,6 +9,7 @@
 #include <bit>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -42,12 +43,12 @@ std::string position_string(const Position<d>& q) {
 template <std::size_t d>
 bool morton_less(const std::array<std::uint64_t, d>& a, const std::array<std::uint64_t, d>& b) noexcept {
   std::size_t best = 0;
-  std::uint64_t bx = a[0] ^ b[0];
+  std::uint64_t best_diff = a[0] ^ b[0];
   for (std::size_t k = 1; k < d; ++k) {
-    const std::uint64_t x = a[k] ^ b[k];
-    if (bx < x && bx < (bx ^ x)) {
+    const std::uint64_t diff = a[k] ^ b[k];
+    if (best_diff < diff && best_diff < (best_diff ^ diff)) {
       best = k;
-      bx = x;
+      best_diff = diff;
     }
   }
   return a[best] < b[best];
@@ -130,7 +131,7 @@ CellId<d> locate_in(const CellTable<d, V>& split, int max_split, const Position<
 /// The leaf (of the tree given by its split set) that contains the unsplit cell c.
 template <std::size_t d, class V>
 CellId<d> leaf_of(const CellTable<d, V>& split, const CellId<d>& c) {
-  return detail::leaf_containing<d>([&](const CellId<d>& x) { return split.contains(x); }, c);
+  return detail::leaf_containing<d>([&](const CellId<d>& cell) { return split.contains(cell); }, c);
 }
 
 /// The leaves touching leaf a, sorted, a excluded, into `out` (`stack` is scratch space).
@@ -139,7 +140,7 @@ void touching_leaves(const CellTable<d, V>& split, const CellId<d>& a, std::vect
                      std::vector<CellId<d>>& stack) {
   out.clear();
   detail::for_each_touching_leaf<d>(
-      a, [&](const CellId<d>& x) { return split.contains(x); }, [](const CellId<d>&) { return true; },
+      a, [&](const CellId<d>& cell) { return split.contains(cell); }, [](const CellId<d>&) { return true; },
       [&](const CellId<d>& leaf) { out.push_back(leaf); },
       [&](const CellId<d>& leaf, const CellId<d>&) { out.push_back(leaf); }, stack);
   std::sort(out.begin(), out.end());
@@ -355,7 +356,7 @@ template <std::size_t d>
   requires SupportedDim<d>
 std::size_t StaticQuadtree<d>::leaf_index(const CellId<d>& c) const {
   const auto it = std::lower_bound(leaves_.begin(), leaves_.end(), c,
-                                   [](const Leaf<d>& leaf, const CellId<d>& x) { return leaf.cell < x; });
+                                   [](const Leaf<d>& leaf, const CellId<d>& cell) { return leaf.cell < cell; });
   if (it == leaves_.end() || it->cell != c)
     throw std::invalid_argument("dynmesh: cell " + to_string<d>(c) + " is not a leaf of this tree");
   return static_cast<std::size_t>(it - leaves_.begin());
@@ -441,54 +442,243 @@ std::string CheckReport<d>::summary() const {
   return s;
 }
 
+namespace {
+
+/// One run of check_tree: the leaves and points under check, what the phases learn about
+/// them, and the report. Each phase reads what the ones before it built.
 template <std::size_t d>
-CheckReport<d> check_tree(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves,
-                          std::size_t max_violations) {
-  CheckReport<d> rep;
-  auto add = [&](ViolationKind kind, const CellId<d>& cell, const CellId<d>& other, std::string msg) {
-    if (rep.violations.size() < max_violations)
-      rep.violations.push_back(Violation<d>{kind, cell, other, std::move(msg)});
-    else
-      rep.truncated = true;
-  };
-  const std::size_t nl = leaves.size();
-  if (nl == 0) {
-    add(ViolationKind::Gap, CellId<d>::root(), CellId<d>::root(), "no leaves: the box is not covered");
-    return rep;
-  }
-  if (nl >= std::numeric_limits<std::uint32_t>::max()) throw std::length_error("check_tree: too many leaves");
+class TreeCheck {
+ public:
+  TreeCheck(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves, std::size_t max_violations)
+      : points_(points), leaves_(leaves), max_violations_(max_violations), nl_(leaves.size()) {}
 
-  // --- Tiling. -----------------------------------------------------------------------------
-  bool structural = true;
-  for (const Leaf<d>& leaf : leaves)
-    if (!valid(leaf.cell)) {
-      structural = false;
-      add(ViolationKind::BadCell, leaf.cell, leaf.cell, "leaf " + to_string<d>(leaf.cell) + " is not a cell of the box");
-    }
-  if (!structural) return rep;
+  CheckReport<d> report;
 
-  // order[k] = index of the k-th leaf in (level, i, j, k) order; the identity when the leaves
-  // come sorted, as every producer in this project delivers them.
-  std::vector<std::uint32_t> order(nl);
-  std::iota(order.begin(), order.end(), std::uint32_t{0});
-  bool sorted = true;
-  for (std::size_t i = 1; i < nl && sorted; ++i) sorted = leaves[i - 1].cell < leaves[i].cell;
-  if (!sorted) {
-    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-      return leaves[a].cell != leaves[b].cell ? leaves[a].cell < leaves[b].cell : a < b;
-    });
-    for (std::size_t k = 1; k < nl; ++k)
-      if (leaves[order[k - 1]].cell == leaves[order[k]].cell) {
-        structural = false;
-        add(ViolationKind::DuplicateLeaf, leaves[order[k]].cell, leaves[order[k]].cell,
-            "leaf " + to_string<d>(leaves[order[k]].cell) + " is listed more than once");
+  // --- Tiling. -------------------------------------------------------------------------------
+
+  /// Every leaf is a cell of the box (false: some is not, and it is reported).
+  bool leaves_are_cells() {
+    bool ok = true;
+    for (const Leaf<d>& leaf : leaves_)
+      if (!valid(leaf.cell)) {
+        ok = false;
+        add(ViolationKind::BadCell, leaf.cell, leaf.cell, "leaf " + to_string<d>(leaf.cell) + " is not a cell of the box");
       }
-    if (!structural) return rep;
+    return ok;
   }
-  auto cell_at = [&](std::size_t k) -> const CellId<d>& { return leaves[order[k]].cell; };
-  constexpr std::size_t kNotALeaf = std::numeric_limits<std::size_t>::max();
-  auto find_leaf = [&](const CellId<d>& c) {  // position in `order`, or kNotALeaf
-    std::size_t lo = 0, hi = nl;
+
+  /// order_[k] = index of the k-th leaf in (level, i, j, k) order; the identity when the
+  /// leaves come sorted, as every producer in this project delivers them. False: a leaf is
+  /// listed twice (reported).
+  bool order_leaves() {
+    order_.resize(nl_);
+    std::iota(order_.begin(), order_.end(), std::uint32_t{0});
+    bool sorted = true;
+    for (std::size_t i = 1; i < nl_ && sorted; ++i) sorted = leaves_[i - 1].cell < leaves_[i].cell;
+    if (sorted) return true;
+    std::sort(order_.begin(), order_.end(), [&](std::uint32_t a, std::uint32_t b) {
+      return leaves_[a].cell != leaves_[b].cell ? leaves_[a].cell < leaves_[b].cell : a < b;
+    });
+    bool distinct = true;
+    for (std::size_t k = 1; k < nl_; ++k)
+      if (cell_at(k - 1) == cell_at(k)) {
+        distinct = false;
+        add(ViolationKind::DuplicateLeaf, cell_at(k), cell_at(k), "leaf " + to_string<d>(cell_at(k)) + " is listed more than once");
+      }
+    return distinct;
+  }
+
+  /// S = the proper ancestors of the leaves, per level in a deterministic order. The value
+  /// of a split cell holds the mask of its children present in S ∪ L (bits 0..2^d−1) and
+  /// kForced, set by check_grading when a deeper split forces this one (rules 2 and 3).
+  void build_split_set() {
+    split_.reserve(nl_ / (kChildren<d> - 1) + 1);
+    split_by_level_.assign(kMaxLevel + 1, {});
+    for (std::size_t k = 0; k < nl_; ++k) {
+      const CellId<d>& c = cell_at(k);
+      // Siblings along the last axis are adjacent in the order: the previous iteration has
+      // already inserted the parent, so only the bit is missing.
+      if (k > 0 && c.level > 0 && cell_at(k - 1).level == c.level && parent(cell_at(k - 1)) == parent(c)) {
+        std::uint16_t* mask = split_.find(parent(c));
+        *mask = static_cast<std::uint16_t>(*mask | (1u << child_number(c)));
+        continue;
+      }
+      attach(c);
+    }
+    for (int l = 0; l <= kMaxLevel; ++l) {
+      const auto& level = split_by_level_[static_cast<std::size_t>(l)];
+      if (!level.empty()) max_split_ = l;
+      for (const CellId<d>& s : level) edges_ += static_cast<std::size_t>(std::popcount(*split_.find(s)));
+    }
+  }
+
+  /// The leaves neither overlap nor leave a gap (false: they do, reported).
+  bool leaves_tile_the_box() {
+    // Every element of S ∪ L but the root hangs below exactly one split cell, so the number
+    // of registered edges is |S ∪ L| − 1: it falls short of |S| + |L| − 1 exactly when some
+    // leaf is also a split cell (contains another leaf), and short of 2^d·|S| exactly when
+    // some child of a split cell is missing (the leaves do not tile the box).
+    bool ok = true;
+    if (edges_ != split_.size() + nl_ - 1) {
+      ok = false;
+      for (std::size_t k = 0; k < nl_; ++k)
+        if (split_.contains(cell_at(k)))
+          add(ViolationKind::Overlap, cell_at(k), cell_at(k), "leaf " + to_string<d>(cell_at(k)) + " contains other leaves");
+    }
+    if (edges_ != split_.size() * kChildren<d>) {
+      ok = false;
+      for (const auto& level : split_by_level_)
+        for (const CellId<d>& s : level) {
+          const unsigned mask = *split_.find(s);
+          for (unsigned w = 0; w < static_cast<unsigned>(kChildren<d>); ++w)
+            if (!((mask >> w) & 1u))
+              add(ViolationKind::Gap, child(s, w), s,
+                  "cell " + to_string<d>(child(s, w)) + " (child of split cell " + to_string<d>(s) +
+                      ") is neither a leaf nor split: the leaves do not tile the box");
+        }
+    }
+    return ok;
+  }
+
+  // --- Occupancy. ----------------------------------------------------------------------------
+
+  /// Locates every point in its leaf (reporting points outside the grid), then checks that
+  /// no leaf holds two points and every leaf's npoints is right. Builds the Morton index of
+  /// the valid points for the phases below.
+  void check_occupancy() {
+    occupied_.reserve(std::min(points_.size(), nl_));
+    std::vector<Position<d>> valid_points;
+    valid_points.reserve(points_.size());
+    for (std::size_t i = 0; i < points_.size(); ++i) {
+      const Position<d>& q = points_[i];
+      if (!position_valid<d>(q)) {
+        add(ViolationKind::BadPoint, CellId<d>::root(), CellId<d>::root(),
+            "point " + std::to_string(i) + " has a position outside [0, 2^52): " + position_string<d>(q));
+        continue;
+      }
+      valid_points.push_back(q);
+      const CellId<d> c = locate_in(split_, max_split_, q);
+      const auto [o, fresh] = occupied_.try_emplace(c, Occupied{0, 0, static_cast<std::uint32_t>(i)});
+      if (fresh) o->position = static_cast<std::uint32_t>(find_leaf(c));
+      ++o->count;
+    }
+    occupied_list_.reserve(occupied_.size());
+    occupied_.for_each([&](const CellId<d>&, const Occupied& o) { occupied_list_.emplace_back(o.position, o.count); });
+    std::sort(occupied_list_.begin(), occupied_list_.end());
+    for (const auto& [k, cnt] : occupied_list_)
+      if (cnt > 1)
+        add(ViolationKind::Overfull, cell_at(k), cell_at(k),
+            "leaf " + to_string<d>(cell_at(k)) + " holds " + std::to_string(cnt) + " points (at most 1 allowed)");
+    for (std::size_t k = 0, j = 0; k < nl_; ++k) {
+      while (j < occupied_list_.size() && occupied_list_[j].first < k) ++j;
+      const std::uint32_t cnt = j < occupied_list_.size() && occupied_list_[j].first == k ? occupied_list_[j].second : 0;
+      if (cnt != leaves_[order_[k]].npoints)
+        add(ViolationKind::CountMismatch, cell_at(k), cell_at(k),
+            "leaf " + to_string<d>(cell_at(k)) + " says npoints = " + std::to_string(leaves_[order_[k]].npoints) +
+                " but holds " + std::to_string(cnt));
+    }
+    index_.emplace(std::move(valid_points));
+  }
+
+  // --- The rules. ----------------------------------------------------------------------------
+
+  /// Grading (rule 3): every level m−1 cell touching a split level-m cell is split. Those
+  /// cells include the parent of every split cell; they are marked forced, which is what
+  /// check_minimality needs.
+  void check_grading() {
+    CellSet<d> reported;
+    for (int m = 1; m <= max_split_; ++m)
+      for (const CellId<d>& s : split_by_level_[static_cast<std::size_t>(m)])
+        for_each_coarser_touching(s, [&](const CellId<d>& u) {
+          if (std::uint16_t* v = split_.find(u)) {
+            *v = static_cast<std::uint16_t>(*v | kForced);
+            return;
+          }
+          const CellId<d> b = leaf_of(split_, u);
+          if (!reported.insert(b)) return;
+          add(ViolationKind::Grading, b, s,
+              "leaf " + to_string<d>(b) + " touches split cell " + to_string<d>(s) +
+                  ", so it touches leaves two or more levels smaller");
+        });
+  }
+
+  /// Separation (no two touching leaves both hold points) and crowding (rule 1: no leaf is
+  /// crowded), in one pass over the neighbourhood of each occupied leaf a. A same-level
+  /// neighbour nb is either split (its points, if any, are found by the Morton index; only
+  /// then can a leaf inside it that touches a be occupied) or lies in a leaf b that touches
+  /// a, whose first point tells whether nb holds a point.
+  void check_separation_and_crowding() {
+    std::vector<CellId<d>> touching_occupied, stack;
+    for (const auto& [k, cnt] : occupied_list_) {
+      const CellId<d>& a = cell_at(k);
+      bool crowded = false;
+      touching_occupied.clear();
+      detail::for_each_touching_leaf<d>(
+          a, [&](const CellId<d>& cell) { return split_.contains(cell); },
+          [&](const CellId<d>& nb) {  // only a split neighbour with points can hide an occupied leaf
+            if (!index_->any(nb)) return false;
+            crowded = true;
+            return true;
+          },
+          [&](const CellId<d>& leaf) {
+            if (occupied_.contains(leaf)) touching_occupied.push_back(leaf);
+          },
+          [&](const CellId<d>& b, const CellId<d>& nb) {
+            if (const Occupied* o = occupied_.find(b)) {
+              touching_occupied.push_back(b);
+              if (contains(nb, points_[o->point])) crowded = true;
+            }
+          },
+          stack);
+      std::sort(touching_occupied.begin(), touching_occupied.end());
+      touching_occupied.erase(std::unique(touching_occupied.begin(), touching_occupied.end()), touching_occupied.end());
+      for (const CellId<d>& b : touching_occupied)
+        if (a < b)
+          add(ViolationKind::TouchingOccupied, a, b,
+              "touching leaves " + to_string<d>(a) + " and " + to_string<d>(b) + " both hold points");
+      if (crowded && cnt == 1)  // overfull leaves are reported (and crowded) already
+        add(ViolationKind::CrowdedLeaf, a, a,
+            "leaf " + to_string<d>(a) + " holds a point and its neighbourhood holds another: it is crowded "
+            "but not split");
+    }
+  }
+
+  /// Minimality: every split is crowded or forced by a deeper split.
+  void check_minimality() {
+    for (const auto& level : split_by_level_)
+      for (const CellId<d>& s : level) {
+        if (*split_.find(s) & kForced) continue;
+        const std::size_t k = index_->count(s);
+        if (k >= 2 || (k == 1 && neighbours_hold_points(s))) continue;
+        add(ViolationKind::UnjustifiedSplit, s, s,
+            "split cell " + to_string<d>(s) +
+                " is not crowded, has no split child and touches no split cell one level smaller");
+      }
+  }
+
+  /// Records a violation, or only that there were more than max_violations.
+  void add(ViolationKind kind, const CellId<d>& cell, const CellId<d>& other, std::string msg) {
+    if (report.violations.size() < max_violations_)
+      report.violations.push_back(Violation<d>{kind, cell, other, std::move(msg)});
+    else
+      report.truncated = true;
+  }
+
+ private:
+  static constexpr std::uint16_t kForced = 1u << 8;
+  static constexpr std::size_t kNotALeaf = std::numeric_limits<std::size_t>::max();
+
+  struct Occupied {
+    std::uint32_t position = 0;  // in `order_`
+    std::uint32_t count = 0;
+    std::uint32_t point = 0;  // the first point found in it
+  };
+
+  const CellId<d>& cell_at(std::size_t k) const { return leaves_[order_[k]].cell; }
+
+  /// c's position in `order_`, or kNotALeaf.
+  std::size_t find_leaf(const CellId<d>& c) const {
+    std::size_t lo = 0, hi = nl_;
     while (lo < hi) {
       const std::size_t mid = lo + (hi - lo) / 2;
       if (cell_at(mid) < c)
@@ -496,188 +686,69 @@ CheckReport<d> check_tree(std::span<const Position<d>> points, std::span<const L
       else
         hi = mid;
     }
-    return lo < nl && cell_at(lo) == c ? lo : kNotALeaf;
-  };
+    return lo < nl_ && cell_at(lo) == c ? lo : kNotALeaf;
+  }
 
-  // S = the proper ancestors of the leaves, per level in a deterministic order. The value of
-  // a split cell holds the mask of its children present in S ∪ L (bits 0..2^d−1) and kForced,
-  // set below when a deeper split forces this one (rules 2 and 3).
-  constexpr std::uint16_t kForced = 1u << 8;
-  CellTable<d, std::uint16_t> split(nl / (kChildren<d> - 1) + 1);
-  std::vector<std::vector<CellId<d>>> split_by_level(kMaxLevel + 1);
-  // Registers the edge c → parent(c), inserting parent(c) and, if it is new, its ancestors.
-  auto attach = [&](CellId<d> c) {
+  /// Registers the edge c → parent(c), inserting parent(c) and, if it is new, its ancestors.
+  void attach(CellId<d> c) {
     while (c.level > 0) {
       const CellId<d> p = parent(c);
-      const auto [mask, fresh] = split.try_emplace(p, 0);
+      const auto [mask, fresh] = split_.try_emplace(p, 0);
       *mask = static_cast<std::uint16_t>(*mask | (1u << child_number(c)));
       if (!fresh) return;
-      split_by_level[static_cast<std::size_t>(p.level)].push_back(p);
+      split_by_level_[static_cast<std::size_t>(p.level)].push_back(p);
       c = p;
     }
-  };
-  for (std::size_t k = 0; k < nl; ++k) {
-    const CellId<d>& c = cell_at(k);
-    // Siblings along the last axis are adjacent in the order: the previous iteration has
-    // already inserted the parent, so only the bit is missing.
-    if (k > 0 && c.level > 0 && cell_at(k - 1).level == c.level && parent(cell_at(k - 1)) == parent(c)) {
-      std::uint16_t* mask = split.find(parent(c));
-      *mask = static_cast<std::uint16_t>(*mask | (1u << child_number(c)));
-      continue;
-    }
-    attach(c);
-  }
-  int max_split = -1;
-  std::size_t edges = 0;
-  for (int l = 0; l <= kMaxLevel; ++l) {
-    const auto& level = split_by_level[static_cast<std::size_t>(l)];
-    if (!level.empty()) max_split = l;
-    for (const CellId<d>& s : level) edges += static_cast<std::size_t>(std::popcount(*split.find(s)));
-  }
-  // Every element of S ∪ L but the root hangs below exactly one split cell, so the number of
-  // registered edges is |S ∪ L| − 1: it falls short of |S| + |L| − 1 exactly when some leaf is
-  // also a split cell (contains another leaf), and short of 2^d·|S| exactly when some child
-  // of a split cell is missing (the leaves do not tile the box).
-  if (edges != split.size() + nl - 1) {
-    structural = false;
-    for (std::size_t k = 0; k < nl; ++k)
-      if (split.contains(cell_at(k)))
-        add(ViolationKind::Overlap, cell_at(k), cell_at(k), "leaf " + to_string<d>(cell_at(k)) + " contains other leaves");
-  }
-  if (edges != split.size() * kChildren<d>) {
-    structural = false;
-    for (const auto& level : split_by_level)
-      for (const CellId<d>& s : level) {
-        const unsigned mask = *split.find(s);
-        for (unsigned w = 0; w < static_cast<unsigned>(kChildren<d>); ++w)
-          if (!((mask >> w) & 1u))
-            add(ViolationKind::Gap, child(s, w), s,
-                "cell " + to_string<d>(child(s, w)) + " (child of split cell " + to_string<d>(s) +
-                    ") is neither a leaf nor split: the leaves do not tile the box");
-      }
-  }
-  if (!structural) return rep;
-
-  // --- Occupancy. ----------------------------------------------------------------------------
-  struct Occupied {
-    std::uint32_t position = 0;  // in `order`
-    std::uint32_t count = 0;
-    std::uint32_t point = 0;  // the first point found in it
-  };
-  CellTable<d, Occupied> occupied(std::min(points.size(), nl));
-  std::vector<Position<d>> valid_points;
-  valid_points.reserve(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Position<d>& q = points[i];
-    if (!position_valid<d>(q)) {
-      add(ViolationKind::BadPoint, CellId<d>::root(), CellId<d>::root(),
-          "point " + std::to_string(i) + " has a position outside [0, 2^52): " + position_string<d>(q));
-      continue;
-    }
-    valid_points.push_back(q);
-    const CellId<d> c = locate_in(split, max_split, q);
-    const auto [o, fresh] = occupied.try_emplace(c, Occupied{0, 0, static_cast<std::uint32_t>(i)});
-    if (fresh) o->position = static_cast<std::uint32_t>(find_leaf(c));
-    ++o->count;
-  }
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> occupied_list;  // (position, count)
-  occupied_list.reserve(occupied.size());
-  occupied.for_each([&](const CellId<d>&, const Occupied& o) { occupied_list.emplace_back(o.position, o.count); });
-  std::sort(occupied_list.begin(), occupied_list.end());
-  for (const auto& [k, cnt] : occupied_list)
-    if (cnt > 1)
-      add(ViolationKind::Overfull, cell_at(k), cell_at(k),
-          "leaf " + to_string<d>(cell_at(k)) + " holds " + std::to_string(cnt) + " points (at most 1 allowed)");
-  for (std::size_t k = 0, j = 0; k < nl; ++k) {
-    while (j < occupied_list.size() && occupied_list[j].first < k) ++j;
-    const std::uint32_t cnt = j < occupied_list.size() && occupied_list[j].first == k ? occupied_list[j].second : 0;
-    if (cnt != leaves[order[k]].npoints)
-      add(ViolationKind::CountMismatch, cell_at(k), cell_at(k),
-          "leaf " + to_string<d>(cell_at(k)) + " says npoints = " + std::to_string(leaves[order[k]].npoints) +
-              " but holds " + std::to_string(cnt));
   }
 
-  // --- Grading (rule 3): every level m−1 cell touching a split level-m cell is split. -------
-  // Those cells include the parent of every split cell; they are marked forced, which is what
-  // minimality needs below.
-  CellSet<d> reported;
-  for (int m = 1; m <= max_split; ++m)
-    for (const CellId<d>& s : split_by_level[static_cast<std::size_t>(m)])
-      for_each_coarser_touching(s, [&](const CellId<d>& u) {
-        if (std::uint16_t* v = split.find(u)) {
-          *v = static_cast<std::uint16_t>(*v | kForced);
-          return;
-        }
-        const CellId<d> b = leaf_of(split, u);
-        if (!reported.insert(b)) return;
-        add(ViolationKind::Grading, b, s,
-            "leaf " + to_string<d>(b) + " touches split cell " + to_string<d>(s) +
-                ", so it touches leaves two or more levels smaller");
-      });
+  bool holds_point(const CellId<d>& c) const {
+    if (split_.contains(c)) return index_->any(c);
+    const Occupied* o = occupied_.find(leaf_of(split_, c));
+    return o != nullptr && contains(c, points_[o->point]);
+  }
 
-  // --- Separation (no two touching leaves both hold points) and crowding (rule 1: no leaf is
-  // crowded), in one pass over the neighbourhood of each occupied leaf a. A same-level
-  // neighbour nb is either split (its points, if any, are found by the Morton index; only then
-  // can a leaf inside it that touches a be occupied) or lies in a leaf b that touches a, whose
-  // first point tells whether nb holds a point.
-  const MortonIndex<d> index(std::move(valid_points));
-  auto holds_point = [&](const CellId<d>& c) {
-    if (split.contains(c)) return index.any(c);
-    const Occupied* o = occupied.find(leaf_of(split, c));
-    return o != nullptr && contains(c, points[o->point]);
-  };
-  auto neighbours_hold_points = [&](const CellId<d>& c) {
+  bool neighbours_hold_points(const CellId<d>& c) const {
     bool found = false;
     for_each_neighbour(c, [&](const CellId<d>& nb) {
       if (!found && holds_point(nb)) found = true;
     });
     return found;
-  };
-  std::vector<CellId<d>> touching_occupied, stack;
-  for (const auto& [k, cnt] : occupied_list) {
-    const CellId<d>& a = cell_at(k);
-    bool crowded = false;
-    touching_occupied.clear();
-    detail::for_each_touching_leaf<d>(
-        a, [&](const CellId<d>& x) { return split.contains(x); },
-        [&](const CellId<d>& nb) {  // only a split neighbour with points can hide an occupied leaf
-          if (!index.any(nb)) return false;
-          crowded = true;
-          return true;
-        },
-        [&](const CellId<d>& leaf) {
-          if (occupied.contains(leaf)) touching_occupied.push_back(leaf);
-        },
-        [&](const CellId<d>& b, const CellId<d>& nb) {
-          if (const Occupied* o = occupied.find(b)) {
-            touching_occupied.push_back(b);
-            if (contains(nb, points[o->point])) crowded = true;
-          }
-        },
-        stack);
-    std::sort(touching_occupied.begin(), touching_occupied.end());
-    touching_occupied.erase(std::unique(touching_occupied.begin(), touching_occupied.end()), touching_occupied.end());
-    for (const CellId<d>& b : touching_occupied)
-      if (a < b)
-        add(ViolationKind::TouchingOccupied, a, b,
-            "touching leaves " + to_string<d>(a) + " and " + to_string<d>(b) + " both hold points");
-    if (crowded && cnt == 1)  // overfull leaves are reported (and crowded) already
-      add(ViolationKind::CrowdedLeaf, a, a,
-          "leaf " + to_string<d>(a) + " holds a point and its neighbourhood holds another: it is crowded "
-          "but not split");
   }
 
-  // --- Minimality: every split is crowded or forced by a deeper split. ---------------------
-  for (const auto& level : split_by_level)
-    for (const CellId<d>& s : level) {
-      if (*split.find(s) & kForced) continue;
-      const std::size_t k = index.count(s);
-      if (k >= 2 || (k == 1 && neighbours_hold_points(s))) continue;
-      add(ViolationKind::UnjustifiedSplit, s, s,
-          "split cell " + to_string<d>(s) +
-              " is not crowded, has no split child and touches no split cell one level smaller");
-    }
-  return rep;
+  std::span<const Position<d>> points_;
+  std::span<const Leaf<d>> leaves_;
+  std::size_t max_violations_;
+  std::size_t nl_;
+  std::vector<std::uint32_t> order_;
+  CellTable<d, std::uint16_t> split_;
+  std::vector<std::vector<CellId<d>>> split_by_level_;
+  int max_split_ = -1;
+  std::size_t edges_ = 0;
+  CellTable<d, Occupied> occupied_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> occupied_list_;  // (position, count)
+  std::optional<MortonIndex<d>> index_;
+};
+
+}  // namespace
+
+template <std::size_t d>
+CheckReport<d> check_tree(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves,
+                          std::size_t max_violations) {
+  TreeCheck<d> check(points, leaves, max_violations);
+  if (leaves.empty()) {
+    check.add(ViolationKind::Gap, CellId<d>::root(), CellId<d>::root(), "no leaves: the box is not covered");
+    return std::move(check.report);
+  }
+  if (leaves.size() >= std::numeric_limits<std::uint32_t>::max()) throw std::length_error("check_tree: too many leaves");
+  // The structure first: the later phases assume a tiling of the box by distinct cells.
+  if (!check.leaves_are_cells() || !check.order_leaves()) return std::move(check.report);
+  check.build_split_set();
+  if (!check.leaves_tile_the_box()) return std::move(check.report);
+  check.check_occupancy();
+  check.check_grading();
+  check.check_separation_and_crowding();
+  check.check_minimality();
+  return std::move(check.report);
 }
 
 template <std::size_t d>

@@ -58,9 +58,9 @@ QuadtreeMesh::QuadtreeMesh(const Box<2>& box, std::span<const Point<2>> points)
   };
   CellTable<2, Mark> marks(qs.size() * 4);
   for (std::size_t i = 0; i < qs.size(); ++i)
-    detail::for_each_marked(targets[i], [&](const CellId<2>& x, std::uint8_t v) {
-      if (!marks.try_emplace(x, Mark{detail::warped_corner(v), i}).second)
-        throw InvariantError("dynmesh: leaf " + to_string(x) + " has two warped corners");
+    detail::for_each_marked(targets[i], [&](const CellId<2>& cell, std::uint8_t v) {
+      if (!marks.try_emplace(cell, Mark{detail::warped_corner(v), i}).second)
+        throw InvariantError("dynmesh: leaf " + to_string(cell) + " has two warped corners");
     });
 
   auto is_split = [&](const CellId<2>& c) { return split.contains(c); };

@@ -20,9 +20,8 @@
 //   * p's T* level is found by reading the `split` values down p's path and testing only
 //     their T* bit (tree_split): postprocess writes land only on cells T* left unsplit and
 //     never set that bit, so the descent sees T* whatever the order of the points. (Reading
-//     the point lists instead, as an earlier version did, re-ran every descent through a
-//     cell whose list head changed: about one per level per deletion, each re-running its
-//     whole tail.)
+//     the point lists instead would re-run every descent through a cell whose list head
+//     changed: about one per level per deletion, each re-running its whole tail.)
 //   * T' is the least closure of the seeds, a set: the order in which the points add to it
 //     changes the trace, not the result. Each point's work is memoized on its list node,
 //     so an insertion or deletion re-runs only its own place() and what reads the cells it
@@ -61,61 +60,61 @@ struct QuadtreeMeshProgram {
 
   using Placement = PointPlacement<2, QuadtreeMeshProgram>;
 
-  Slot<2>& slot(sac::Engine& r, const CellId<2>& c) { return dir->get(r, c); }
+  Slot<2>& slot(sac::Engine& rt, const CellId<2>& c) { return dir->get(rt, c); }
   const MeshGrid& grid() const { return log->grid; }
 
-  static void main(sac::Engine& r, QuadtreeMeshProgram* cx) {
-    r.memo_read(*cx->input, sac::fn<&Placement::place>(cx));
-    r.memo(sac::fn<&visit_root>(cx));
+  static void main(sac::Engine& rt, QuadtreeMeshProgram* program) {
+    rt.memo_read(*program->input, sac::fn<&Placement::place>(program));
+    rt.memo(sac::fn<&visit_root>(program));
   }
 
   // ------------------------------------------------------------------ the points
-  static void settle(sac::Engine& r, QuadtreeMeshProgram* cx, Node* n, int tree_level) {
+  static void settle(sac::Engine& rt, QuadtreeMeshProgram* program, Node* n, int tree_level) {
     const auto* in = static_cast<const InputNode<2>*>(n);
-    const WarpTarget t = warp_target(cx->grid(), n->q, in->point, tree_level);
-    for_each_coarser_touching(t.leaf, [&](const CellId<2>& s) { Placement::split(r, cx, s); });
-    for_each_marked(t, [&](const CellId<2>& x, std::uint8_t mark) { Placement::mark(r, cx, x, mark); });
-    r.write(cx->slot(r, t.leaf).pts, n);
+    const WarpTarget t = warp_target(program->grid(), n->q, in->point, tree_level);
+    for_each_coarser_touching(t.leaf, [&](const CellId<2>& s) { Placement::split(rt, program, s); });
+    for_each_marked(t, [&](const CellId<2>& cell, std::uint8_t mark) { Placement::mark(rt, program, cell, mark); });
+    rt.write(program->slot(rt, t.leaf).pts, n);
   }
 
   // ------------------------------------------------------------------ the leaves
-  static void visit_root(sac::Engine& r, QuadtreeMeshProgram* cx) { look(r, cx, CellId<2>::root()); }
+  static void visit_root(sac::Engine& rt, QuadtreeMeshProgram* program) { look(rt, program, CellId<2>::root()); }
 
-  static void look(sac::Engine& r, QuadtreeMeshProgram* cx, const CellId<2>& c) {
-    r.read(cx->slot(r, c).split, [cx, c](sac::Engine& e, std::uint8_t v) {
-      if (any_split(v)) e.memo(sac::fn<&visit>(cx, c));
-      else side(e, cx, LeafShape{c, 0, -1, {}}, v, 0);
+  static void look(sac::Engine& rt, QuadtreeMeshProgram* program, const CellId<2>& c) {
+    rt.read(program->slot(rt, c).split, [program, c](sac::Engine& rt2, std::uint8_t v) {
+      if (any_split(v)) rt2.memo(sac::fn<&visit>(program, c));
+      else side(rt2, program, LeafShape{c, 0, -1, {}}, v, 0);
     });
   }
 
-  static void visit(sac::Engine& r, QuadtreeMeshProgram* cx, CellId<2> c) {
-    for (unsigned w = 0; w < 4; ++w) look(r, cx, child(c, w));
+  static void visit(sac::Engine& rt, QuadtreeMeshProgram* program, CellId<2> c) {
+    for (unsigned w = 0; w < 4; ++w) look(rt, program, child(c, w));
   }
 
   /// Reads the neighbour across side s (a split one puts a midpoint on the side), then the
   /// next side; after the last, the warping point if the leaf is marked.
-  static void side(sac::Engine& r, QuadtreeMeshProgram* cx, LeafShape shape, std::uint8_t mark, unsigned s) {
+  static void side(sac::Engine& rt, QuadtreeMeshProgram* program, LeafShape shape, std::uint8_t mark, unsigned s) {
     CellId<2> nb;
     while (s < 4 && !side_neighbour(shape.cell, s, nb)) ++s;
-    if (s == 4) return finish(r, cx, shape, mark);
-    r.read(cx->slot(r, nb).split, [cx, shape, mark, s](sac::Engine& e, std::uint8_t v) {
+    if (s == 4) return finish(rt, program, shape, mark);
+    rt.read(program->slot(rt, nb).split, [program, shape, mark, s](sac::Engine& rt2, std::uint8_t v) {
       LeafShape next = shape;
       if (any_split(v)) next.midpoints = static_cast<std::uint8_t>(next.midpoints | (1u << s));
-      side(e, cx, next, mark, s + 1);
+      side(rt2, program, next, mark, s + 1);
     });
   }
 
-  static void finish(sac::Engine& r, QuadtreeMeshProgram* cx, LeafShape shape, std::uint8_t mark) {
+  static void finish(sac::Engine& rt, QuadtreeMeshProgram* program, LeafShape shape, std::uint8_t mark) {
     if (!is_warped(mark)) {
-      r.make<LeafBlock>(cx->log, shape);
+      rt.make<LeafBlock>(program->log, shape);
       return;
     }
     shape.warped = static_cast<std::int8_t>(warped_corner(mark));
-    r.read(cx->slot(r, warp_source(shape.cell, mark)).pts, [cx, shape](sac::Engine& e, Node* p) {
+    rt.read(program->slot(rt, warp_source(shape.cell, mark)).pts, [program, shape](sac::Engine& rt2, Node* p) {
       if (!p) throw InvariantError("dynmesh: a warped leaf without its point");
       LeafShape s = shape;
       s.warp_to = static_cast<const InputNode<2>*>(p)->point;
-      e.make<LeafBlock>(cx->log, s);
+      rt2.make<LeafBlock>(program->log, s);
     });
   }
 };

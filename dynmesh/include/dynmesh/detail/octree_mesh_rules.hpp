@@ -262,7 +262,7 @@ inline void tetrahedralize_leaf(const OctreeGrid& grid, const CellId<3>& cell, s
 /// `mask`: the block's neighbourhood split mask.
 inline void tetrahedralize_block(const OctreeGrid& grid, const CellId<3>& owner, unsigned corner, const Point<3>& p,
                                  std::uint64_t mask, std::vector<Tetrahedron>& out) {
-  for_each_block_cell(BlockTarget{owner, corner}, [&](const CellId<3>& x, std::uint8_t mark) {
+  for_each_block_cell(BlockTarget{owner, corner}, [&](const CellId<3>& cell, std::uint8_t mark) {
     const unsigned b = block_position(mark);
     // x's position in the mask's frame is 1 + b per axis.
     auto split = [mask, b](int dx, int dy, int dz) {
@@ -270,10 +270,10 @@ inline void tetrahedralize_block(const OctreeGrid& grid, const CellId<3>& owner,
                 z0 = 1 + static_cast<int>((b >> 2) & 1u) + dz;
       return ((mask >> block_bit(x0, y0, z0)) & 1u) != 0;
     };
-    const GridPoint3 lo = octree_detail::cell_corner(x);
+    const GridPoint3 lo = octree_detail::cell_corner(cell);
     // The outer faces: on axis a, the side away from v.
     for (unsigned axis = 0; axis < 3; ++axis)
-      octree_detail::cone_face(lo, x.level, axis, ((b >> axis) & 1u) != 0, split,
+      octree_detail::cone_face(lo, cell.level, axis, ((b >> axis) & 1u) != 0, split,
                                [&](const GridPoint3& g0, const GridPoint3& g1, const GridPoint3& g2) {
                                  out.push_back(canonical_tetrahedron(p, grid.vertex(g0), grid.vertex(g1), grid.vertex(g2)));
                                });

@@ -253,7 +253,7 @@ inline void triangulate_leaf(const MeshGrid& grid, const LeafShape& s, std::vect
   evaluate(best, true);
 }
 
-/// The triangles of a leaf, for the feed's blocks (mesh/block_feed.hpp); a changed leaf
+/// The triangles of a leaf, for the change feed's blocks; a changed leaf
 /// gives all of its triangles, old and new.
 inline void emit_simplices(const MeshGrid& grid, const LeafShape& s, std::vector<Triangle>& out) {
   triangulate_leaf(grid, s, out);
