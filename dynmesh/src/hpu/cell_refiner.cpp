@@ -14,6 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include <sac/splitmix64.hpp>
+
 #include "dynmesh/errors.hpp"
 #include "dynmesh/predicates.hpp"
 #include "dynmesh/quadtree_mesh.hpp"
@@ -29,14 +31,9 @@ namespace {
 using Vid = std::uint32_t;
 constexpr Vid kNone = 0xffff'ffffu;
 
-std::uint64_t mix(std::uint64_t h) noexcept {
-  h ^= h >> 30;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  h ^= h >> 27;
-  h *= 0x94d049bb133111ebULL;
-  return h ^ (h >> 31);
-}
-std::uint64_t mix(std::uint64_t h, std::uint64_t x) noexcept { return mix(h * 0x9e3779b97f4a7c15ULL + x); }
+// The step log's fingerprints (CellStep): sac::mix64 over the running hash times the golden
+// gamma plus the next word, so that the order of the words counts.
+std::uint64_t mix(std::uint64_t h, std::uint64_t x) noexcept { return sac::mix64(h * sac::kGoldenGamma + x); }
 std::uint64_t mix(std::uint64_t h, const Point<2>& p) noexcept {
   return mix(mix(h, std::bit_cast<std::uint64_t>(p[0] + 0.0)), std::bit_cast<std::uint64_t>(p[1] + 0.0));
 }

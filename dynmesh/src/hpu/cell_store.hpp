@@ -40,6 +40,7 @@
 
 #include <sac/engine.hpp>
 #include <sac/mod.hpp>
+#include <sac/splitmix64.hpp>
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/errors.hpp"
@@ -98,7 +99,7 @@ struct CellKey {
     return (c.ix >> s) == ix && (c.iy >> s) == iy;
   }
   std::uint64_t hash() const noexcept {
-    std::uint64_t h = static_cast<std::uint64_t>(level) * 0x9e3779b97f4a7c15ULL;
+    std::uint64_t h = static_cast<std::uint64_t>(level) * sac::kGoldenGamma;
     h ^= ix + 0xbf58476d1ce4e5b9ULL + (h << 6) + (h >> 2);
     h ^= iy + 0x94d049bb133111ebULL + (h << 6) + (h >> 2);
     h ^= h >> 31;

@@ -317,10 +317,12 @@ struct HpuCellsProgram {
   }
 
   /// One in about kBlockSpan initial vertices opens a block, chosen by its coordinates
-  /// (never by an address). Other spans measured: bench/RESULTS.md.
+  /// (never by an address, so the blocks are the same in every run). The mix is a short one
+  /// (two shifts, one multiply), not sac::mix64: its values place the block boundaries, and
+  /// with them the trace, so it stays as it is.
   static constexpr std::uint64_t kBlockSpan = 32;
   static bool opens_block(HV v) noexcept {
-    std::uint64_t h = std::bit_cast<std::uint64_t>(v->p[0]) * 0x9e3779b97f4a7c15ull ^ std::bit_cast<std::uint64_t>(v->p[1]);
+    std::uint64_t h = std::bit_cast<std::uint64_t>(v->p[0]) * sac::kGoldenGamma ^ std::bit_cast<std::uint64_t>(v->p[1]);
     h ^= h >> 31;
     h *= 0xbf58476d1ce4e5b9ull;
     h ^= h >> 29;

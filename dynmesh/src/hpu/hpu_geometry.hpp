@@ -31,6 +31,8 @@
 #include <utility>
 #include <vector>
 
+#include <sac/splitmix64.hpp>
+
 #include "dynmesh/box.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh.hpp"
@@ -112,14 +114,9 @@ inline bool morton_less(const Box<2>& box, const Point<2>& a, const Point<2>& b)
 /// 2003): the trailing zero bits of a hash of its coordinates (capped at 24), so about half
 /// the points are at level 0, a quarter at 1, and so on; a function of the point alone.
 inline int brio_level(const Point<2>& p) noexcept {
-  std::uint64_t h = std::bit_cast<std::uint64_t>(p[0] + 0.0) * 0x9e3779b97f4a7c15ULL;
+  std::uint64_t h = std::bit_cast<std::uint64_t>(p[0] + 0.0) * sac::kGoldenGamma;
   h ^= std::bit_cast<std::uint64_t>(p[1] + 0.0) + 0x632be59bd9b4e019ULL + (h << 6) + (h >> 2);
-  h ^= h >> 30;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  h ^= h >> 27;
-  h *= 0x94d049bb133111ebULL;
-  h ^= h >> 31;
-  return std::min(std::countr_zero(h), 24);
+  return std::min(std::countr_zero(sac::mix64(h)), 24);
 }
 
 /// The order in which the hpu mesh takes its non-corner vertices (the input list, and the
