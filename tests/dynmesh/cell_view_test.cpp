@@ -334,11 +334,11 @@ TEST(CellView, TheNearestSearchFromTheLeafUpVisitsWhatTheSearchFromTheRootVisits
     for (const CellVertex& v : vs) {
       NearestRecord down{v.p, std::numeric_limits<double>::infinity(), {}};
       NearestRecord up = down;
-      view.reset();
+      view.begin_run();
       view.search(v.p, 0.0, dir.margin_for(v.p, 0.0), [&](double a, double b, double c, double d) { return down.keep(a, b, c, d); },
                   [&](const CellVertex* w) { return down.see(w); });
       view.used_all();
-      view.reset();
+      view.begin_run();
       view.search_near(v.p, 0.0, dir.margin_for(v.p, 0.0), [&](double a, double b, double c, double d) { return up.keep(a, b, c, d); },
                        [&](const CellVertex* w) { return up.see(w); }, [&] { return up.reach(); });
       view.used_all();

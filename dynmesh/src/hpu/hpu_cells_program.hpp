@@ -70,7 +70,7 @@
 #include "dynmesh/point.hpp"
 #include "hpu/cell_questions.hpp"
 #include "hpu/cell_store.hpp"
-#include "hpu/cell_view.hpp"
+#include "hpu/step_rounds.hpp"
 #include "hpu/hpu_geometry.hpp"
 #include "hpu/hpu_inputs.hpp"
 #include "hpu/hpu_cells_state.hpp"
