@@ -122,11 +122,10 @@ inline int brio_level(const Point<2>& p) noexcept {
 /// The order in which the hpu mesh takes its non-corner vertices (the input list, and the
 /// first queue entries): BRIO level descending, then (Morton, xy) within a level. Why not
 /// plain Morton order: each insertion re-makes the big triangles just ahead of it, so in
-/// Morton order a change at one point re-ran every later insertion along that frontier
-/// (about 340 insertions for a point at the box's centre at n = 20,000), and off-centers
-/// along the data's hull re-made the long triangles out to the box one after another
-/// (about 1,000 pairs per class for a hull point). Coarse random rounds first cut those
-/// chains to O(1) expected length, as in randomized incremental construction.
+/// Morton order a change at one point would re-run every later insertion along that
+/// frontier, and off-centers along the data's hull would re-make the long triangles out to
+/// the box one after another. Coarse random rounds first cut those chains to O(1) expected
+/// length, as in randomized incremental construction.
 inline bool insertion_less(const Box<2>& box, const Point<2>& a, const Point<2>& b) noexcept {
   const int la = brio_level(a), lb = brio_level(b);
   if (la != lb) return la > lb;
@@ -219,9 +218,9 @@ inline std::vector<Point<2>> side_midpoints(const Box<2>& box, std::span<const P
 
 /// How far the continuation rule of class j looks (hpu_mesh.hpp, rule 3): a vertex goes on
 /// while its star has a triangle of circumradius above 2^(j+1+kGoOnReach), or a loose edge
-/// of a class above j, which the star's walked triangles decide. A reach of 1 instead of 0
-/// let a quarter fewer collects run on uniform points, for 10% fewer instructions; 2 gave
-/// no more (bench/RESULTS.md, "Fewer collects").
+/// of a class above j, which the star's walked triangles decide. A reach of 1 rather than 0
+/// lets fewer collects run (a vertex whose star has only slightly larger triangles stops
+/// sooner); a larger reach saves no more.
 inline constexpr int kGoOnReach = 1;
 
 /// Is the circumradius of a, b, c above 2^(j+1) (the continuation rule, kGoOnReach)? In one
