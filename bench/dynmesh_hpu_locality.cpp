@@ -32,6 +32,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <sac/splitmix64.hpp>
 
 #include "bench_stats.hpp"
 
@@ -151,7 +152,7 @@ int main(int argc, char** argv) {
                         l[l.size() * 99 / 100], l.back());
         }
       }
-      std::mt19937_64 rng(seed ^ 0x9e3779b97f4a7c15ULL);
+      std::mt19937_64 rng(seed ^ sac::kGoldenGamma);
       std::vector<double> changed, reads;
       double kind[4] = {0, 0, 0, 0}, kind_leaves[4] = {0, 0, 0, 0};
       std::map<int, double> classes, reaches;

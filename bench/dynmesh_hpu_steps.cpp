@@ -10,14 +10,13 @@
 // compared with HpuMesh's. Flat in n is the goal for every per-update column. With --tail K,
 // the K costliest propagations of each row follow it: the operation, the trace distance, the
 // events created, the reads re-executed, and the steps re-run by kind. An update that creates
-// far more events than its steps explain has re-run a list pass (bench/RESULTS.md, "Fewer
-// collects"). --breakdown prints where the trace's bytes go after each build; --engine-stats
-// the engine's counters (sac::Stats) after each series; --search-stats what the steps'
-// searches asked and read, per input point from scratch and per update: left searches and
-// leaves read (counters the program keeps anyway: counting more inside the view's leaf loop
-// cost 2% of an update's instructions, bench/RESULTS.md). --points FILE measures a point
-// file instead (its one row is named after the file, n is its size; --box sets the box,
-// else it is derived from the points), with the same delete-insert updates.
+// far more events than its steps explain has re-run a list pass. --breakdown prints where
+// the trace's bytes go after each build; --engine-stats the engine's counters (sac::Stats)
+// after each series; --search-stats what the steps' searches asked and read, per input point
+// from scratch and per update: left searches and leaves read (counters the program keeps
+// anyway: counting more inside the view's leaf loop would slow every search). --points FILE
+// measures a point file instead (its one row is named after the file, n is its size; --box
+// sets the box, else it is derived from the points), with the same delete-insert updates.
 //
 //   dynmesh_hpu_steps [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
 //                     [--seed 1] [--angle 20.7] [--verify] [--tail K] [--breakdown] [--engine-stats]
@@ -55,7 +54,7 @@ struct Run {
       : state(box), program(engine, state, angle) {
     state.start(engine);
     apply(pts, {});
-    engine.run([this](sac::Engine& e) { detail::HpuCellsProgram::main(e, &program); });
+    engine.run([this](sac::Engine& rt) { detail::HpuCellsProgram::main(rt, &program); });
     state.feed.clear_change();
   }
   ~Run() { state.feed.close(); }

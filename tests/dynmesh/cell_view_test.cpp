@@ -1,4 +1,4 @@
-// Tests of cell_view.hpp's record of what a step used of a cell (CellInterest): the 256ths
+// Tests of cell_interest.hpp's record of what a step used of a cell (CellInterest): the 256ths
 // of a box hold every vertex inside the box, whatever the cell and the rounding, and a change
 // of a leaf counts exactly when it changes the vertices inside the used box (or the kind).
 // The program's reads that rely on it are checked end to end by hpu_cells_program_test.cpp
@@ -108,15 +108,15 @@ TEST(FollowCell, TheCellItFollowsToHoldsWhatTheStepUsed) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int followed[2] = {0, 0}, refused[2] = {0, 0};
   for (int t = 0; t < 4000; ++t) {
-    sac::Engine e;
+    sac::Engine rt;
     const Box<2> box{{-3.7 + u(rng), 1e3 * u(rng)}, 0.1 + 100 * u(rng)};
     CellDirectory dir(box);
     const int level = 1 + static_cast<int>(rng() % 20);
     const std::uint64_t side = std::uint64_t{1} << level;
-    CellNode* n = dir.node(e, CellKey{level, rng() % side, rng() % side});
+    CellNode* n = dir.node(rt, CellKey{level, rng() % side, rng() % side});
     const bool up = t % 2 == 1;  // a merge above n, else a split of n
-    CellNode* p = dir.node(e, n->key.parent());
-    for (unsigned c = 0; c < 4; ++c) dir.node(e, (up ? p : n)->key.child(c));
+    CellNode* p = dir.node(rt, n->key.parent());
+    for (unsigned c = 0; c < 4; ++c) dir.node(rt, (up ? p : n)->key.child(c));
     const CellFrame fn(box, n->key);
     const double w = 256.0 / fn.inv;
     const auto in_cell = [&](const CellKey& k, const Point<2>& x) {
@@ -225,11 +225,11 @@ TEST(FollowCell, TheCellItFollowsToHoldsWhatTheStepUsed) {
 }
 
 TEST(FollowCell, AWholeCellOrALeafStillALeafNeverFollows) {
-  sac::Engine e;
+  sac::Engine rt;
   const Box<2> box{{0, 0}, 16};
   CellDirectory dir(box);
-  CellNode* n = dir.node(e, CellKey{2, 1, 1});  // [4, 8] × [4, 8]
-  for (unsigned c = 0; c < 4; ++c) dir.node(e, n->key.child(c));
+  CellNode* n = dir.node(rt, CellKey{2, 1, 1});  // [4, 8] × [4, 8]
+  for (unsigned c = 0; c < 4; ++c) dir.node(rt, n->key.child(c));
   std::deque<CellVertex> vs;
   const CellVertex* a = &vs.emplace_back(Point<2>{4.5, 4.5});
   const CellVertex* b = &vs.emplace_back(Point<2>{7.5, 7.5});
@@ -257,11 +257,11 @@ TEST(FollowCell, AWholeCellOrALeafStillALeafNeverFollows) {
 }
 
 TEST(CellDirectory, NodesLinkTheirParentAndChildrenWhateverTheOrderMade) {
-  sac::Engine e;
+  sac::Engine rt;
   CellDirectory dir(Box<2>{{0, 0}, 1});
-  CellNode* c = dir.node(e, CellKey{2, 1, 2});  // below a cell not made yet
-  CellNode* root = dir.node(e, CellKey{});
-  CellNode* mid = dir.node(e, CellKey{1, 0, 1});
+  CellNode* c = dir.node(rt, CellKey{2, 1, 2});  // below a cell not made yet
+  CellNode* root = dir.node(rt, CellKey{});
+  CellNode* mid = dir.node(rt, CellKey{1, 0, 1});
   EXPECT_EQ(c->parent, mid);
   EXPECT_EQ(mid->parent, root);
   EXPECT_EQ(root->parent, nullptr);
@@ -277,16 +277,16 @@ TEST(CellDirectory, NodesLinkTheirParentAndChildrenWhateverTheOrderMade) {
 }
 
 TEST(CellDirectory, OneViewAtATimeKeepsItsMarksOnTheNodes) {
-  sac::Engine e;
+  sac::Engine rt;
   CellDirectory dir(Box<2>{{0, 0}, 1});
-  CellNode* root = dir.node(e, CellKey{});
+  CellNode* root = dir.node(rt, CellKey{});
   {
-    CellView v(e, dir);
-    EXPECT_THROW(CellView(e, dir), dynmesh::InvariantError);
+    CellView v(rt, dir);
+    EXPECT_THROW(CellView(rt, dir), dynmesh::InvariantError);
     root->mark.gen = 1;  // as a step of the first view leaves it
     root->mark.read = true;
   }
-  CellView w(e, dir);  // the first is gone: the marks start clean
+  CellView w(rt, dir);  // the first is gone: the marks start clean
   EXPECT_EQ(root->mark.gen, 0u);
   EXPECT_FALSE(root->mark.read);
 }
@@ -314,7 +314,7 @@ TEST(CellView, TheNearestSearchFromTheLeafUpVisitsWhatTheSearchFromTheRootVisits
   std::mt19937_64 rng(20261128);
   std::printf("seed 20261128\n");
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  sac::Engine e;
+  sac::Engine rt;
   const Box<2> box{{-2.1, 3.3}, 7.7};  // inexact, so that points on midlines round either way
   CellDirectory dir(box);
   InputCells in(dir);
@@ -325,20 +325,20 @@ TEST(CellView, TheNearestSearchFromTheLeafUpVisitsWhatTheSearchFromTheRootVisits
     const double s = i % 3 == 0 ? 1.0 : i % 3 == 1 ? 1.0 / 64 : 1.0 / 4096;
     const Point<2> x{box.origin[0] + box.side * (s * u(rng) + (1 - s) * 0.3),
                      box.origin[1] + box.side * (s * u(rng) + (1 - s) * 0.6)};
-    in.insert(e, &vs.emplace_back(x));
+    in.insert(rt, &vs.emplace_back(x));
   }
-  for (int i = 1; i < 16; ++i) in.insert(e, &vs.emplace_back(Point<2>{box.origin[0] + box.side * i / 16, box.origin[1] + box.side / 2}));
-  CellView view(e, dir);
+  for (int i = 1; i < 16; ++i) in.insert(rt, &vs.emplace_back(Point<2>{box.origin[0] + box.side * i / 16, box.origin[1] + box.side / 2}));
+  CellView view(rt, dir);
   std::size_t focused = 0;
-  e.run([&](sac::Engine&) {  // a view peeks, which only the computation may
+  rt.run([&](sac::Engine&) {  // a view peeks, which only the computation may
     for (const CellVertex& v : vs) {
       NearestRecord down{v.p, std::numeric_limits<double>::infinity(), {}};
       NearestRecord up = down;
-      view.reset();
+      view.begin_run();
       view.search(v.p, 0.0, dir.margin_for(v.p, 0.0), [&](double a, double b, double c, double d) { return down.keep(a, b, c, d); },
                   [&](const CellVertex* w) { return down.see(w); });
       view.used_all();
-      view.reset();
+      view.begin_run();
       view.search_near(v.p, 0.0, dir.margin_for(v.p, 0.0), [&](double a, double b, double c, double d) { return up.keep(a, b, c, d); },
                        [&](const CellVertex* w) { return up.see(w); }, [&] { return up.reach(); });
       view.used_all();

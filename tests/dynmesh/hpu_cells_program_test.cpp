@@ -62,7 +62,7 @@ class HpuHarness {
       : box_(box), state_(box), program_(engine_, state_, angle) {
     state_.start(engine_);
     set_list(pts);
-    engine_.run([this](sac::Engine& e) { HpuCellsProgram::main(e, &program_); });
+    engine_.run([this](sac::Engine& rt) { HpuCellsProgram::main(rt, &program_); });
     state_.feed.clear_change();
   }
   ~HpuHarness() { state_.feed.close(); }
@@ -556,11 +556,11 @@ TEST(HpuInputs, CheckerCatchesABrokenList) {
   const Box<2> box{{0, 0}, 1};
   // Points near the bottom side, so that the list holds side midpoints too.
   const std::vector<Point<2>> pts = {{0.3, 0.01}, {0.7, 0.4}, {0.55, 0.8}, {0.2, 0.6}};
-  sac::Engine engine;
+  sac::Engine rt;
   detail::HpuInputs inputs(box);
   std::vector<Edit<2>> edits;
   for (const Point<2>& p : pts) edits.push_back({EditOp::Insert, p});
-  inputs.commit(engine, inputs.plan(edits));
+  inputs.commit(rt, inputs.plan(edits));
   ASSERT_NO_THROW(inputs.check_invariants(pts));
   EXPECT_GT(inputs.size(), pts.size()) << "the bottom side's midpoints are listed";
   // A point the list does not hold, and one it holds that is not an input.
@@ -572,15 +572,15 @@ TEST(HpuInputs, CheckerCatchesABrokenList) {
   detail::HpuInputNode* first = inputs.head().get();
   detail::HpuInputNode* second = first->next.get();
   detail::HpuInputNode* third = second->next.get();
-  engine.set(first->next, static_cast<detail::HpuInputNode*>(nullptr));
+  rt.set(first->next, static_cast<detail::HpuInputNode*>(nullptr));
   EXPECT_THROW(inputs.check_invariants(pts), InvariantError);
-  engine.set(inputs.head(), second);
-  engine.set(second->next, first);
-  engine.set(first->next, third);
+  rt.set(inputs.head(), second);
+  rt.set(second->next, first);
+  rt.set(first->next, third);
   EXPECT_THROW(inputs.check_invariants(pts), InvariantError);
-  engine.set(inputs.head(), first);
-  engine.set(first->next, second);
-  engine.set(second->next, third);
+  rt.set(inputs.head(), first);
+  rt.set(first->next, second);
+  rt.set(second->next, third);
   EXPECT_NO_THROW(inputs.check_invariants(pts));
 }
 

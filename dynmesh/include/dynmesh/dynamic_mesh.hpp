@@ -61,7 +61,7 @@ struct MeshOptions {
 };
 
 namespace detail {
-struct MeshState;
+class MeshState;
 }
 
 class DynamicMesh {

@@ -35,9 +35,8 @@
 //      its newer end was born, whose entries reach its class: nothing loose remains. The
 //      rule reads the vertices within 2^{j+3} of v only: without a larger triangle, both
 //      triangles of every longer edge are in the star, and they decide its looseness.
-//      (Going on for every longer edge and every triangle above 2^{j+1} made 1.8× the
-//      entries on unif1e5, most of them collecting nothing; the vertex counts moved by
-//      under 0.01%.)
+//      (Not every longer edge and every triangle above 2^{j+1}: most of the entries that
+//      would make collect nothing.)
 //   4. A while-iteration of class j (a "round") takes all of Q_j, collects, and processes the
 //      pairs in collection order (a pair found from both ends is no longer loose the second
 //      time: looseness and edges, once lost, never return): a pair still loose gets

@@ -15,6 +15,8 @@
 // tree is a function of the vertex set (not of the insertion order); every vertex lies in
 // the leaf whose cell contains its position, exactly once.
 // Complexity: insert O(depth + kCapacity); a query O(cells met + depth).
+// Paper: Har-Peled & Üngör (2005), whose queries are local in a graded mesh; docs/HPU_ON_CELLS.md,
+// "Where the vertices live".
 #pragma once
 
 #include <algorithm>
@@ -174,8 +176,8 @@ class BucketTree {
   /// The widening of cells that keeps every vertex of a cell inside it despite the rounding
   /// of point location, for a query of radius r around c. position() is off by less than
   /// 2^-51·(|x| + |origin|) in coordinates (the difference, the scale and their product
-  /// each round once); the absolute term is at least 16 times that (it was 2^-40: see
-  /// cellq::ulp_room), and the relative one covers the vertices' distance from c.
+  /// each round once); the absolute term is at least 16 times that (as small as that allows:
+  /// see cellq::ulp_room), and the relative one covers the vertices' distance from c.
   double margin_for(const Point<2>& c, double r) const noexcept {
     const double mag = std::max({std::abs(c[0]), std::abs(c[1]), std::abs(box_.origin[0]), std::abs(box_.origin[1])});
     return r * 0x1p-30 + (mag + box_.side) * 0x1p-46;

@@ -40,7 +40,7 @@
 // Invariants: a question reads nothing but the store; given a store that does not fail, the
 // answers are those of the twin's triangulation on the same vertices (tests/dynmesh/
 // hpu_cells_test.cpp compares meshes on every distribution and angle bound).
-// Complexity: O(1) cells per question in a graded mesh (measured in bench/RESULTS.md).
+// Complexity: O(1) cells per question in a graded mesh (CellQuestionStats counts them).
 // Paper: Acar & Hudson, Figure 5 and Appendix A; Har-Peled & Üngör (2005).
 #pragma once
 
@@ -85,10 +85,9 @@ inline constexpr double kSlack = 0x1p-20;
 
 /// An absolute allowance for the rounding of coordinates near p: computed centres and
 /// differences are off by a few ulps of the coordinates (2^-52 of them each), which can be
-/// large against a small question's radius. 2^-46 is 64 such ulps. It was 2^-40, which in
-/// a cluster of radius 10^-11 in the unit box widened every question by several vertex
-/// spacings: a search read thousands of leaves (bench/RESULTS.md, "Clusters far below the
-/// box's scale").
+/// large against a small question's radius. 2^-46 is 64 such ulps: enough for the rounding,
+/// and no larger, since in a cluster far below the box's scale a larger allowance widens
+/// every question by several vertex spacings and a search reads many more leaves.
 inline double ulp_room(const Point<2>& p) noexcept { return std::max(std::abs(p[0]), std::abs(p[1])) * 0x1p-46; }
 
 /// |(dx, dy)| for radii and thresholds that carry a slack: within two ulps of std::hypot at

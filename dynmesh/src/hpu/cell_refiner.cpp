@@ -1,4 +1,10 @@
 // cell_refiner.cpp — the hpu refinement on cell questions (see cell_refiner.hpp).
+//
+// Purpose: the static cell refiner: the twin's rules asked of a BucketTree through
+// cell_questions.hpp, with an optional log of its steps (CellStep fingerprints).
+// Invariants and Complexity: cell_refiner.hpp's.
+// Paper: Acar & Hudson, Figure 5 and Appendix A; docs/HPU_ON_CELLS.md, "The questions, and
+// why each answer is exact".
 #include "hpu/cell_refiner.hpp"
 
 #include <algorithm>
@@ -13,6 +19,8 @@
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <sac/splitmix64.hpp>
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/predicates.hpp"
@@ -29,14 +37,9 @@ namespace {
 using Vid = std::uint32_t;
 constexpr Vid kNone = 0xffff'ffffu;
 
-std::uint64_t mix(std::uint64_t h) noexcept {
-  h ^= h >> 30;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  h ^= h >> 27;
-  h *= 0x94d049bb133111ebULL;
-  return h ^ (h >> 31);
-}
-std::uint64_t mix(std::uint64_t h, std::uint64_t x) noexcept { return mix(h * 0x9e3779b97f4a7c15ULL + x); }
+// The step log's fingerprints (CellStep): sac::mix64 over the running hash times the golden
+// gamma plus the next word, so that the order of the words counts.
+std::uint64_t mix(std::uint64_t h, std::uint64_t x) noexcept { return sac::mix64(h * sac::kGoldenGamma + x); }
 std::uint64_t mix(std::uint64_t h, const Point<2>& p) noexcept {
   return mix(mix(h, std::bit_cast<std::uint64_t>(p[0] + 0.0)), std::bit_cast<std::uint64_t>(p[1] + 0.0));
 }
@@ -45,7 +48,7 @@ class CellRefiner {
  public:
   CellRefiner(const Box<2>& box, double min_angle_deg, std::size_t max_vertices, CellRefinement& out,
               const CellRefineOptions& options)
-      : box_(box), tree_(box), q_(box, min_angle_deg, tree_, Coords{&pts_}, kNone, out.questions),
+      : box_(box), tree_(box), questions_(box, min_angle_deg, tree_, Coords{&pts_}, kNone, out.questions),
         max_vertices_(max_vertices), out_(out), check_tree_(options.check_tree), log_steps_(options.log_steps) {
     const double lo[2] = {box.origin[0], box.origin[1]}, hi[2] = {box.origin[0] + box.side, box.origin[1] + box.side};
     // The corners first (vertices 0-3: the first entries' order puts them ahead).
@@ -56,17 +59,17 @@ class CellRefiner {
 
   void insert_inputs(std::span<const Point<2>> points) {
     for (const Point<2>& m : side_midpoints(box_, points)) {
-      if (!q_.find(m)) add(m);
+      if (!questions_.find(m)) add(m);
       ++out_.stats.side_splits;
     }
     for (const Point<2>& p : points)
-      if (!q_.find(p)) add(p);
+      if (!questions_.find(p)) add(p);
   }
 
   void refine() {
     for (const Vid v : first_entry_order(box_, pts_)) {
       step_begin();
-      const int c = q_.first_class(v, 0.0);
+      const int c = questions_.first_class(v, 0.0);
       step_end(CellStep::FirstClass, pts_[v], mix(0, pts_[v]), static_cast<std::uint64_t>(c));
       queues_[c].push_back({v, true});
     }
@@ -83,7 +86,7 @@ class CellRefiner {
     for (Vid v = 0; v < pts_.size(); ++v) {
       step_begin();
       std::uint64_t answer = 0;
-      q_.triangles_of(v, 0.0, mine);
+      questions_.triangles_of(v, 0.0, mine);
       for (const auto& [a, b] : mine) {
         out.push_back(canonical_triangle(pts_[v], pts_[a], pts_[b]));
         answer = mix(mix(answer, pts_[a]), pts_[b]);
@@ -143,7 +146,7 @@ class CellRefiner {
     ++out_.stats.entries;
     step_begin();
     const std::size_t before = out_.questions.leaves_read;
-    const bool go_on = q_.collect(v, j, birth, local_pairs_);
+    const bool go_on = questions_.collect(v, j, birth, local_pairs_);
     pairs_.insert(pairs_.end(), local_pairs_.begin(), local_pairs_.end());
     if (go_on) queues_[j + 1].push_back({v, false});
     std::uint64_t answer = go_on;
@@ -158,7 +161,7 @@ class CellRefiner {
     const std::size_t before = out_.questions.leaves_read;
     std::uint64_t answer = 0;
     for (;;) {
-      const CellDecision<Vid> d = q_.decide(p, q, j);
+      const CellDecision<Vid> d = questions_.decide(p, q, j);
       if (d.kind == CellDecision<Vid>::Done) break;
       ++out_.stats.loose_pairs;
       if (d.kind == CellDecision<Vid>::Split) {
@@ -181,7 +184,7 @@ class CellRefiner {
 
   void split_side(Vid a, Vid b, int j) {
     const Point<2> mid = side_midpoint(pts_[a], pts_[b]);
-    if (q_.find(mid)) throw InvariantError("dynmesh: a box edge's midpoint is already a vertex");
+    if (questions_.find(mid)) throw InvariantError("dynmesh: a box edge's midpoint is already a vertex");
     const Vid v = add(mid);
     ++out_.stats.side_splits;
     queues_[j].push_back({v, true});
@@ -190,7 +193,7 @@ class CellRefiner {
   Box<2> box_;
   BucketTree tree_;
   std::vector<Point<2>> pts_;
-  CellQuestions<BucketTree, Vid, Coords> q_;
+  CellQuestions<BucketTree, Vid, Coords> questions_;
   std::size_t max_vertices_;
   CellRefinement& out_;
   bool check_tree_, log_steps_;

@@ -30,7 +30,7 @@
 // Invariants: those of BucketTree after every insertion; the output equals HpuMesh's
 // (tests/dynmesh/hpu_cells_test.cpp checks it on every distribution and angle bound).
 // Complexity: the twin's steps, each on the vertices of the cells its disc meets: O(1)
-// expected in a graded mesh; CellQuestionStats counts them (bench/RESULTS.md).
+// expected in a graded mesh; CellQuestionStats counts them.
 // Paper: Acar & Hudson, Figure 5 and Appendix A; Har-Peled & Üngör (2005), whose
 // algorithm answers the same questions from the quadtree's cells.
 #pragma once

@@ -40,6 +40,7 @@
 
 #include <sac/engine.hpp>
 #include <sac/mod.hpp>
+#include <sac/splitmix64.hpp>
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/errors.hpp"
@@ -98,7 +99,7 @@ struct CellKey {
     return (c.ix >> s) == ix && (c.iy >> s) == iy;
   }
   std::uint64_t hash() const noexcept {
-    std::uint64_t h = static_cast<std::uint64_t>(level) * 0x9e3779b97f4a7c15ULL;
+    std::uint64_t h = static_cast<std::uint64_t>(level) * sac::kGoldenGamma;
     h ^= ix + 0xbf58476d1ce4e5b9ULL + (h << 6) + (h >> 2);
     h ^= iy + 0x94d049bb133111ebULL + (h << 6) + (h >> 2);
     h ^= h >> 31;
@@ -146,12 +147,12 @@ class CellDirectory {
   CellDirectory& operator=(const CellDirectory&) = delete;
 
   /// The cell's node, made (with the default value) if new. Mutator or computation.
-  CellNode* node(sac::Engine& e, const CellKey& k) {
+  CellNode* node(sac::Engine& rt, const CellKey& k) {
     const std::uint64_t h = k.hash();
-    Entry* x = probe(k, h);
+    Entry* x = &table_[probe(k, h)];
     if (x->node) return x->node;
     CellNode* n = &nodes_.emplace_back(k);
-    e.init_default(n->state);
+    rt.init_default(n->state);
     *x = Entry{h, n};
     if (2 * nodes_.size() > table_.size()) grow();
     if (k.level > 0)
@@ -203,7 +204,7 @@ class CellDirectory {
   /// The cell's node if it was ever made, else null. O(1) expected: the questions ask it for
   /// every cell they look at, so it is an open-addressing table whose entries carry the
   /// key's hash (a miss or a collision costs no visit to a node).
-  CellNode* find(const CellKey& k) const { return const_cast<CellDirectory*>(this)->probe(k, k.hash())->node; }
+  CellNode* find(const CellKey& k) const { return table_[probe(k, k.hash())].node; }
 
   /// The exact grid position of x (bucket_tree.hpp's).
   std::array<std::uint64_t, 2> position(const Point<2>& x) const noexcept { return grid_.position(x); }
@@ -256,12 +257,12 @@ class CellDirectory {
     CellNode* node = nullptr;  // null: free (nodes are never removed)
   };
 
-  /// k's entry: its node's, or the free one where it would go (linear probing).
-  Entry* probe(const CellKey& k, std::uint64_t h) {
+  /// The index of k's entry: its node's, or the free one where it would go (linear probing).
+  std::size_t probe(const CellKey& k, std::uint64_t h) const {
     const std::size_t mask = table_.size() - 1;
     for (std::size_t i = h & mask;; i = (i + 1) & mask) {
-      Entry& x = table_[i];
-      if (!x.node || (x.hash == h && x.node->key == k)) return &x;
+      const Entry& x = table_[i];
+      if (!x.node || (x.hash == h && x.node->key == k)) return i;
     }
   }
   void grow() {
@@ -293,7 +294,7 @@ class InputCells {
   InputCells& operator=(const InputCells&) = delete;
 
   /// Adds v (not present, and no other vertex at its position).
-  void insert(sac::Engine& e, const CellVertex* v) {
+  void insert(sac::Engine& rt, const CellVertex* v) {
     const auto q = dir_->position(v->p);
     CellKey k{};
     for (;;) {
@@ -321,11 +322,11 @@ class InputCells {
       }
       k = CellDirectory::cell_at(q, k.level + 1);
     }
-    flush(e);
+    flush(rt);
   }
 
   /// Removes v (present).
-  void erase(sac::Engine& e, const CellVertex* v) {
+  void erase(sac::Engine& rt, const CellVertex* v) {
     const auto q = dir_->position(v->p);
     CellKey k{};
     CellKey merge_at{-1, 0, 0};  // the highest split cell left at capacity or below
@@ -349,7 +350,7 @@ class InputCells {
       m.items = std::move(all);
       touched_.push_back(merge_at);
     }
-    flush(e);
+    flush(rt);
   }
 
   std::size_t size() const noexcept {
@@ -386,7 +387,7 @@ class InputCells {
   }
 
   /// The base value of every touched cell from the tree (a cell not in the map is absent).
-  void flush(sac::Engine& e) {
+  void flush(sac::Engine& rt) {
     for (const CellKey& k : touched_) {
       const auto it = cells_.find(k);
       CellState s;
@@ -396,8 +397,8 @@ class InputCells {
       }
       CellNode* n = dir_->find(k);
       if (!n && s.kind == CellState::Absent) continue;  // never made, and absent anyway
-      if (!n) n = dir_->node(e, k);
-      e.set(n->state, s);
+      if (!n) n = dir_->node(rt, k);
+      rt.set(n->state, s);
     }
     touched_.clear();
   }

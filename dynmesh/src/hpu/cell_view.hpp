@@ -1,40 +1,30 @@
-// cell_view.hpp (private) — how a step of the self-adjusting hpu program reads the cells:
-// its view of the cell store, the rounds of reads that fill it, and the insertion step.
+// cell_view.hpp (private) — CellView: a step's view of the hpu cell store, on which the
+// static questions of cell_questions.hpp run.
 //
-// Purpose: a step (a vertex's first class, an entry's collect, one try of a pair, a vertex's
-// final triangles) runs the static questions of cell_questions.hpp on a CellView. The view
-// holds the cells the step has read and answers searches from them. A cell it has not read
-// is looked up with Engine::peek (its value now, recorded nothing), so every answer is
-// exact, and the cell becomes pending: the run "fails" and must not act. run_step() then
-// reads the pending cells as one Engine::read_many (one trace event, up to 16 cells), nested
-// in the reads before, and runs the step again; that run takes the answers of the run
-// before (the same values: kept()) and does the step's writes. So a step is one read of
-// exactly the cells its answers depend on (1.01 rounds per step measured: bench/RESULTS.md),
-// and it re-runs only when what it used of one of them changes: each read is a read of a
-// projection (Engine::read_many with affected()) that keeps, per cell, the box of the
-// vertices the step's searches could see (CellInterest); a vertex entering or leaving the
-// cell outside it is no change, nor is anything in a cell the step used none of. A leaf that
-// split or merged away moves the read to the cell that now holds the used box, when the
-// vertices inside it are the same (follow_cell, Engine::read_many's follow()); else the step
-// re-runs. The runtime asks when propagation reaches the read, so a change undone before
-// then costs nothing.
+// Purpose: a step (a vertex's first class, an entry's collect, one try of a pair, an
+// insertion, a vertex's final triangles) asks its questions of a CellView. The view holds the
+// cells the step has read (the rounds of step_rounds.hpp add them) and answers searches from
+// them. A cell it has not read is looked up with Engine::peek (its value now, recorded
+// nothing), so every answer is exact, and the cell becomes pending: the run has failed and
+// must not act; its next round reads pending(). Once a run's answers stand, done() gives each
+// read cell what the answers used of it (CellInterest, cell_interest.hpp), which the round
+// that read it keeps.
 // Which cells a step depends on: the leaves a search hands vertices from, a split cell whose
 // children it all prunes, and the leaf an insertion locates. The leaves tile the region the
 // search covers, so any change there (a vertex, a split, a merge) changes one of them; the
 // cells above them are split, implied by the leaves. A bounded search starts at the cells as
 // wide as its box (at most 2 × 2), each at its deepest present ancestor.
 // Invariants: a view's read cells are read by the step's enclosing reads; a run that did
-// not fail used no cell beyond them. A round that runs right after the run it was issued by
-// keeps that run's view, peeked cells included (no write between: a step writes only in its
-// last run); any other (a round re-run by change propagation) rebuilds the view, looking the
-// outer rounds' values up with Engine::current. A failed run writes, allocates and issues
-// nothing but the next round; a run that did not fail answers as the static tree on the same
+// not fail used no cell beyond them. A view kept across runs (begin_run() returned true)
+// holds the cells of the run that handed it over, peeked cells included; any other run
+// starts from no cells. A run that did not fail answers as the static tree on the same
 // vertices, and done() has then given every cell of every round its used box: a vertex the
-// answers depend on lies inside the used box of the leaf that holds it.
+// answers depend on lies inside the used box of the leaf that holds it. One view at a time
+// per directory (its marks live on the directory's nodes).
 // Complexity: a step's questions once, on peeked cells (each peek a directory lookup and a
 // version walk); O(1) cells per question in a graded mesh.
 // Paper: Acar & Hudson, Section 4; Hammer, Acar & Chen (CEAL, 2009) for reads as the unit of
-// re-execution.
+// re-execution; docs/HPU_ON_CELLS.md, "A step peeks, then reads exactly the cells it used".
 #pragma once
 
 #include <algorithm>
@@ -44,149 +34,24 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
-#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <sac/engine.hpp>
-#include <sac/mod.hpp>
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/point.hpp"
+#include "hpu/cell_interest.hpp"
 #include "hpu/cell_questions.hpp"
 #include "hpu/cell_store.hpp"
 
 namespace dynmesh::detail {
 
-inline constexpr std::size_t kCellsPerRead = 16;  // Engine::read_many's most
-
-/// What a step's answers used of a cell it read: the vertices inside a box of the cell, in
-/// 256ths of its width on each axis (inclusive; x0 > x1: none, only the cell's kind). The
-/// default is all of it. A vertex's 256th is found by one fixed sequence of double operations,
-/// monotone in its coordinate, so a vertex inside a box is inside the box's 256ths.
-struct CellInterest {
-  std::uint8_t x0 = 0, y0 = 0, x1 = 255, y1 = 255;
-  static constexpr CellInterest none() noexcept { return {1, 1, 0, 0}; }
-};
-
-static_assert(BucketTree::kMaxLevel < 1023, "CellFrame's widths are normal powers of two");
-
-/// A cell's frame for CellInterest: its lower corner and 256 over its width.
-struct CellFrame {
-  double ox, oy, inv;
-  CellFrame(const Box<2>& box, const CellKey& k) {
-    // box.side · 2^-level: a product by a power of two is rounded as ldexp's result is, and
-    // costs a multiply rather than a libm call (one frame per cell a step read).
-    const double w = box.side * std::bit_cast<double>(static_cast<std::uint64_t>(1023 - k.level) << 52);
-    ox = box.origin[0] + grid_double(k.ix) * w;
-    oy = box.origin[1] + grid_double(k.iy) * w;
-    inv = 256.0 / w;
-  }
-  static std::uint8_t part(double x, double o, double inv) noexcept {
-    // ⌊t⌋ clamped to [0, 255], by truncation, which is the floor for t > 0 (as position()).
-    const double t = (x - o) * inv;
-    return static_cast<std::uint8_t>(!(t > 0) ? 0 : t >= 255 ? 255 : static_cast<int>(t));  // x, o finite
-  }
-  /// The 256ths of the box [x0, x1] × [y0, y1] (any box: parts outside the cell clamp).
-  CellInterest interest(double x0, double y0, double x1, double y1) const noexcept {
-    return {part(x0, ox, inv), part(y0, oy, inv), part(x1, ox, inv), part(y1, oy, inv)};
-  }
-  bool inside(const CellInterest& in, const Point<2>& p) const noexcept {
-    const std::uint8_t x = part(p[0], ox, inv), y = part(p[1], oy, inv);
-    return x >= in.x0 && x <= in.x1 && y >= in.y0 && y <= in.y1;
-  }
-};
-
-/// Are the vertices of `a` inside `in` of frame f the same, in order, as those of `b` inside
-/// it that `keep` accepts?
-template <class Keep>
-bool same_inside(const CellFrame& f, const CellInterest& in, const CellState& a, const CellState& b, Keep&& keep) {
-  std::size_t i = 0, j = 0;
-  for (;; ++i, ++j) {
-    while (i < a.count && !f.inside(in, a.items[i]->p)) ++i;
-    while (j < b.count && !(f.inside(in, b.items[j]->p) && keep(b.items[j]))) ++j;
-    if (i == a.count || j == b.count) return (i == a.count) == (j == b.count);
-    if (a.items[i] != b.items[j]) return false;
-  }
-}
-
-/// Does replacing a cell's value `before` by `after` change what `in` used of it? Nothing
-/// when it used none of it: its answers held whatever the cell held (a split cell whose
-/// children a search all pruned, a cell a round read that the run then did not use). Else a
-/// change of kind always does; for two leaves, the vertices inside the box, in order, must be
-/// the same.
-inline bool interest_changed(const Box<2>& box, const CellKey& k, const CellInterest& in, const CellState& before,
-                             const CellState& after) {
-  if (in.x0 > in.x1) return false;
-  if (before.kind != after.kind) return true;
-  if (before.kind != CellState::Leaf) return before != after;
-  return !same_inside(CellFrame(box, k), in, before, after, [](const CellVertex*) { return true; });
-}
-
-/// A read of a leaf n with interest `in` whose value at the read's time is no longer a leaf:
-/// the cell that now holds what it used, or null (then the step re-runs). `seen`: n's leaf
-/// when the step ran; value(node): a cell's value at the read's time (null: none). On
-/// success, *in becomes the interest in the returned cell's frame.
-///   - n split: down to the leaf inside which the used box lies, at least one 256th from its
-///     children's border on each axis, so that every vertex inside it lies in that child
-///     (the rounding of a 256th is far below one).
-///   - n absent (a merge above it): up to the leaf that holds its region now.
-/// Either way the cell must hold, inside the used box in n's frame, exactly the vertices
-/// `seen` held there, in order: the step's answers used no others (each vertex they used
-/// lies inside it), so they stand. The new interest widens the old one by a 256th on each
-/// side of each level's change of frame: a vertex inside the old is inside it however the
-/// two frames round.
-/// An interest of the whole cell (an insertion's leaf, which the insertion writes) never
-/// follows.
-template <class Value>
-CellNode* follow_cell(const Box<2>& box, const CellDirectory& dir, CellNode* n, CellInterest* in,
-                      const CellState& seen, const CellState& now, Value&& value) {
-  const CellInterest u = *in;
-  if (seen.kind != CellState::Leaf || now.kind == CellState::Leaf) return nullptr;
-  if (u.x0 == 0 && u.y0 == 0 && u.x1 == 255 && u.y1 == 255) return nullptr;
-  const auto clamp = [](int v) { return static_cast<std::uint8_t>(std::clamp(v, 0, 255)); };
-  CellInterest b = u;
-  CellNode* d = n;
-  const CellState* s = nullptr;
-  if (now.kind == CellState::Split) {
-    for (;;) {
-      const int qx = b.x1 <= 126 ? 0 : b.x0 >= 129 ? 1 : -1;
-      const int qy = b.y1 <= 126 ? 0 : b.y0 >= 129 ? 1 : -1;
-      if (qx < 0 || qy < 0) return nullptr;
-      d = d->child[static_cast<unsigned>(qx | (qy << 1))];
-      if (!d) return nullptr;
-      b = CellInterest{clamp(2 * b.x0 - 256 * qx - 1), clamp(2 * b.y0 - 256 * qy - 1),
-                       clamp(2 * b.x1 + 2 - 256 * qx), clamp(2 * b.y1 + 2 - 256 * qy)};
-      s = value(d);
-      if (!s || s->kind == CellState::Absent) return nullptr;
-      if (s->kind == CellState::Leaf) break;
-    }
-    if (!same_inside(CellFrame(box, n->key), u, seen, *s, [](const CellVertex*) { return true; })) return nullptr;
-  } else {
-    for (;;) {
-      if (!d->parent) return nullptr;
-      const int qx = static_cast<int>(d->key.ix & 1), qy = static_cast<int>(d->key.iy & 1);
-      b = CellInterest{clamp((b.x0 + 256 * qx) / 2 - 1), clamp((b.y0 + 256 * qy) / 2 - 1),
-                       clamp((b.x1 + 1 + 256 * qx) / 2 + 1), clamp((b.y1 + 1 + 256 * qy) / 2 + 1)};
-      d = d->parent;
-      s = value(d);
-      if (!s) return nullptr;
-      if (s->kind == CellState::Leaf) break;
-      if (s->kind == CellState::Split) return nullptr;
-    }
-    // The leaf holds the vertices of its siblings' regions too: only n's count.
-    const CellKey& k = n->key;
-    const auto in_n = [&](const CellVertex* v) { return k.contains(CellDirectory::cell_at(dir.position(v->p), k.level)); };
-    if (!same_inside(CellFrame(box, k), u, seen, *s, in_n)) return nullptr;
-  }
-  *in = b;
-  return d;
-}
-
 class CellView {
  public:
   using V = const CellVertex*;
 
-  CellView(sac::Engine& e, CellDirectory& dir) : e_(&e), dir_(&dir), box_(dir.box()) {
+  CellView(sac::Engine& rt, CellDirectory& dir) : rt_(&rt), dir_(&dir), box_(dir.box()) {
     dir.claim_marks(this);
     for (int l = 0; l <= BucketTree::kMaxLevel; ++l) width_[l] = std::ldexp(box_.side, -l);
   }
@@ -196,12 +61,14 @@ class CellView {
 
   // ---------------------------------------------------------------- filling
 
-  /// A new round. `parent`: the round this one is nested in (null for a step's first run).
-  /// When the view's last run was that round's (it needed cells and issued this one), the
-  /// view keeps its cells, peeked ones included (no write between), and returns true: the
-  /// caller adds only this round's, and kept() tells the step that its last run's answers
-  /// stand (see kept()). Otherwise it forgets every cell and returns false.
-  bool reset(const void* parent = nullptr, std::uint32_t serial = 0) {
+  /// The start of a run of a step (step_rounds.hpp's states): S1, a step's first run
+  /// (no arguments), or S4, a round's run, where `parent` is the round this one is nested in
+  /// (null for a first round, which names the run that issued it by `serial` instead). When
+  /// the view's last run is the one that issued this round (S3 handed the view over to it),
+  /// the view keeps its cells, peeked ones included (nothing was written between), and
+  /// returns true: the caller adds only this round's cells, and kept() tells the step that
+  /// its last run's answers stand. Otherwise it forgets every cell and returns false.
+  bool begin_run(const void* parent = nullptr, std::uint32_t serial = 0) {
     kept_ = parent != nullptr ? parent == owner_ : serial != 0 && serial == owner_serial_;
     owner_ = nullptr;
     owner_serial_ = 0;
@@ -298,8 +165,7 @@ class CellView {
   /// used_all().
   template <class Keep, class F>
   void search(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f) const {
-    auto* self = const_cast<CellView*>(this);
-    self->run_search(focus, margin, keep, f, false, 0.0);
+    run_search(focus, margin, keep, f, false, 0.0);
   }
   /// search() for a keep() that accepts no cell whose box (widened by margin) lies farther
   /// than radius() from focus, where radius() only shrinks as the search goes (a nearest
@@ -312,36 +178,32 @@ class CellView {
   template <class Keep, class F, class Radius>
   void search_near(const Point<2>& focus, double /*scale*/, double margin, Keep&& keep, F&& f,
                    Radius&& radius) const {
-    const_cast<CellView*>(this)->run_search_near(focus, margin, keep, f, radius);
+    run_search_near(focus, margin, keep, f, radius);
   }
   /// search() over the cells that cover the box [focus ± R] only (starts_for), for a
   /// keep() that accepts no cell beyond it. Unlike search_within(), the question states
   /// afterwards what its answer used, as after search(); more search_from()s may come first.
   template <class Keep, class F>
   void search_from(const Point<2>& focus, double R, double margin, Keep&& keep, F&& f) const {
-    auto* self = const_cast<CellView*>(this);
-    self->run_search(focus, margin, keep, f, false, R);
+    run_search(focus, margin, keep, f, false, R);
   }
   /// The last search()'s answer used the vertices within r of c only (of the leaves it met).
   void used_within(const Point<2>& c, double r) const {
-    auto* self = const_cast<CellView*>(this);
     const double R = r * (1 + 0x1p-20) + cellq::ulp_room(c);
-    for (CellNode* n : visited_) self->widen(self->mark(n), c, R);
-    self->visited_.clear();
+    for (CellNode* n : visited_) widen(mark(n), c, R);
+    visited_.clear();
   }
   /// The last search()'s answer used the vertices inside the closed box [x0, x1] × [y0, y1]
   /// only (of the leaves it met). A degenerate box (a stretch of a box side) is exact: a
   /// vertex's 256th and the box's come from the same monotone function.
   void used_box(double x0, double y0, double x1, double y1) const {
-    auto* self = const_cast<CellView*>(this);
-    for (CellNode* n : visited_) widen(self->mark(n), x0, y0, x1, y1);
-    self->visited_.clear();
+    for (CellNode* n : visited_) widen(mark(n), x0, y0, x1, y1);
+    visited_.clear();
   }
   /// The last search()'s answer may depend on any vertex of the leaves it met.
   void used_all() const {
-    auto* self = const_cast<CellView*>(this);
-    for (CellNode* n : visited_) self->mark(n).all = true;
-    self->visited_.clear();
+    for (CellNode* n : visited_) mark(n).all = true;
+    visited_.clear();
   }
 
   /// search() for a keep() that accepts no cell farther than radius from focus: it starts at
@@ -349,21 +211,22 @@ class CellView {
   template <class Keep, class F>
   void search_within(const Point<2>& focus, double radius, double /*scale*/, double margin, Keep&& keep,
                      F&& f) const {
-    auto* self = const_cast<CellView*>(this);
-    self->run_search(focus, margin, keep, f, true, radius + 3 * margin);
+    run_search(focus, margin, keep, f, true, radius + 3 * margin);
   }
 
-  /// After a run that needed cells: it was the run of round `self`, which issues the next.
+  /// S3 after a round's run that failed: the view now belongs to the round `self`, whose
+  /// run issues the next round (nested in it), which then finds the view kept.
   void hand_over(const void* self) noexcept { owner_ = self; }
-  /// The same after a step's first run: its first round names the run by the serial.
-  std::uint32_t hand_over_root() noexcept {
+  /// S3 after a step's first run that failed: the same, the run named by a serial (it has no
+  /// round), which its first round carries.
+  std::uint32_t hand_over_first_run() noexcept {
     if (++serial_ == 0) serial_ = 1;
     return owner_serial_ = serial_;
   }
 
-  /// The leaf that holds grid position q, and its value (pending when unread).
-  std::pair<CellNode*, const CellState*> locate(const std::array<std::uint64_t, 2>& q, double /*scale*/) {
-    CellNode* n = deepest_present(CellDirectory::cell_at(q, BucketTree::kMaxLevel));
+  /// The leaf that holds grid position pos, and its value (pending when unread).
+  std::pair<CellNode*, const CellState*> locate(const std::array<std::uint64_t, 2>& pos, double /*scale*/) {
+    CellNode* n = deepest_present(CellDirectory::cell_at(pos, BucketTree::kMaxLevel));
     CellMark& x = resolve(n);
     if (x.tag != Tag::Leaf) throw InvariantError("dynmesh: CellView: a position with no leaf");
     touch(n, x);
@@ -400,16 +263,16 @@ class CellView {
   /// n's mark, its state looked up now if the view does not know it: a peek, which records
   /// nothing (the runtime's guess for a prefetch); a search that uses the cell makes it
   /// pending, and the step reads it before it acts.
-  CellMark& resolve(CellNode* n) {
+  CellMark& resolve(CellNode* n) const {
     CellMark& x = mark(n);
     if (x.tag == Tag::Unknown) {
-      x.state = e_->peek(n->state);
+      x.state = rt_->peek(n->state);
       x.tag = tag_of(x.state);
     }
     return x;
   }
 
-  void touch(CellNode* n, CellMark& x) {
+  void touch(CellNode* n, CellMark& x) const {
     if (x.read || x.pending) return;
     x.pending = true;
     pending_.push_back(n);
@@ -417,11 +280,10 @@ class CellView {
 
   /// The deepest cell on k's path to the root that is not absent (a leaf or a split; the
   /// path is split cells, then the leaf, then absent ones, and a cell never made is absent).
-  CellNode* deepest_present(const CellKey& k) {
+  CellNode* deepest_present(const CellKey& k) const {
     // From the last answer by the tree's links, when it is near k: a step's searches are
     // mostly in one region, where the nodes are in the cache, but a lookup of a key not
-    // looked up before misses on the table however hot its node is (bench/RESULTS.md, "The
-    // program's searches start from their last answer"). Else by the lookups.
+    // looked up before misses on the table however hot its node is. Else by the lookups.
     if (finger_) {
       const CellKey& f = finger_->key;
       const int m = std::min(f.level, k.level);
@@ -443,7 +305,7 @@ class CellView {
 
   /// deepest_present(k) from n, whose ancestor at level c (≤ k.level) is k's: up to that
   /// ancestor, up past absent cells, then down k's path while the cells are split.
-  CellNode* walk_from(CellNode* n, int c, const CellKey& k) {
+  CellNode* walk_from(CellNode* n, int c, const CellKey& k) const {
     while (n->key.level > c) n = n->parent;
     while (resolve(n).tag == Tag::Absent) n = n->parent;  // the root is present
     while (n->key.level < k.level && resolve(n).tag == Tag::Split) {
@@ -455,7 +317,7 @@ class CellView {
   }
 
   /// deepest_present(k) by directory lookups: a binary search over the levels.
-  CellNode* probe_deepest_present(const CellKey& k) {
+  CellNode* probe_deepest_present(const CellKey& k) const {
     int lo = 0, hi = k.level;  // the root is present
     const auto present = [&](int level) {
       const int s = k.level - level;
@@ -488,7 +350,7 @@ class CellView {
   }
 
   template <class Keep, class F>
-  void run_search(const Point<2>& focus, double margin, Keep& keep, F& f, bool bounded, double R) {
+  void run_search(const Point<2>& focus, double margin, Keep& keep, F& f, bool bounded, double R) const {
     // Only a search_from() may come between a search and the statement of its use.
     if (!visited_.empty() && !(searched_from_ && !bounded && R != 0))
       throw InvariantError("dynmesh: CellView: a search's use was not stated");
@@ -513,7 +375,7 @@ class CellView {
   }
 
   template <class Keep, class F, class Radius>
-  void run_search_near(const Point<2>& focus, double margin, Keep& keep, F& f, Radius& radius) {
+  void run_search_near(const Point<2>& focus, double margin, Keep& keep, F& f, Radius& radius) const {
     const auto from_root = [&] { run_search(focus, margin, keep, f, false, 0.0); };
     const double x1 = box_.origin[0] + box_.side, y1 = box_.origin[1] + box_.side;
     if (!(focus[0] >= box_.origin[0] && focus[0] <= x1 && focus[1] >= box_.origin[1] && focus[1] <= y1))
@@ -575,10 +437,10 @@ class CellView {
 
   /// Where a search of the box [focus ± R] starts: the cells of the finest level as wide as
   /// the box (at most 2 × 2 of them cover it), each replaced by its deepest present ancestor
-  /// (itself when present), without repeats, nearest to the focus first. Starting at the
-  /// smallest cell holding the whole box instead walked down from the root whenever the box
-  /// straddled a coarse cell's boundary.
-  std::size_t starts_for(const Point<2>& focus, double R, std::array<CellNode*, 4>& out) {
+  /// (itself when present), without repeats, nearest to the focus first. Not the smallest
+  /// cell holding the whole box: for a box that straddles a coarse cell's boundary that is a
+  /// cell near the root, and the search would walk down from there.
+  std::size_t starts_for(const Point<2>& focus, double R, std::array<CellNode*, 4>& out) const {
     const auto a = dir_->position(Point<2>{focus[0] - R, focus[1] - R});
     const auto b = dir_->position(Point<2>{focus[0] + R, focus[1] + R});
     const int g = BucketTree::kMaxLevel - std::bit_width(std::max(b[0] - a[0], b[1] - a[1]));
@@ -607,7 +469,7 @@ class CellView {
   /// deepest_present(k) for a start cell, remembered for the step: the probes of one
   /// step (a star walk's left searches around one vertex) ask for the same few cells of a
   /// level again and again, and the walk to each costs a resolve() per cell on its way.
-  CellNode* start_cell(const CellKey& k) {
+  CellNode* start_cell(const CellKey& k) const {
     StartMemo& m = start_memo_[(k.ix * 5 + k.iy * 3 + static_cast<std::uint64_t>(k.level)) & (kStartMemo - 1)];
     if (m.gen == gen_ && m.level == k.level && m.ix == k.ix && m.iy == k.iy) {
 #ifdef SAC_DEBUG_CHECKS
@@ -620,7 +482,7 @@ class CellView {
     return m.node;
   }
 
-  CellNode* root() {
+  CellNode* root() const {
     if (!root_) root_ = dir_->find(CellKey{});
     return root_;
   }
@@ -629,7 +491,7 @@ class CellView {
   /// a split cell whose children it all prunes; those cells are used (touched). Every other
   /// cell it passes is an ancestor of a used one, known split through it.
   template <class Keep, class F>
-  void search_node(CellNode* n, const Point<2>& focus, double margin, Keep& keep, F& f, bool& stop) {
+  void search_node(CellNode* n, const Point<2>& focus, double margin, Keep& keep, F& f, bool& stop) const {
     const CellKey& k = n->key;
     double x0, y0, x1, y1;
     cell_box(k, margin, x0, y0, x1, y1);
@@ -667,12 +529,18 @@ class CellView {
     }
   }
 
-  sac::Engine* e_;
+  // The members marked mutable are the searches' scratch. The questions of
+  // cell_questions.hpp take their store as a const Store& (the static BucketTree is the other
+  // store they run on), and a search of this view, though it changes no cell, peeks at cells
+  // (pending_, the marks on the nodes), records the leaves it met (visited_, the region) and
+  // remembers where it ended (finger_, start_memo_, root_) — state of the running step that a
+  // const question must be able to change.
+  sac::Engine* rt_;
   CellDirectory* dir_;
   Box<2> box_;
   std::array<double, BucketTree::kMaxLevel + 1> width_{};
-  CellNode* root_ = nullptr;  // the directory's, made before any step runs
-  std::uint32_t gen_ = 0;     // the marks of this generation are this step's
+  mutable CellNode* root_ = nullptr;  // the directory's, made before any step runs
+  std::uint32_t gen_ = 0;             // the marks of this generation are this step's
   struct ReadCell {
     CellNode* node;
     const CellState* state;
@@ -680,17 +548,17 @@ class CellView {
   };
   std::vector<ReadCell> read_;
   std::size_t settled_ = 0;  // read_'s prefix settle() has seen
-  std::vector<CellNode*> pending_;
+  mutable std::vector<CellNode*> pending_;
   // The running search's disc of used vertices (region_), or, for a search() without one,
   // the leaves it met, until the question states its use.
-  bool region_ = false;
-  Point<2> region_c_{};
-  double region_r_ = 0;
-  std::vector<CellNode*> visited_;
-  bool searched_from_ = false;  // the last search was a search_from()
+  mutable bool region_ = false;
+  mutable Point<2> region_c_{};
+  mutable double region_r_ = 0;
+  mutable std::vector<CellNode*> visited_;
+  mutable bool searched_from_ = false;  // the last search was a search_from()
   // deepest_present's last answer: where the next starts (its walk, or its lookups at the
   // answer's level first), a hint only, whose state is looked up again.
-  CellNode* finger_ = nullptr;
+  mutable CellNode* finger_ = nullptr;
   // start_cell()'s answers of this generation, by key (direct-mapped).
   struct StartMemo {
     std::uint32_t gen = 0;
@@ -699,136 +567,15 @@ class CellView {
     CellNode* node = nullptr;
   };
   static constexpr std::size_t kStartMemo = 16;
-  std::array<StartMemo, kStartMemo> start_memo_{};
-  std::size_t leaves_read_ = 0;
+  mutable std::array<StartMemo, kStartMemo> start_memo_{};
+  mutable std::size_t leaves_read_ = 0;
   Counts counts_;
-  // The run the view was last filled for, when it failed (see reset()).
+  // The run the view was handed over to when it failed (S3; see begin_run()).
   const void* owner_ = nullptr;     // a round, by its closure
   std::uint32_t owner_serial_ = 0;  // or the step's first run, by its serial
   std::uint32_t serial_ = 0;
   bool kept_ = false;
 };
 
-// -------------------------------------------------------------------- rounds of reads
-
-/// The part of a round's closure that later rounds look through: the round before, and how
-/// many cells this one read (the cells follow it in CellRound).
-struct CellRoundHead {
-  const CellRoundHead* parent;
-  std::uint16_t n;    // cells read
-  std::uint16_t cap;  // N
-  std::uint32_t serial;  // a first round: its step's run that issued it (CellView::hand_over)
-};
-
-/// A round's cells, and what the step used of each (the read's own state: the step's last
-/// run that did not fail wrote it, CellView::done(); the read asks it on every change).
-template <std::size_t N>
-struct CellRoundCells {
-  CellRoundHead head;
-  mutable std::array<CellNode*, N> cells;  // follow() may move a read to another cell
-  mutable std::array<CellInterest, N> used;
-};
-
-inline CellNode* const* cells_of(const CellRoundHead* h) {
-  // Every CellRound<Step, N> starts with a CellRoundCells<N> (standard layout), whose cells
-  // follow the head at the same offset for every N, and whose `used` follows the N cells.
-  return reinterpret_cast<const CellRoundCells<1>*>(h)->cells.data();
-}
-inline CellInterest* used_of(const CellRoundHead* h) {
-  return const_cast<CellInterest*>(reinterpret_cast<const CellInterest*>(cells_of(h) + h->cap));
-}
-
-template <class Step>
-void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::uint32_t serial,
-                 std::span<CellNode* const> misses);
-
-/// One round of a step: reads its cells, then runs the step on the view of all its rounds.
-/// A read of a projection (sac::Engine::read_many): a change of a cell re-runs it only when
-/// it changes what the step used of that cell.
-template <class Step, std::size_t N>
-struct CellRound {
-  CellRoundCells<N> c;
-  Step step;
-
-  void operator()(sac::Engine& e, std::span<const CellState* const> vals) const {
-    CellView& v = *step.view(e);
-    const bool kept = v.reset(c.head.parent, c.head.serial);  // the view before is still there
-    for (std::uint32_t i = 0; i < c.head.n; ++i) v.add(c.cells[i], vals[i], &c.used[i]);
-    if (!kept)
-      for (const CellRoundHead* r = c.head.parent; r; r = r->parent) {
-        CellNode* const* cells = cells_of(r);
-        CellInterest* used = used_of(r);
-        for (std::uint32_t i = 0; i < r->n; ++i) v.add(cells[i], &e.current(cells[i]->state), &used[i]);
-      }
-    v.settle();
-    if (!step.run(e, v)) {
-      v.hand_over(&c.head);
-      issue_round(e, step, &c.head, 0, v.pending());
-    }
-  }
-
-  bool affected(std::size_t i, const CellState& before, const CellState& after) const {
-    return interest_changed(step.box(), c.cells[i]->key, c.used[i], before, after);
-  }
-
-  /// A leaf that split or merged away: its read moves to the cell that holds what the step
-  /// used of it, when that is unchanged (follow_cell).
-  const sac::Mod<CellState>* follow(std::size_t i, const CellState& seen, const CellState& now,
-                                    const sac::Engine::At& at) const {
-    CellInterest in = c.used[i];
-    CellNode* d = follow_cell(step.box(), step.dir(), c.cells[i], &in, seen, now,
-                              [&](const CellNode* x) { return at.value(x->state); });
-    if (!d) return nullptr;
-    c.cells[i] = d;
-    c.used[i] = in;
-    return &d->state;
-  }
-};
-
-template <class Step, std::size_t N>
-void issue_round_n(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::uint32_t serial,
-                   std::span<CellNode* const> misses) {
-  static_assert(std::is_standard_layout_v<CellRoundCells<N>>);
-  static_assert(offsetof(CellRoundCells<N>, cells) == offsetof(CellRoundCells<1>, cells));
-  static_assert(offsetof(CellRoundCells<N>, used) == offsetof(CellRoundCells<N>, cells) + N * sizeof(CellNode*));
-  CellRound<Step, N> r{{{parent, static_cast<std::uint16_t>(misses.size()), static_cast<std::uint16_t>(N), serial}, {}, {}},
-                       step};
-  std::array<const sac::Mod<CellState>*, N> mods;
-  for (std::size_t i = 0; i < misses.size(); ++i) {
-    r.c.cells[i] = misses[i];
-    mods[i] = &misses[i]->state;
-  }
-  e.read_many(std::span<const sac::Mod<CellState>* const>(mods.data(), misses.size()), std::move(r));
-}
-
-template <class Step>
-void issue_round(sac::Engine& e, const Step& step, const CellRoundHead* parent, std::uint32_t serial,
-                 std::span<CellNode* const> misses) {
-  if (misses.empty()) throw InvariantError("dynmesh: a step failed without a pending cell");
-  if (misses.size() > kCellsPerRead) misses = misses.first(kCellsPerRead);  // the rest next round
-  step.view(e)->count_round(misses.size());
-  if (misses.size() <= 2) return issue_round_n<Step, 2>(e, step, parent, serial, misses);
-  if (misses.size() <= 4) return issue_round_n<Step, 4>(e, step, parent, serial, misses);
-  if (misses.size() <= 8) return issue_round_n<Step, 8>(e, step, parent, serial, misses);
-  issue_round_n<Step, kCellsPerRead>(e, step, parent, serial, misses);
-}
-
-/// Runs a step: step.run(e, view) on an empty view, which peeks at every cell the step's
-/// questions use and so fails (unless they use none); then, round after round, on the
-/// cells it used, read, until a run does not fail (one round when it uses at most 16
-/// cells). A run in a kept view (CellView::kept()) takes the answers of the run before from
-/// the step's scratch. Step: copyable (it is each round's closure), with CellView*
-/// view(Engine&), const Box<2>& box() (the store's) and bool run(Engine&, CellView&). run
-/// returns false when CellView::done() does (the view failed), and has then written,
-/// allocated and issued nothing; otherwise it does the step's effects, in this order: writes and
-/// allocations first (they use the view and the program's scratch), then the reads, memo
-/// calls and run_step calls that continue the program (a write after an issued call would
-/// run that call on the spot, and it would reuse the view).
-template <class Step>
-void run_step(sac::Engine& e, const Step& step) {
-  CellView& v = *step.view(e);
-  v.reset();
-  if (!step.run(e, v)) issue_round(e, step, nullptr, v.hand_over_root(), v.pending());
-}
 
 }  // namespace dynmesh::detail

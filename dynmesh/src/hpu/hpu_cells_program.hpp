@@ -5,7 +5,7 @@
 // static twin HpuMesh (hpu_mesh.cpp) on the current input points, box and angle, bit for bit.
 // It takes the twin's decisions (rules 1-6 of dynmesh/hpu_mesh.hpp) in the twin's order,
 // asking the questions of cell_questions.hpp (the same code as the static cell refiner) on a
-// view of the cell store (cell_view.hpp):
+// view of the cell store (cell_view.hpp), each step run by the protocol of step_rounds.hpp:
 //   1. the initial vertices: the box's corners in (Morton, xy) order, then the input list
 //      (the inputs and their side midpoints in insertion_less order, kept by the mutator,
 //      hpu_inputs.hpp), whose vertices are also the store's base values (cell_store.hpp);
@@ -26,7 +26,7 @@
 //      a leaf finds the triangles whose (x, y)-smallest corner it is, from its star, and
 //      makes them one block of the change feed (hpu_mesh_feed.hpp).
 // Lists by destination passing, with the memo keys that keep an update local
-// (docs/EXPERIMENTS.md, "What made the trace distance flat"): every list cell is a keyed
+// (docs/HPU_ON_CELLS.md, "The rest"): every list cell is a keyed
 // allocation (an entry by (vertex, class, birth), a pair by (its collector's entry, p, q), a
 // class by j, a round by the modifiable holding its first entry), a list step's key holds its
 // predecessor's predecessor, and phases that follow a list pass are issued after it as
@@ -36,18 +36,18 @@
 // entry's collect, a pair's tries, a vertex's final triangles) is a memo of its own keyed
 // without it: the collect and the tries with Engine::memo_near, so that an entry that an
 // update moved far runs anew rather than undoing all the trace up to its old step. Each step
-// reads its cells as a few multi-reads (cell_view.hpp), so its cost is a few events however
+// reads its cells as a few multi-reads (step_rounds.hpp), so its cost is a few events however
 // many vertices it looks at, and it re-runs only when a cell it read changes.
 // Invariants: those of the twin's rules; every list is terminated by its pass before a later
 // phase reads it; a vertex has at most one entry per class, so the entry keys are unique in a
 // run; a step writes, allocates and issues only in the round whose view did not fail.
 // Complexity: the twin's steps (O(n lg n + m) expected), each O(1) cells in a graded mesh. An
 // update re-runs the steps whose cells it changes, plus list steps up to the next cell
-// appended as before, and a class's tail copies up to the next block that holds it
-// (bench/RESULTS.md, docs/EXPERIMENTS.md).
+// appended as before, and a class's tail copies up to the next block that holds it.
 // Paper: Acar & Hudson, Figure 5 and Appendix A (DynHPU), Section 4; Har-Peled & Üngör (2005);
 // Üngör, "Off-centers" (2004); Acar, Ahmed & Blume (2008) for keyed allocation and
-// destination passing.
+// destination passing; docs/DESIGN.md, "DynHPU"; docs/HPU_ON_CELLS.md, "Stage 2: the
+// self-adjusting program".
 #pragma once
 
 #include <algorithm>
@@ -70,7 +70,7 @@
 #include "dynmesh/point.hpp"
 #include "hpu/cell_questions.hpp"
 #include "hpu/cell_store.hpp"
-#include "hpu/cell_view.hpp"
+#include "hpu/step_rounds.hpp"
 #include "hpu/hpu_geometry.hpp"
 #include "hpu/hpu_inputs.hpp"
 #include "hpu/hpu_cells_state.hpp"
@@ -84,7 +84,7 @@ struct HcPair;
 
 /// A queue entry (the twin's Entry), keyed by (vertex, class, birth).
 struct HcEntry {
-  HcEntry(HV x, bool b) : v(x), birth(b) {}
+  HcEntry(HV vertex, bool is_birth) : v(vertex), birth(is_birth) {}
   HcEntry(const HcEntry&) = delete;
   HcEntry& operator=(const HcEntry&) = delete;
   HV v;
@@ -104,7 +104,7 @@ struct HcBirths {
 
 /// A collected pair p→q, keyed by (its collector's entry, p, q).
 struct HcPair {
-  HcPair(HV a, HV b) : p(a), q(b) {}
+  HcPair(HV from, HV to) : p(from), q(to) {}
   HcPair(const HcPair&) = delete;
   HcPair& operator=(const HcPair&) = delete;
   HV p;
@@ -115,7 +115,7 @@ struct HcPair {
 
 /// An initial vertex, keyed by it: its class, and the rest of the list.
 struct HcCell {
-  explicit HcCell(HV x) : v(x) {}
+  explicit HcCell(HV vertex) : v(vertex) {}
   HcCell(const HcCell&) = delete;
   HcCell& operator=(const HcCell&) = delete;
   HV v;
@@ -126,7 +126,7 @@ struct HcCell {
 
 /// A size class, keyed by j.
 struct HcClass {
-  explicit HcClass(int c) : j(c) {}
+  explicit HcClass(int size_class) : j(size_class) {}
   HcClass(const HcClass&) = delete;
   HcClass& operator=(const HcClass&) = delete;
   int j;
@@ -147,7 +147,7 @@ struct HcClassSet {
 /// A block of the initial vertices: from the one that opens it (HpuCellsProgram::opens_block;
 /// the list's head for the first) to the next block's. Keyed by that vertex (null: the first).
 struct HcCellBlock {
-  explicit HcCellBlock(HcCell* f) : first(f) {}
+  explicit HcCellBlock(HcCell* opener) : first(opener) {}
   HcCellBlock(const HcCellBlock&) = delete;
   HcCellBlock& operator=(const HcCellBlock&) = delete;
   HcCell* first;
@@ -196,7 +196,7 @@ struct HcStepCounts {
   std::array<std::uint64_t, kKinds> done{};
   std::uint64_t total() const noexcept {
     std::uint64_t t = 0;
-    for (auto x : done) t += x;
+    for (auto count : done) t += count;
     return t;
   }
 };
@@ -210,13 +210,14 @@ struct HpuCellsProgram {
   };
   using Questions = CellQuestions<CellView, HV, Coords>;
 
-  HpuCellsProgram(sac::Engine& e, CellDirectory& d, sac::Mod<HpuInputNode*>& in,
-                  const std::array<const CellVertex*, 4>& box_corners, double min_angle_deg, HpuMeshFeed& f,
-                  SteinerVertices& sv)
-      : dir(&d), input(&in), corners(box_corners), feed(&f), steiner(&sv), view(e, d),
-        q(d.box(), min_angle_deg, view, Coords{}, nullptr, stats) {}
-  HpuCellsProgram(sac::Engine& e, HpuCellsState& st, double min_angle_deg)
-      : HpuCellsProgram(e, st.cells, st.inputs.head(), st.corner_vertices(), min_angle_deg, st.feed, st.steiner) {}
+  HpuCellsProgram(sac::Engine& rt, CellDirectory& cells, sac::Mod<HpuInputNode*>& inputs,
+                  const std::array<const CellVertex*, 4>& box_corners, double min_angle_deg, HpuMeshFeed& out,
+                  SteinerVertices& steiner_pool)
+      : dir(&cells), input(&inputs), corners(box_corners), feed(&out), steiner(&steiner_pool), view(rt, cells),
+        questions(cells.box(), min_angle_deg, view, Coords{}, nullptr, stats) {}
+  HpuCellsProgram(sac::Engine& rt, HpuCellsState& state, double min_angle_deg)
+      : HpuCellsProgram(rt, state.cells, state.inputs.head(), state.corner_vertices(), min_angle_deg, state.feed,
+                        state.steiner) {}
   HpuCellsProgram(const HpuCellsProgram&) = delete;
   HpuCellsProgram& operator=(const HpuCellsProgram&) = delete;
 
@@ -229,9 +230,9 @@ struct HpuCellsProgram {
   CellView view;  // the running step's (steps run one at a time)
   CellQuestionStats stats;
   HcStepCounts steps;
-  Questions q;
+  Questions questions;
   // Scratch of the running step: its answers, which a run in a kept view takes as they are
-  // (CellView::kept()).
+  // (S4a of step_rounds.hpp, CellView::kept()).
   int first_class = 0;
   bool go_on = false;
   std::vector<std::array<HV, 2>> pairs, tris;
@@ -244,219 +245,239 @@ struct HpuCellsProgram {
   /// The distance scale of class j.
   static double scale_of(int j) noexcept { return std::ldexp(1.0, std::clamp(j, -1070, 1020)); }
 
+  /// What the five steps (FirstClassStep, CollectStep, TryStep, InsertStep, FinalStep) share:
+  /// the program, whose view, store and scratch they use, and the part of run_step's Step
+  /// interface that comes from it (step_rounds.hpp). Each step adds its own operands and
+  /// run(). A step is its rounds' closure, so it holds pointers only.
+  struct StepBase {
+    HpuCellsProgram* program;
+    CellView* view(sac::Engine&) const { return &program->view; }
+    const Box<2>& box() const noexcept { return program->box(); }
+    const CellDirectory& dir() const noexcept { return *program->dir; }
+  };
+
   // ---------------------------------------------------------------- 1. initial vertices
 
-  static void main(sac::Engine& e, HpuCellsProgram* pg) {
-    pg->start = e.alloc<HcStart>(0);
-    std::array<HV, 4> order = pg->corners;
-    std::sort(order.begin(), order.end(), [pg](HV a, HV b) { return morton_less(pg->box(), a->p, b->p); });
-    sac::Mod<HcCell*>* dest = &pg->start->cells;
+  static void main(sac::Engine& rt, HpuCellsProgram* program) {
+    program->start = rt.alloc<HcStart>(0);
+    std::array<HV, 4> order = program->corners;
+    std::sort(order.begin(), order.end(), [program](HV a, HV b) { return morton_less(program->box(), a->p, b->p); });
+    sac::Mod<HcCell*>* dest = &program->start->cells;
     HcCell* head = nullptr;  // the list's first cell: a corner's, fixed
     for (HV v : order) {
-      HcCell* c = e.alloc<HcCell>(v, v);
-      e.write(*dest, c);
+      HcCell* c = rt.alloc<HcCell>(v, v);
+      rt.write(*dest, c);
       dest = &c->next;
       if (!head) head = c;
     }
-    e.memo_read(*pg->input, sac::fn<&place>(pg, dest));
-    e.memo_read(pg->start->cells, sac::fn<&class_step>(pg));
+    rt.memo_read(*program->input, sac::fn<&place>(program, dest));
+    rt.memo_read(program->start->cells, sac::fn<&class_step>(program));
     // The corners come first, so the list's head is a fixed cell.
-    pg->start->blocks = e.alloc<HcCellBlock>(HV{nullptr}, head);
-    e.memo(sac::fn<&block_classes>(pg->start->blocks->first, pg, pg->start->blocks, std::uint64_t{0}, INT_MIN, INT_MAX));
-    e.memo(sac::fn<&block_bounds>(pg->start->blocks, pg, INT_MAX, INT_MIN));
-    e.memo(sac::fn<&refine_start>(pg));
-    e.memo(sac::fn<&final_start>(pg));
+    program->start->blocks = rt.alloc<HcCellBlock>(HV{nullptr}, head);
+    rt.memo(sac::fn<&block_classes>(program->start->blocks->first, program, program->start->blocks, std::uint64_t{0},
+                                    INT_MIN, INT_MAX));
+    rt.memo(sac::fn<&block_bounds>(program->start->blocks, program, INT_MAX, INT_MIN));
+    rt.memo(sac::fn<&refine_start>(program));
+    rt.memo(sac::fn<&final_start>(program));
   }
 
-  static sac::Mod<HcCell*>* append_cell(sac::Engine& e, HV v, sac::Mod<HcCell*>* dest) {
-    HcCell* c = e.alloc<HcCell>(v, v);
-    e.write(*dest, c);
+  static sac::Mod<HcCell*>* append_cell(sac::Engine& rt, HV v, sac::Mod<HcCell*>* dest) {
+    HcCell* c = rt.alloc<HcCell>(v, v);
+    rt.write(*dest, c);
     return &c->next;
   }
 
-  static void place(sac::Engine& e, HpuInputNode* n, HpuCellsProgram* pg, sac::Mod<HcCell*>* dest) {
-    if (!n) return e.write(*dest, nullptr);
-    dest = append_cell(e, n, dest);
-    e.memo_read(n->next, sac::fn<&place>(pg, dest));
+  static void place(sac::Engine& rt, HpuInputNode* n, HpuCellsProgram* program, sac::Mod<HcCell*>* dest) {
+    if (!n) return rt.write(*dest, nullptr);
+    dest = append_cell(rt, n, dest);
+    rt.memo_read(n->next, sac::fn<&place>(program, dest));
   }
 
   // ---------------------------------------------------------------- 2. initial classes
 
-  /// The class of an initial vertex. Its key holds nothing of the vertices before it: with
-  /// the least class so far in it, an update that changed that least class ran every step
-  /// after again (7,488 nearest searches in one update at uniform 10^5); the least class is
-  /// now the blocks' (block_bounds). The view's searches take no scale, so none is guessed.
-  struct FirstClassStep {
-    HpuCellsProgram* pg;
+  /// The class of an initial vertex. Its key holds nothing of the vertices before it: a
+  /// running least class in the key would change for every step after a vertex whose class
+  /// an update lowered, and re-run them all; the least class comes from the blocks instead
+  /// (block_bounds). The view's searches take no scale, so none is guessed.
+  struct FirstClassStep : StepBase {
     HcCell* cell;
-    CellView* view(sac::Engine&) const { return &pg->view; }
-    const Box<2>& box() const noexcept { return pg->box(); }
-    const CellDirectory& dir() const noexcept { return *pg->dir; }
-    bool run(sac::Engine& e, CellView& v) const {
-      if (!v.kept()) pg->first_class = pg->q.first_class(cell->v, pg->box().side / 4);
+    bool run(sac::Engine& rt, CellView& v) const {
+      if (!v.kept()) program->first_class = program->questions.first_class(cell->v, program->box().side / 4);
       if (!v.done()) return false;
-      ++pg->steps.done[HcStepCounts::FirstClass];
-      e.write(cell->cls, pg->first_class);
-      e.memo_read(cell->next, sac::fn<&class_step>(pg));
+      ++program->steps.done[HcStepCounts::FirstClass];
+      rt.write(cell->cls, program->first_class);
+      rt.memo_read(cell->next, sac::fn<&class_step>(program));
       return true;
     }
   };
 
-  static void class_step(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg) {
-    if (cell) run_step(e, FirstClassStep{pg, cell});
+  static void class_step(sac::Engine& rt, HcCell* cell, HpuCellsProgram* program) {
+    if (cell) run_step(rt, FirstClassStep{{program}, cell});
   }
 
   // ---------------------------------------------------------------- 3. classes and rounds
 
-  static void refine_start(sac::Engine& e, HpuCellsProgram* pg) {
-    e.read(pg->start->min_class, [pg](sac::Engine& e2, int j) {
-      HcClass* cs = e2.alloc<HcClass>(j, j);
-      e2.write(cs->cont, nullptr);  // nothing continues into the first class
-      e2.memo(sac::fn<&class_start>(pg, cs));
+  static void refine_start(sac::Engine& rt, HpuCellsProgram* program) {
+    rt.read(program->start->min_class, [program](sac::Engine& rt2, int j) {
+      HcClass* size_class = rt2.alloc<HcClass>(j, j);
+      rt2.write(size_class->cont, nullptr);  // nothing continues into the first class
+      rt2.memo(sac::fn<&class_start>(program, size_class));
     });
   }
 
   /// One in about kBlockSpan initial vertices opens a block, chosen by its coordinates
-  /// (never by an address). Other spans measured: bench/RESULTS.md.
+  /// (never by an address, so the blocks are the same in every run). The mix is a short one
+  /// (two shifts, one multiply), not sac::mix64: its values place the block boundaries, and
+  /// with them the trace, so it stays as it is.
   static constexpr std::uint64_t kBlockSpan = 32;
   static bool opens_block(HV v) noexcept {
-    std::uint64_t h = std::bit_cast<std::uint64_t>(v->p[0]) * 0x9e3779b97f4a7c15ull ^ std::bit_cast<std::uint64_t>(v->p[1]);
+    std::uint64_t h = std::bit_cast<std::uint64_t>(v->p[0]) * sac::kGoldenGamma ^ std::bit_cast<std::uint64_t>(v->p[1]);
     h ^= h >> 31;
     h *= 0xbf58476d1ce4e5b9ull;
     h ^= h >> 29;
     return h % kBlockSpan == 0;
   }
 
-  /// The classes of block b's initial vertices from `cell` on, given those before it (mask,
+  /// The classes of the block's initial vertices from `cell` on, given those before it (mask,
   /// max), and the block's vertices linked by class: `cell` goes after the last vertex of its
   /// class mod 64, through that class's tail. A class that changes re-runs the steps after it
   /// in its block only, and the next member's link of the classes it left and joined.
-  static void block_classes(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, HcCellBlock* b, std::uint64_t mask,
-                            int max, int min) {
-    e.read(cell->cls, [cell, pg, b, mask, max, min](sac::Engine& e2, int c) {
+  static void block_classes(sac::Engine& rt, HcCell* cell, HpuCellsProgram* program, HcCellBlock* block,
+                            std::uint64_t mask, int max, int min) {
+    rt.read(cell->cls, [cell, program, block, mask, max, min](sac::Engine& rt2, int c) {
       const unsigned k = static_cast<unsigned>(c) & 63;
       if (!((mask >> k) & 1)) {
-        e2.write(b->head[k], cell);
-        e2.write(b->tail[k], &cell->next_same);
+        rt2.write(block->head[k], cell);
+        rt2.write(block->tail[k], &cell->next_same);
       } else {
-        e2.read(b->tail[k], [cell, b, k](sac::Engine& e3, sac::Mod<HcCell*>* qd) {
-          e3.write(*qd, cell);
-          e3.write(b->tail[k], &cell->next_same);
+        rt2.read(block->tail[k], [cell, block, k](sac::Engine& rt3, sac::Mod<HcCell*>* dest) {
+          rt3.write(*dest, cell);
+          rt3.write(block->tail[k], &cell->next_same);
         });
       }
-      e2.memo_read(cell->next,
-                   sac::fn<&block_classes_next>(pg, b, mask | std::uint64_t{1} << k, std::max(max, c), std::min(min, c)));
+      rt2.memo_read(cell->next, sac::fn<&block_classes_next>(program, block, mask | std::uint64_t{1} << k,
+                                                             std::max(max, c), std::min(min, c)));
     });
   }
 
-  static void block_classes_next(sac::Engine& e, HcCell* nx, HpuCellsProgram* pg, HcCellBlock* b, std::uint64_t mask,
-                                 int max, int min) {
-    if (nx && !opens_block(nx->v)) return block_classes(e, nx, pg, b, mask, max, min);
-    e.write(b->classes, HcClassSet{mask, max, min});
+  static void block_classes_next(sac::Engine& rt, HcCell* next, HpuCellsProgram* program, HcCellBlock* block,
+                                 std::uint64_t mask, int max, int min) {
+    if (next && !opens_block(next->v)) return block_classes(rt, next, program, block, mask, max, min);
+    rt.write(block->classes, HcClassSet{mask, max, min});
     for (std::uint64_t m = mask; m; m &= m - 1)
-      e.read(b->tail[static_cast<unsigned>(std::countr_zero(m))],
-             [](sac::Engine& e2, sac::Mod<HcCell*>* qd) { e2.write(*qd, nullptr); });
-    if (!nx) return e.write(b->next, nullptr);
-    HcCellBlock* nb = e.alloc<HcCellBlock>(nx->v, nx);
-    e.write(b->next, nb);
-    block_classes(e, nx, pg, nb, 0, INT_MIN, INT_MAX);
+      rt.read(block->tail[static_cast<unsigned>(std::countr_zero(m))],
+             [](sac::Engine& rt2, sac::Mod<HcCell*>* dest) { rt2.write(*dest, nullptr); });
+    if (!next) return rt.write(block->next, nullptr);
+    HcCellBlock* next_block = rt.alloc<HcCellBlock>(next->v, next);
+    rt.write(block->next, next_block);
+    block_classes(rt, next, program, next_block, 0, INT_MIN, INT_MAX);
   }
 
   /// The smallest and the largest initial class, from the blocks' sets, in a walk of the
   /// blocks. A block that changes the least or the greatest so far re-runs this walk up to
-  /// the next block beyond it, a step per block with no question asked. Threaded through
-  /// the first-class steps instead, a new least class re-ran every one after it; threaded
-  /// through each class's walk of the blocks ("a block before holds a class above j"), a
-  /// change of the first block above j re-ran that class's walk up to the next.
-  static void block_bounds(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, int mn, int mx) {
-    e.read(cb->classes, [cb, pg, mn, mx](sac::Engine& e2, const HcClassSet& set) {
-      e2.memo_read(cb->next, sac::fn<&block_bounds_next>(pg, std::min(mn, set.min), std::max(mx, set.max)));
+  /// the next block beyond it, a step per block with no question asked. Not threaded through
+  /// the first-class steps, where a new least class would re-run every one after it; nor
+  /// through each class's walk of the blocks ("a block before holds a class above j"), where
+  /// a change of the first block above j would re-run that class's walk up to the next.
+  static void block_bounds(sac::Engine& rt, HcCellBlock* block, HpuCellsProgram* program, int least, int greatest) {
+    rt.read(block->classes, [block, program, least, greatest](sac::Engine& rt2, const HcClassSet& set) {
+      rt2.memo_read(block->next,
+                    sac::fn<&block_bounds_next>(program, std::min(least, set.min), std::max(greatest, set.max)));
     });
   }
 
-  static void block_bounds_next(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, int mn, int mx) {
-    if (cb) return block_bounds(e, cb, pg, mn, mx);
-    e.write(pg->start->min_class, mn);
-    e.write(pg->start->max_class, mx);
+  static void block_bounds_next(sac::Engine& rt, HcCellBlock* block, HpuCellsProgram* program, int least,
+                                int greatest) {
+    if (block) return block_bounds(rt, block, program, least, greatest);
+    rt.write(program->start->min_class, least);
+    rt.write(program->start->max_class, greatest);
   }
 
   /// Class j: its initial entries from the blocks that hold some, then its rounds.
-  static void class_start(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs) {
-    HcClass* csn = e.alloc<HcClass>(cs->j + 1, cs->j + 1);
-    HcBlock* b = e.alloc<HcBlock>(std::tuple{cs->j, HV{nullptr}});
-    e.write(b->init_tail, &cs->init);
-    e.memo(sac::fn<&class_block>(pg->start->blocks, pg, cs, b));
-    e.memo(sac::fn<&round>(pg, cs, csn, &cs->init, &csn->cont));
+  static void class_start(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class) {
+    HcClass* next_class = rt.alloc<HcClass>(size_class->j + 1, size_class->j + 1);
+    HcBlock* class_tail = rt.alloc<HcBlock>(std::tuple{size_class->j, HV{nullptr}});
+    rt.write(class_tail->init_tail, &size_class->init);
+    rt.memo(sac::fn<&class_block>(program->start->blocks, program, size_class, class_tail));
+    rt.memo(sac::fn<&round_start>(program, size_class, next_class, &size_class->init, &next_class->cont));
   }
 
-  /// Class j in block cb: its members appended at b's tail, which the next block's copy
-  /// continues.
+  /// Class j in `block`: its members appended at class_tail's tail, which the next block's
+  /// copy continues.
   /// The tail is a modifiable, not an argument: with it in the key, a vertex that joined or
-  /// left the class gave every step after it a new key up to the next member, thousands of
-  /// steps at the class holding most vertices. Through the tail's versions it re-runs the
-  /// next member's append, or the copies up to the next block with a member. A block bounds
-  /// a tail's versions, which the runtime walks from the newest to read or write at a time:
-  /// one tail for the whole class was as exact, and several times slower (bench/RESULTS.md,
-  /// "Class lists by block").
-  static void class_block(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
-    e.read(cb->classes, [cb, pg, cs, b](sac::Engine& e2, const HcClassSet& set) {
-      if (set.has(cs->j)) e2.memo_read(cb->head[static_cast<unsigned>(cs->j) & 63], sac::fn<&class_member>(pg, cs, b));
-      HcBlock* nb = e2.alloc<HcBlock>(std::tuple{cs->j, cb->first->v});
-      e2.read(b->init_tail, [nb](sac::Engine& e3, sac::Mod<HcEntry*>* qd) { e3.write(nb->init_tail, qd); });
-      e2.memo_read(cb->next, sac::fn<&class_block_next>(pg, cs, nb));
+  /// left the class would give every step after it a new key up to the next member. Through
+  /// the tail's versions it re-runs the next member's append, or the copies up to the next
+  /// block with a member. A tail per block, not one for the whole class: the runtime walks a
+  /// modifiable's versions from the newest to read or write at a time, and a block bounds
+  /// how many a tail has.
+  static void class_block(sac::Engine& rt, HcCellBlock* block, HpuCellsProgram* program, HcClass* size_class,
+                          HcBlock* class_tail) {
+    rt.read(block->classes, [block, program, size_class, class_tail](sac::Engine& rt2, const HcClassSet& set) {
+      if (set.has(size_class->j))
+        rt2.memo_read(block->head[static_cast<unsigned>(size_class->j) & 63],
+                      sac::fn<&class_member>(program, size_class, class_tail));
+      HcBlock* next_class_tail = rt2.alloc<HcBlock>(std::tuple{size_class->j, block->first->v});
+      rt2.read(class_tail->init_tail, [next_class_tail](sac::Engine& rt3, sac::Mod<HcEntry*>* dest) {
+        rt3.write(next_class_tail->init_tail, dest);
+      });
+      rt2.memo_read(block->next, sac::fn<&class_block_next>(program, size_class, next_class_tail));
     });
   }
 
-  static void class_block_next(sac::Engine& e, HcCellBlock* cb, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
-    if (cb) return class_block(e, cb, pg, cs, b);
+  static void class_block_next(sac::Engine& rt, HcCellBlock* block, HpuCellsProgram* program, HcClass* size_class,
+                               HcBlock* class_tail) {
+    if (block) return class_block(rt, block, program, size_class, class_tail);
     // Q_j = its initial entries ++ the continuations of class j − 1 (terminated by now).
-    e.read(b->init_tail, [cs](sac::Engine& e2, sac::Mod<HcEntry*>* qd) {
-      e2.read(cs->cont, [qd](sac::Engine& e3, HcEntry* h) { e3.write(*qd, h); });
+    rt.read(class_tail->init_tail, [size_class](sac::Engine& rt2, sac::Mod<HcEntry*>* dest) {
+      rt2.read(size_class->cont, [dest](sac::Engine& rt3, HcEntry* h) { rt3.write(*dest, h); });
     });
   }
 
   /// One initial vertex of class j mod 64 in a block: appended to Q_j's initial entries if of
-  /// class j. The walk passes the block's members of j's class mod 64 only: it used to pass
-  /// every vertex of the block, five for each member (bench/RESULTS.md, "Class walks over a
-  /// block's members").
-  static void class_member(sac::Engine& e, HcCell* cell, HpuCellsProgram* pg, HcClass* cs, HcBlock* b) {
+  /// class j. The walk passes the block's members of j's class mod 64 only (next_same), not
+  /// every vertex of the block.
+  static void class_member(sac::Engine& rt, HcCell* cell, HpuCellsProgram* program, HcClass* size_class,
+                           HcBlock* class_tail) {
     if (!cell) return;
-    e.read(cell->cls, [cell, cs, b](sac::Engine& e2, int c) {
-      if (c != cs->j) return;
-      HcEntry* ent = e2.alloc<HcEntry>(std::tuple{cell->v, cs->j, true}, cell->v, true);
-      e2.read(b->init_tail, [b, ent](sac::Engine& e3, sac::Mod<HcEntry*>* qd) {
-        e3.write(*qd, ent);
-        e3.write(b->init_tail, &ent->next);
+    rt.read(cell->cls, [cell, size_class, class_tail](sac::Engine& rt2, int c) {
+      if (c != size_class->j) return;
+      HcEntry* entry = rt2.alloc<HcEntry>(std::tuple{cell->v, size_class->j, true}, cell->v, true);
+      rt2.read(class_tail->init_tail, [class_tail, entry](sac::Engine& rt3, sac::Mod<HcEntry*>* dest) {
+        rt3.write(*dest, entry);
+        rt3.write(class_tail->init_tail, &entry->next);
       });
     });
-    e.memo_read(cell->next_same, sac::fn<&class_member>(pg, cs, b));
+    rt.memo_read(cell->next_same, sac::fn<&class_member>(program, size_class, class_tail));
   }
 
   /// A round of class j on the entries from `head`: collect all, then process the pairs,
   /// then the next round (the births) or the next class.
-  static void round(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcClass* csn, sac::Mod<HcEntry*>* head,
-                    sac::Mod<HcEntry*>* cdest) {
-    HcRound* rs = e.alloc<HcRound>(head);
-    e.memo_read(*head, sac::fn<&collect_step>(pg, cs, rs, cdest, nullptr, nullptr));
-    e.memo_read(*head, sac::fn<&process_entry>(pg, cs, rs, &rs->births, nullptr, nullptr));
-    e.memo(sac::fn<&round_end>(pg, cs, csn, rs));
+  static void round_start(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcClass* next_class,
+                          sac::Mod<HcEntry*>* head, sac::Mod<HcEntry*>* cont_dest) {
+    HcRound* round = rt.alloc<HcRound>(head);
+    rt.memo_read(*head, sac::fn<&collect_step>(program, size_class, round, cont_dest, nullptr, nullptr));
+    rt.memo_read(*head, sac::fn<&process_entry>(program, size_class, round, &round->births, nullptr, nullptr));
+    rt.memo(sac::fn<&round_end>(program, size_class, next_class, round));
   }
 
-  static void round_end(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcClass* csn, HcRound* rs) {
-    e.read(rs->births, [pg, cs, csn, rs](sac::Engine& e2, HcEntry* b) {
-      e2.read(rs->cont_tail, [pg, cs, csn, rs, b](sac::Engine& e3, sac::Mod<HcEntry*>* tail) {
-        if (b) return e3.memo(sac::fn<&round>(pg, cs, csn, &rs->births, tail));
-        e3.write(*tail, nullptr);
-        e3.memo(sac::fn<&class_end>(pg, cs, csn));
-      });
+  static void round_end(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcClass* next_class,
+                        HcRound* round) {
+    rt.read(round->births, [program, size_class, next_class, round](sac::Engine& rt2, HcEntry* births) {
+      rt2.read(round->cont_tail,
+               [program, size_class, next_class, round, births](sac::Engine& rt3, sac::Mod<HcEntry*>* tail) {
+                 if (births)
+                   return rt3.memo(sac::fn<&round_start>(program, size_class, next_class, &round->births, tail));
+                 rt3.write(*tail, nullptr);
+                 rt3.memo(sac::fn<&class_end>(program, size_class, next_class));
+               });
     });
   }
 
   /// The next class when anything is left: continuations, or initial vertices above j.
-  static void class_end(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcClass* csn) {
-    e.read(csn->cont, [pg, cs, csn](sac::Engine& e2, HcEntry* c) {
-      e2.read(pg->start->max_class, [pg, cs, csn, c](sac::Engine& e3, int max) {
-        if (c || cs->j < max) e3.memo(sac::fn<&class_start>(pg, csn));
+  static void class_end(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcClass* next_class) {
+    rt.read(next_class->cont, [program, size_class, next_class](sac::Engine& rt2, HcEntry* cont) {
+      rt2.read(program->start->max_class, [program, size_class, next_class, cont](sac::Engine& rt3, int max) {
+        if (cont || size_class->j < max) rt3.memo(sac::fn<&class_start>(program, next_class));
       });
     });
   }
@@ -465,64 +486,64 @@ struct HpuCellsProgram {
 
   /// The twin's collect(v, j, birth): loose pairs (both sides, of class j, ≤ j at a birth) in
   /// (x, y) order, and v's continuation into Q_{j+1}.
-  struct CollectStep {
-    HpuCellsProgram* pg;
-    HcClass* cs;
-    HcRound* rs;
-    HcEntry* ent;
-    CellView* view(sac::Engine&) const { return &pg->view; }
-    const Box<2>& box() const noexcept { return pg->box(); }
-    const CellDirectory& dir() const noexcept { return *pg->dir; }
-    bool run(sac::Engine& e, CellView& v) const {
-      const int j = cs->j;
-      if (!v.kept()) pg->go_on = pg->q.collect(ent->v, j, ent->birth, pg->pairs);
+  struct CollectStep : StepBase {
+    HcClass* size_class;
+    HcRound* round;
+    HcEntry* entry;
+    bool run(sac::Engine& rt, CellView& v) const {
+      const int j = size_class->j;
+      if (!v.kept()) program->go_on = program->questions.collect(entry->v, j, entry->birth, program->pairs);
       if (!v.done()) return false;
-      ++pg->steps.done[HcStepCounts::Collect];
+      ++program->steps.done[HcStepCounts::Collect];
       // The entry's own list: no tail threads through the round, so a change in one
       // entry's pairs does not change the keys of the (mostly pairless) entries after it.
-      sac::Mod<HcPair*>* pd = &ent->pairs;
-      for (const auto& [a, b] : pg->pairs) {
-        HcPair* pc = e.alloc<HcPair>(std::tuple{ent, a, b}, a, b);
-        e.write(*pd, pc);
-        pd = &pc->next;
+      sac::Mod<HcPair*>* pairs_dest = &entry->pairs;
+      for (const auto& [a, b] : program->pairs) {
+        HcPair* pair = rt.alloc<HcPair>(std::tuple{entry, a, b}, a, b);
+        rt.write(*pairs_dest, pair);
+        pairs_dest = &pair->next;
       }
-      e.write(*pd, nullptr);
-      e.write(ent->cont, pg->go_on ? e.alloc<HcEntry>(std::tuple{ent->v, j + 1, false}, ent->v, false) : nullptr);
+      rt.write(*pairs_dest, nullptr);
+      rt.write(entry->cont,
+               program->go_on ? rt.alloc<HcEntry>(std::tuple{entry->v, j + 1, false}, entry->v, false) : nullptr);
       return true;
     }
   };
 
-  /// The collect of ent, memoized apart from the list step: its key holds no destination
+  /// The collect of an entry, memoized apart from the list step: its key holds no destination
   /// and no place, so an entry that an update gave another predecessor keeps its collect.
   /// The old call is reused only when it is at most kCollectReach stamps ahead
-  /// (Engine::memo_near): an entry that an update moved matched its old collect far ahead,
-  /// and the hit discarded all the trace in between (a deletion at uniform 32,000 re-ran
-  /// 10,020 collects when the key held ent alone and the reuse had no bound).
+  /// (Engine::memo_near): an entry that an update moved would match its old collect far
+  /// ahead, and the hit would discard all the trace in between.
   static constexpr std::uint32_t kCollectReach = 64;
-  static void collect_entry(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcRound* rs, HcEntry* ent) {
-    run_step(e, CollectStep{pg, cs, rs, ent});
+  static void collect_entry(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcRound* round,
+                            HcEntry* entry) {
+    run_step(rt, CollectStep{{program}, size_class, round, entry});
   }
 
-  /// ent was read from owner's `next` (owner null: the round's head). owner's predecessor
+  /// entry was read from owner's `next` (owner null: the round's head). owner's predecessor
   /// is in the key: when an update moves an entry earlier in the list, its own `next` and the
   /// destinations can be those of its old step far ahead, which would then match and discard
   /// everything in between; with the predecessor it runs anew in place.
-  static void collect_step(sac::Engine& e, HcEntry* ent, HpuCellsProgram* pg, HcClass* cs, HcRound* rs,
-                           sac::Mod<HcEntry*>* cdest, HcEntry* owner, HcEntry* owner_pred) {
+  static void collect_step(sac::Engine& rt, HcEntry* entry, HpuCellsProgram* program, HcClass* size_class,
+                           HcRound* round, sac::Mod<HcEntry*>* cont_dest, HcEntry* owner, HcEntry* owner_pred) {
+    // owner_pred is in the memo key only: without it, an entry an update moved earlier
+    // could match its old step far ahead (same entry, next and destination), and the hit
+    // would discard the trace in between; with it the step runs anew in place.
     (void)owner_pred;
-    if (!ent) return e.write(rs->cont_tail, cdest);
+    if (!entry) return rt.write(round->cont_tail, cont_dest);
     // The continuations' tail threads through the list, and a continuation that appears or
     // goes changes it for every entry up to the next one that continues. So the collect
     // itself is a memo of its own, which such a change re-runs as a hit, and only this
     // link step runs again.
-    e.memo_near(kCollectReach, sac::fn<&collect_entry>(pg, cs, rs, ent));
-    e.read(ent->cont, [pg, cs, rs, cdest, ent, owner](sac::Engine& e2, HcEntry* c) {
-      sac::Mod<HcEntry*>* cd = cdest;
-      if (c) {
-        e2.write(*cd, c);
-        cd = &c->next;
+    rt.memo_near(kCollectReach, sac::fn<&collect_entry>(program, size_class, round, entry));
+    rt.read(entry->cont, [program, size_class, round, cont_dest, entry, owner](sac::Engine& rt2, HcEntry* cont) {
+      sac::Mod<HcEntry*>* dest = cont_dest;
+      if (cont) {
+        rt2.write(*dest, cont);
+        dest = &cont->next;
       }
-      e2.memo_read(ent->next, sac::fn<&collect_step>(pg, cs, rs, cd, ent, owner));
+      rt2.memo_read(entry->next, sac::fn<&collect_step>(program, size_class, round, dest, entry, owner));
     });
   }
 
@@ -530,64 +551,76 @@ struct HpuCellsProgram {
 
   /// Where a pair's tries stand: the pair, and the births so far (the first, and where the
   /// next goes; null: none yet).
-  struct Ctx {
-    HpuCellsProgram* pg;
-    HcClass* cs;
-    HcRound* rs;
-    HcPair* pc;
+  struct PairTries : StepBase {
+    HcClass* size_class;
+    HcRound* round;
+    HcPair* pair;
     HcEntry* head;
-    sac::Mod<HcEntry*>* bdest;
+    sac::Mod<HcEntry*>* births_dest;
   };
 
-  static void process_entry(sac::Engine& e, HcEntry* nent, HpuCellsProgram* pg, HcClass* cs, HcRound* rs,
-                            sac::Mod<HcEntry*>* bdest, HcEntry* owner, HcEntry* owner_pred) {
+  static void process_entry(sac::Engine& rt, HcEntry* entry, HpuCellsProgram* program, HcClass* size_class,
+                            HcRound* round, sac::Mod<HcEntry*>* births_dest, HcEntry* owner, HcEntry* owner_pred) {
+    // owner_pred is in the memo key only: without it, an entry an update moved earlier
+    // could match its old step far ahead (same entry, next and destination), and the hit
+    // would discard the trace in between; with it the step runs anew in place.
     (void)owner_pred;
-    if (!nent) return e.write(*bdest, nullptr);
-    e.memo_read(nent->pairs, sac::fn<&process_step>(pg, cs, rs, bdest, nent, owner, nullptr, nullptr));
+    if (!entry) return rt.write(*births_dest, nullptr);
+    rt.memo_read(entry->pairs,
+                 sac::fn<&process_step>(program, size_class, round, births_dest, entry, owner, nullptr, nullptr));
   }
 
-  static void process_step(sac::Engine& e, HcPair* pc, HpuCellsProgram* pg, HcClass* cs, HcRound* rs,
-                           sac::Mod<HcEntry*>* bdest, HcEntry* ent, HcEntry* ent_prev, HcPair* owner,
+  static void process_step(sac::Engine& rt, HcPair* pair, HpuCellsProgram* program, HcClass* size_class, HcRound* round,
+                           sac::Mod<HcEntry*>* births_dest, HcEntry* entry, HcEntry* entry_prev, HcPair* owner,
                            HcPair* owner_pred) {
+    // owner_pred is in the memo key only (entry_prev too, for process_entry's): without it,
+    // a pair an update moved earlier could match its old step far ahead (same pair, next and
+    // destination), and the hit would discard the trace in between.
     (void)owner_pred;
-    if (!pc) return e.memo_read(ent->next, sac::fn<&process_entry>(pg, cs, rs, bdest, ent, ent_prev));
+    if (!pair)
+      return rt.memo_read(entry->next,
+                          sac::fn<&process_entry>(program, size_class, round, births_dest, entry, entry_prev));
     // The tries are a memo of their own, as a collect is: their key holds neither the births'
     // tail nor the pair's place, which an earlier pair's births or an update to the lists
-    // change for every pair after it. They hand their births over in pc->births, and only
+    // change for every pair after it. They hand their births over in pair->births, and only
     // this link step runs again for such a change.
-    e.memo_near(kTryReach, sac::fn<&try_pair>(pg, cs, rs, pc));
-    e.read(pc->births, [pg, cs, rs, bdest, ent, ent_prev, pc, owner](sac::Engine& e2, const HcBirths& b) {
-      sac::Mod<HcEntry*>* bd = bdest;
-      if (b.head) {
-        e2.write(*bd, b.head);
-        bd = b.tail;
+    rt.memo_near(kTryReach, sac::fn<&try_pair>(program, size_class, round, pair));
+    rt.read(pair->births, [program, size_class, round, births_dest, entry, entry_prev, pair, owner](
+                              sac::Engine& rt2, const HcBirths& births) {
+      sac::Mod<HcEntry*>* dest = births_dest;
+      if (births.head) {
+        rt2.write(*dest, births.head);
+        dest = births.tail;
       }
-      e2.memo_read(pc->next, sac::fn<&process_step>(pg, cs, rs, bd, ent, ent_prev, pc, owner));
+      rt2.memo_read(pair->next,
+                    sac::fn<&process_step>(program, size_class, round, dest, entry, entry_prev, pair, owner));
     });
   }
 
   static constexpr std::uint32_t kTryReach = 64;
-  static void try_pair(sac::Engine& e, HpuCellsProgram* pg, HcClass* cs, HcRound* rs, HcPair* pc) {
-    run_step(e, TryStep{Ctx{pg, cs, rs, pc, nullptr, nullptr}});
+  static void try_pair(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcRound* round, HcPair* pair) {
+    run_step(rt, TryStep{PairTries{{program}, size_class, round, pair, nullptr, nullptr}});
   }
 
   /// The pair is done: its births go to the link step.
-  static void done(sac::Engine& e, const Ctx& c) { e.write(c.pc->births, HcBirths{c.head, c.bdest}); }
+  static void done(sac::Engine& rt, const PairTries& tries) {
+    rt.write(tries.pair->births, HcBirths{tries.head, tries.births_dest});
+  }
 
-  /// x was inserted: its birth entry joins the next round, after the pair's births before it.
-  static Ctx birth(sac::Engine& e, Ctx c, HV x) {
-    HcEntry* ent = e.alloc<HcEntry>(std::tuple{x, c.cs->j, true}, x, true);
-    if (c.head) e.write(*c.bdest, ent);
-    else c.head = ent;
-    c.bdest = &ent->next;
-    return c;
+  /// v was inserted: its birth entry joins the next round, after the pair's births before it.
+  static PairTries birth(sac::Engine& rt, PairTries tries, HV v) {
+    HcEntry* entry = rt.alloc<HcEntry>(std::tuple{v, tries.size_class->j, true}, v, true);
+    if (tries.head) rt.write(*tries.births_dest, entry);
+    else tries.head = entry;
+    tries.births_dest = &entry->next;
+    return tries;
   }
 
   /// The Steiner vertex at p: one object per point for as long as the trace holds it
   /// (steiner_vertices.hpp), so a try that re-runs elsewhere in the trace hands the steps
   /// that read it the vertex they saw.
-  static const CellVertex* steiner_at(sac::Engine& e, HpuCellsProgram* pg, const Point<2>& p) {
-    return e.alloc<SteinerRef>(std::pair{p[0], p[1]}, pg->steiner, p)->v;
+  static const CellVertex* steiner_at(sac::Engine& rt, HpuCellsProgram* program, const Point<2>& p) {
+    return rt.alloc<SteinerRef>(std::pair{p[0], p[1]}, program->steiner, p)->v;
   }
 
   /// Box edges to split, in order.
@@ -597,31 +630,27 @@ struct HpuCellsProgram {
   };
 
   /// One try of the twin's process(p, q, j) loop.
-  struct TryStep {
-    Ctx c;
-    CellView* view(sac::Engine&) const { return &c.pg->view; }
-    const Box<2>& box() const noexcept { return c.pg->box(); }
-    const CellDirectory& dir() const noexcept { return *c.pg->dir; }
-    bool run(sac::Engine& e, CellView& v) const {
-      HpuCellsProgram* pg = c.pg;
-      if (!v.kept()) pg->decision = pg->q.decide(c.pc->p, c.pc->q, c.cs->j);
+  struct TryStep : PairTries {
+    bool run(sac::Engine& rt, CellView& v) const {
+      if (!v.kept()) program->decision = program->questions.decide(pair->p, pair->q, size_class->j);
       if (!v.done()) return false;
-      const CellDecision<HV> d = pg->decision;  // a copy: the steps it issues use the scratch
-      ++pg->steps.done[HcStepCounts::Try];
-      switch (d.kind) {
+      const CellDecision<HV> decision = program->decision;  // a copy: the steps it issues use the scratch
+      ++program->steps.done[HcStepCounts::Try];
+      switch (decision.kind) {
         case CellDecision<HV>::Done:
-          done(e, c);
+          done(rt, *this);
           break;
         case CellDecision<HV>::Split: {
-          Splits sp;
-          if (d.splits.size() > sp.s.size()) throw InvariantError("dynmesh: more than four box edges to split");
-          for (const auto& s : d.splits) sp.s[sp.n++] = s;
-          split_next(e, c, sp, 0);
+          Splits splits;
+          if (decision.splits.size() > splits.s.size())
+            throw InvariantError("dynmesh: more than four box edges to split");
+          for (const auto& edge : decision.splits) splits.s[splits.n++] = edge;
+          split_next(rt, *this, splits, 0);
           break;
         }
         case CellDecision<HV>::Insert: {
-          const CellVertex* x = steiner_at(e, pg, d.at);
-          run_step(e, InsertStep<AfterOffCenter>{pg, x, c.cs->j, AfterOffCenter{c}});
+          const CellVertex* off_center = steiner_at(rt, program, decision.at);
+          run_step(rt, InsertStep<AfterOffCenter>{{program}, off_center, size_class->j, AfterOffCenter{*this}});
           break;
         }
       }
@@ -630,112 +659,106 @@ struct HpuCellsProgram {
   };
 
   struct AfterOffCenter {
-    Ctx c;
-    void operator()(sac::Engine& e, HV x) const { done(e, birth(e, c, x)); }
+    PairTries tries;
+    void operator()(sac::Engine& rt, HV v) const { done(rt, birth(rt, tries, v)); }
   };
 
-  /// Splits sp.s[i..] in order, then tries the pair again.
-  static void split_next(sac::Engine& e, const Ctx& c, const Splits& sp, std::uint32_t i) {
-    if (i == sp.n) return run_step(e, TryStep{c});
-    const Point<2> mid = side_midpoint(sp.s[i][0]->p, sp.s[i][1]->p);
-    const CellVertex* m = steiner_at(e, c.pg, mid);
-    run_step(e, InsertStep<AfterSplit>{c.pg, m, c.cs->j, AfterSplit{c, sp, i}});
+  /// Splits splits.s[i..] in order, then tries the pair again.
+  static void split_next(sac::Engine& rt, const PairTries& tries, const Splits& splits, std::uint32_t i) {
+    if (i == splits.n) return run_step(rt, TryStep{tries});
+    const Point<2> mid = side_midpoint(splits.s[i][0]->p, splits.s[i][1]->p);
+    const CellVertex* m = steiner_at(rt, tries.program, mid);
+    run_step(rt, InsertStep<AfterSplit>{{tries.program}, m, tries.size_class->j, AfterSplit{tries, splits, i}});
   }
 
   struct AfterSplit {
-    Ctx c;
-    Splits sp;
+    PairTries tries;
+    Splits splits;
     std::uint32_t i;
-    void operator()(sac::Engine& e, HV x) const { split_next(e, birth(e, c, x), sp, i + 1); }
+    void operator()(sac::Engine& rt, HV v) const { split_next(rt, birth(rt, tries, v), splits, i + 1); }
   };
 
-  /// Inserts x into the store at this time (the leaf that holds it now gets its next value,
-  /// or splits), then k(e, x).
-  template <class K>
-  struct InsertStep {
-    HpuCellsProgram* pg;
-    HV x;
+  /// Inserts vertex into the store at this time (the leaf that holds it now gets its next
+  /// value, or splits), then then(rt, vertex).
+  template <class Then>
+  struct InsertStep : StepBase {
+    HV vertex;
     int j;
-    K k;
-    CellView* view(sac::Engine&) const { return &pg->view; }
-    const Box<2>& box() const noexcept { return pg->box(); }
-    const CellDirectory& dir() const noexcept { return *pg->dir; }
-    bool run(sac::Engine& e, CellView& v) const {
-      if (!v.kept()) std::tie(pg->at_node, pg->at_state) = v.locate(pg->dir->position(x->p), scale_of(j));
+    Then then;
+    bool run(sac::Engine& rt, CellView& v) const {
+      if (!v.kept())
+        std::tie(program->at_node, program->at_state) = v.locate(program->dir->position(vertex->p), scale_of(j));
       if (!v.done()) return false;
-      CellNode* const node = pg->at_node;
-      const CellState* const s = pg->at_state;
-      ++pg->steps.done[HcStepCounts::Insert];
+      CellNode* const node = program->at_node;
+      const CellState* const s = program->at_state;
+      ++program->steps.done[HcStepCounts::Insert];
       std::array<HV, CellState::kCapacity + 1> items;
       std::size_t n = 0;
       for (std::size_t i = 0; i < s->count; ++i) {
-        if (s->items[i]->p == x->p) throw InvariantError("dynmesh: a Steiner vertex inserted twice");
+        if (s->items[i]->p == vertex->p) throw InvariantError("dynmesh: a Steiner vertex inserted twice");
         items[n++] = s->items[i];
       }
-      items[n++] = x;
-      put(e, pg, node, std::span<HV>(items.data(), n));
-      k(e, x);
+      items[n++] = vertex;
+      put(rt, program, node, std::span<HV>(items.data(), n));
+      then(rt, vertex);
       return true;
     }
   };
 
   /// Writes n's value holding `items` (n's cell), splitting while they overflow: the children
   /// first, then n (no read sees a split without its children).
-  static void put(sac::Engine& e, HpuCellsProgram* pg, CellNode* n, std::span<HV> items) {
-    if (items.size() <= CellState::kCapacity) return e.write(n->state, CellState::leaf(items.begin(), items.end()));
+  static void put(sac::Engine& rt, HpuCellsProgram* program, CellNode* n, std::span<HV> items) {
+    if (items.size() <= CellState::kCapacity) return rt.write(n->state, CellState::leaf(items.begin(), items.end()));
     if (n->key.level >= BucketTree::kMaxLevel)
       throw InvariantError("dynmesh: the cell store: vertices closer than the finest cell");
     std::array<std::array<HV, CellState::kCapacity + 1>, 4> part;
     std::array<std::size_t, 4> count{};
     for (HV w : items) {
-      const CellKey c = CellDirectory::cell_at(pg->dir->position(w->p), n->key.level + 1);
+      const CellKey c = CellDirectory::cell_at(program->dir->position(w->p), n->key.level + 1);
       const unsigned k = CellDirectory::child_index(c);
       part[k][count[k]++] = w;
     }
     for (unsigned k = 0; k < 4; ++k)
-      put(e, pg, pg->dir->node(e, n->key.child(k)), std::span<HV>(part[k].data(), count[k]));
-    e.write(n->state, CellState::split());
+      put(rt, program, program->dir->node(rt, n->key.child(k)), std::span<HV>(part[k].data(), count[k]));
+    rt.write(n->state, CellState::split());
   }
 
   // ---------------------------------------------------------------- 4. the final mesh
 
-  static void final_start(sac::Engine& e, HpuCellsProgram* pg) {
-    e.memo(sac::fn<&final_node>(pg, pg->dir->node(e, CellKey{})));
+  static void final_start(sac::Engine& rt, HpuCellsProgram* program) {
+    rt.memo(sac::fn<&final_node>(program, program->dir->node(rt, CellKey{})));
   }
 
-  static void final_node(sac::Engine& e, HpuCellsProgram* pg, CellNode* n) {
-    e.read(n->state, [pg, n](sac::Engine& e2, const CellState& s) {
+  static void final_node(sac::Engine& rt, HpuCellsProgram* program, CellNode* n) {
+    rt.read(n->state, [program, n](sac::Engine& rt2, const CellState& s) {
       if (s.kind == CellState::Split) {
-        for (unsigned k = 0; k < 4; ++k) e2.memo(sac::fn<&final_node>(pg, pg->dir->node(e2, n->key.child(k))));
+        for (unsigned k = 0; k < 4; ++k)
+          rt2.memo(sac::fn<&final_node>(program, program->dir->node(rt2, n->key.child(k))));
       } else if (s.kind == CellState::Leaf) {
         // One step a vertex, each memoized on the vertex alone: when the leaf gains or loses
         // a vertex, splits or merges, the others' steps are found again with their reads,
         // and a change near one vertex re-runs its star walk only, not the leaf's.
-        for (std::size_t i = 0; i < s.count; ++i) e2.memo(sac::fn<&final_vertex>(pg, s.items[i]));
+        for (std::size_t i = 0; i < s.count; ++i) rt2.memo(sac::fn<&final_vertex>(program, s.items[i]));
       }
     });
   }
 
-  static void final_vertex(sac::Engine& e, HpuCellsProgram* pg, HV a) { run_step(e, FinalStep{pg, a}); }
+  static void final_vertex(sac::Engine& rt, HpuCellsProgram* program, HV a) { run_step(rt, FinalStep{{program}, a}); }
 
   /// The triangles whose (x, y)-smallest corner is a, as one block.
-  struct FinalStep {
-    HpuCellsProgram* pg;
+  struct FinalStep : StepBase {
     HV a;
-    CellView* view(sac::Engine&) const { return &pg->view; }
-    const Box<2>& box() const noexcept { return pg->box(); }
-    const CellDirectory& dir() const noexcept { return *pg->dir; }
-    bool run(sac::Engine& e, CellView& v) const {
+    bool run(sac::Engine& rt, CellView& v) const {
       if (!v.kept()) {
-        pg->block.clear();
+        program->block.clear();
         // The view's nearest search starts at a's leaf and ignores the scale, so the step
         // is a function of a alone, whichever leaf holds it.
-        pg->q.triangles_of(a, 0.0, pg->tris);
-        for (const auto& [b, c] : pg->tris) pg->block.push_back(canonical_triangle(a->p, b->p, c->p));
+        program->questions.triangles_of(a, 0.0, program->tris);
+        for (const auto& [b, c] : program->tris) program->block.push_back(canonical_triangle(a->p, b->p, c->p));
       }
       if (!v.done()) return false;
-      ++pg->steps.done[HcStepCounts::Final];
-      if (!pg->block.empty()) e.make<HpuTriBlock>(pg->feed, std::span<const Triangle>(pg->block));
+      ++program->steps.done[HcStepCounts::Final];
+      if (!program->block.empty()) rt.make<HpuTriBlock>(program->feed, std::span<const Triangle>(program->block));
       return true;
     }
   };

@@ -43,8 +43,8 @@ struct HpuCellsState {
   HpuCellsState& operator=(const HpuCellsState&) = delete;
 
   /// Puts the corners into the store (once, before the first commit) and ties the list to it.
-  void start(sac::Engine& e) {
-    for (const auto& c : corners) input_cells.insert(e, c.get());
+  void start(sac::Engine& rt) {
+    for (const auto& c : corners) input_cells.insert(rt, c.get());
     inputs.attach(&input_cells);
   }
   std::array<const CellVertex*, 4> corner_vertices() const noexcept {
@@ -52,11 +52,11 @@ struct HpuCellsState {
   }
   /// The edits' plan (validated by the caller's rules; changes nothing), then its commit.
   HpuInputs::Plan plan(std::span<const Edit<2>> edits) const { return inputs.plan(edits); }
-  void commit(sac::Engine& e, const HpuInputs::Plan& plan) { inputs.commit(e, plan); }
+  void commit(sac::Engine& rt, const HpuInputs::Plan& plan) { inputs.commit(rt, plan); }
   /// After the propagation that follows a commit: frees the list nodes that left, and the
   /// Steiner vertices no trace record holds any more.
-  void release(sac::Engine& e) {
-    inputs.release(e);
+  void release(sac::Engine& rt) {
+    inputs.release(rt);
     steiner.collect();
   }
 

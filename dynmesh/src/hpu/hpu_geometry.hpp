@@ -31,6 +31,8 @@
 #include <utility>
 #include <vector>
 
+#include <sac/splitmix64.hpp>
+
 #include "dynmesh/box.hpp"
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh.hpp"
@@ -112,24 +114,18 @@ inline bool morton_less(const Box<2>& box, const Point<2>& a, const Point<2>& b)
 /// 2003): the trailing zero bits of a hash of its coordinates (capped at 24), so about half
 /// the points are at level 0, a quarter at 1, and so on; a function of the point alone.
 inline int brio_level(const Point<2>& p) noexcept {
-  std::uint64_t h = std::bit_cast<std::uint64_t>(p[0] + 0.0) * 0x9e3779b97f4a7c15ULL;
+  std::uint64_t h = std::bit_cast<std::uint64_t>(p[0] + 0.0) * sac::kGoldenGamma;
   h ^= std::bit_cast<std::uint64_t>(p[1] + 0.0) + 0x632be59bd9b4e019ULL + (h << 6) + (h >> 2);
-  h ^= h >> 30;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  h ^= h >> 27;
-  h *= 0x94d049bb133111ebULL;
-  h ^= h >> 31;
-  return std::min(std::countr_zero(h), 24);
+  return std::min(std::countr_zero(sac::mix64(h)), 24);
 }
 
 /// The order in which the hpu mesh takes its non-corner vertices (the input list, and the
 /// first queue entries): BRIO level descending, then (Morton, xy) within a level. Why not
 /// plain Morton order: each insertion re-makes the big triangles just ahead of it, so in
-/// Morton order a change at one point re-ran every later insertion along that frontier
-/// (about 340 insertions for a point at the box's centre at n = 20,000), and off-centers
-/// along the data's hull re-made the long triangles out to the box one after another
-/// (about 1,000 pairs per class for a hull point). Coarse random rounds first cut those
-/// chains to O(1) expected length, as in randomized incremental construction.
+/// Morton order a change at one point would re-run every later insertion along that
+/// frontier, and off-centers along the data's hull would re-make the long triangles out to
+/// the box one after another. Coarse random rounds first cut those chains to O(1) expected
+/// length, as in randomized incremental construction.
 inline bool insertion_less(const Box<2>& box, const Point<2>& a, const Point<2>& b) noexcept {
   const int la = brio_level(a), lb = brio_level(b);
   if (la != lb) return la > lb;
@@ -222,9 +218,9 @@ inline std::vector<Point<2>> side_midpoints(const Box<2>& box, std::span<const P
 
 /// How far the continuation rule of class j looks (hpu_mesh.hpp, rule 3): a vertex goes on
 /// while its star has a triangle of circumradius above 2^(j+1+kGoOnReach), or a loose edge
-/// of a class above j, which the star's walked triangles decide. A reach of 1 instead of 0
-/// let a quarter fewer collects run on uniform points, for 10% fewer instructions; 2 gave
-/// no more (bench/RESULTS.md, "Fewer collects").
+/// of a class above j, which the star's walked triangles decide. A reach of 1 rather than 0
+/// lets fewer collects run (a vertex whose star has only slightly larger triangles stops
+/// sooner); a larger reach saves no more.
 inline constexpr int kGoOnReach = 1;
 
 /// Is the circumradius of a, b, c above 2^(j+1) (the continuation rule, kGoOnReach)? In one

@@ -131,10 +131,10 @@ class HpuInputs {
     return pl;
   }
 
-  /// Applies a plan made on the current state, relinking the list with e.set (outside the
+  /// Applies a plan made on the current state, relinking the list with rt.set (outside the
   /// computation).
-  void commit(sac::Engine& e, const Plan& pl) {
-    if (!head_.written()) e.set(head_, nullptr);
+  void commit(sac::Engine& rt, const Plan& pl) {
+    if (!head_.written()) rt.set(head_, nullptr);
     std::vector<Point<2>> touched;
     for (const auto& [p, present] : pl.inputs) touched.push_back(p);
     for (int k = 0; k < 4; ++k) {
@@ -169,17 +169,17 @@ class HpuInputs {
       const auto in = input_after.find(p);
       const bool input = in != input_after.end() ? in->second : it != list_.end() && it->second.input;
       const bool listed = (input || is_midpoint(p)) && !is_corner(p);
-      if (listed && it == list_.end()) link(e, p, input);
-      else if (!listed && it != list_.end()) unlink(e, it);
+      if (listed && it == list_.end()) link(rt, p, input);
+      else if (!listed && it != list_.end()) unlink(rt, it);
       else if (it != list_.end()) it->second.input = input;
     }
   }
 
   /// After the propagation that follows commit(): frees the nodes that left the list.
-  void release(sac::Engine& e) {
+  void release(sac::Engine& rt) {
     for (auto& n : gone_) {
-      if (!e.unused(n->next)) throw InvariantError("dynmesh: HpuInputs: the trace still reads a node that left");
-      e.retire(n->next);
+      if (!rt.unused(n->next)) throw InvariantError("dynmesh: HpuInputs: the trace still reads a node that left");
+      rt.retire(n->next);
     }
     gone_.clear();
   }
@@ -269,19 +269,19 @@ class HpuInputs {
     }
     return false;
   }
-  void link(sac::Engine& e, const Point<2>& p, bool input) {
+  void link(sac::Engine& rt, const Point<2>& p, bool input) {
     auto [it, fresh] = list_.emplace(key(p), Entry{std::make_unique<HpuInputNode>(p), input});
     HpuInputNode* n = it->second.node.get();
-    if (cells_) cells_->insert(e, n);
+    if (cells_) cells_->insert(rt, n);
     const auto after = std::next(it);
-    e.set(n->next, after == list_.end() ? nullptr : after->second.node.get());
-    e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next, n);
+    rt.set(n->next, after == list_.end() ? nullptr : after->second.node.get());
+    rt.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next, n);
   }
-  void unlink(sac::Engine& e, std::map<InsertionKey, Entry>::iterator it) {
+  void unlink(sac::Engine& rt, std::map<InsertionKey, Entry>::iterator it) {
     const auto after = std::next(it);
-    e.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next,
+    rt.set(it == list_.begin() ? head_ : std::prev(it)->second.node->next,
           after == list_.end() ? nullptr : after->second.node.get());
-    if (cells_) cells_->erase(e, it->second.node.get());
+    if (cells_) cells_->erase(rt, it->second.node.get());
     gone_.push_back(std::move(it->second.node));
     list_.erase(it);
   }

@@ -1,5 +1,12 @@
 // hpu_mesh.cpp — off-center refinement by size classes on the Delaunay triangulation (see
 // hpu_mesh.hpp for the algorithm and its choices).
+//
+// Purpose: HpuMesh, the static twin of the self-adjusting hpu mesh: rules 1-6 of
+// hpu_mesh.hpp on a Delaunay triangulation, in the twin's order.
+// Invariants: those of hpu_mesh.hpp (the output is the mesh those rules define).
+// Complexity: O(n lg n + m) expected (hpu_mesh.hpp).
+// Paper: Acar & Hudson, Figure 5 and Appendix A; Har-Peled & Üngör (2005); docs/DESIGN.md,
+// "DynHPU".
 #include "dynmesh/hpu_mesh.hpp"
 
 #include <algorithm>
@@ -57,8 +64,8 @@ class Refiner {
     }
     // In BRIO order (insertion_less), not plain Morton order: the triangulation of a Morton
     // prefix of points along curves holds long triangles ahead of the frontier, which every
-    // insertion there re-made (on a spiral of 32,000 points, 100 triangles made per final
-    // one and cavities of 6,000). Random rounds bound the expected work whatever the input.
+    // insertion there would re-make, with large cavities. Random rounds bound the expected
+    // work whatever the input.
     std::vector<std::pair<detail::InsertionKey, std::size_t>> order(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) order[i] = {detail::insertion_key(box_, points[i]), i};
     std::sort(order.begin(), order.end(),

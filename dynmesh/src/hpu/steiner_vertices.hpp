@@ -2,13 +2,12 @@
 // outside the trace.
 //
 // Purpose: a step that depends on a cell compares the cell's vertices by identity
-// (cell_view.hpp, same_inside), so a Steiner vertex that the program makes again at the same
+// (cell_interest.hpp, same_inside), so a Steiner vertex that the program makes again at the same
 // point must be the same object, or every step that reads it re-runs, and their outputs
 // (pairs, entries, off-centers) are new objects in turn. A keyed allocation in the trace gives
-// the old object back only inside the re-executed read's window; an off-center whose try
-// re-ran elsewhere got a new one, and one such update at uniform 20,000 and 30° re-made
-// 1,501 vertices and re-ran 8,655 final steps for 56 changed triangles (bench/RESULTS.md,
-// "Steiner vertices by point"). Here a point maps to one CellVertex while any trace record
+// the old object back only inside the re-executed read's window, so an off-center whose try
+// re-ran elsewhere would be a new object, and every step that read the old one would re-run.
+// Here a point maps to one CellVertex while any trace record
 // holds it (SteinerRef, a keyed allocation, holds one reference), and a vertex left without
 // references is freed only by collect(), which the mutator calls after a propagation, so a
 // vertex released and made again within one propagation is the same object.
@@ -162,10 +161,8 @@ class SteinerVertices {
     return s;
   }
   // A CellVertex is the first member of its Slot (standard layout), so its address is the
-  // slot's.
-  Slot& slot_of(const CellVertex* v) noexcept {
-    return *reinterpret_cast<Slot*>(const_cast<CellVertex*>(v));
-  }
+  // slot's; the slot names its own index, through which the pool hands it out writable.
+  Slot& slot_of(const CellVertex* v) noexcept { return slots_[reinterpret_cast<const Slot*>(v)->self]; }
 
   std::deque<Slot> slots_;           // stable addresses
   std::vector<std::uint32_t> table_;  // slot indices by point, open addressing

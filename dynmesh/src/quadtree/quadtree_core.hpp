@@ -1,13 +1,17 @@
 // quadtree_core.hpp (private) — the program layer: the engine, the input point list, the
 // cell directory and QuadTreeRefine, composed so that more than one program can share them.
 //
-// Purpose: DynamicQuadtree runs QuadTreeRefine alone; DynamicMesh runs it and then a
-// postprocess in the same engine and the same run(), so one propagate() carries a point
-// update through the tree into the mesh. QuadtreeCore owns everything both need: the
-// engine, the input list (the root's point list, appended in insertion order), the point
-// indexes, the directory of cell slots (quadtree_refine.hpp), validation of a batch of
-// edits, and the mutator's side of an update (link, unlink, propagate, release, compact).
-// A postprocess is a callable run after Refine::main inside the same run().
+// Purpose: DynamicQuadtree runs QuadTreeRefine alone; DynamicMesh's quadtree mesh (and the
+// octree mesh) runs it and then a postprocess in the same engine and the same run(), so one
+// propagate() carries a point update through the tree into the mesh. Two pieces:
+//   InputPoints  – the input list (the root's point list, appended in insertion order), the
+//                  point indexes and ids, validation of a batch of edits, and the mutator's
+//                  linking and unlinking of points; also used alone by the hpu mesh's state,
+//                  which runs no tree (src/mesh/dynamic_mesh.cpp);
+//   QuadtreeCore – InputPoints plus the engine, the directory of cell slots
+//                  (quadtree_refine.hpp) and the update (link, unlink, propagate, release,
+//                  compact). A postprocess is a callable run after Refine::main inside the
+//                  same run().
 //
 // Invariants (check_invariants()): the engine's; the input list, its mirror and the two
 // indexes hold the same points; every per-level list node holds its point; the directory's.
@@ -232,18 +236,16 @@ struct NoExtraChecks {
   void erase(const Q&) {}
 };
 
+/// The input points: a list of modifiables in insertion order (the root's point list, which
+/// a program reads), mirrored for the mutator, with indexes by located position and by id.
+/// The engine is its owner's, passed to each call that writes the list; the owner sets
+/// `head` to null once its engine exists, and destroys the engine before this.
 template <std::size_t d>
-class QuadtreeCore {
+class InputPoints {
  public:
   using Node = InputNode<d>;
-  using Program = Refine<d, Directory<d>>;
 
-  explicit QuadtreeCore(const Box<d>& b) : box(b) {
-    validate_box(box);
-    rt.set(head, static_cast<PNode<d>*>(nullptr));
-    program.dir = &dir;
-    program.input = &head;
-  }
+  explicit InputPoints(const Box<d>& b) : box(b) { validate_box(box); }
 
   Box<d> box;
   StablePool<Node> inputs;
@@ -252,13 +254,7 @@ class QuadtreeCore {
   std::unordered_map<Position<d>, Node*, PositionHash<d>> by_pos;
   std::unordered_map<PointId, Node*> by_id;
   PointId next_id = 0;
-  Directory<d> dir;
   sac::Mod<PNode<d>*> head;
-  UpdateStats last;
-  std::size_t compact_mark = 0;
-  Program program{};
-  // Declared last, destroyed first: its records point into the slots and input nodes.
-  sac::Engine rt;
 
   // ------------------------------------------------------------------ validation
   /// Checks a batch of edits against the set as it will be when each applies, changing
@@ -281,7 +277,8 @@ class QuadtreeCore {
       };
       std::optional<Position<d>> located;
       for (std::size_t a = 0; a < d; ++a)
-        if (!std::isfinite(e.point[a])) fail(InputError::Kind::NotFinite, "point " + to_string<d>(e.point) + " has a NaN or infinite coordinate");
+        if (!std::isfinite(e.point[a]))
+          fail(InputError::Kind::NotFinite, "point " + to_string<d>(e.point) + " has a NaN or infinite coordinate");
       located = try_locate(box, e.point);
       if (!located) fail(InputError::Kind::OutsideBox, "point " + to_string<d>(e.point) + " is outside the domain box");
       const Position<d> q = *located;
@@ -338,50 +335,42 @@ class QuadtreeCore {
     if (near) fail(*near);
   }
 
-  // ------------------------------------------------------------------ building and updating
-  /// Links the (validated) points and runs QuadTreeRefine (unless `with_tree` is false: a
-  /// postprocess that reads its own inputs, not the tree), then `post(engine)` in the same
-  /// run. Ids are the input indices.
-  template <class Post>
-  void build(std::span<const Point<d>> points, Post&& post, bool with_tree = true) {
+  // ------------------------------------------------------------------ linking
+  /// Links (validated) points to build from; ids are the input indices.
+  void link_all(sac::Engine& rt, std::span<const Point<d>> points) {
     by_pos.reserve(points.size());
     by_id.reserve(points.size());
-    for (const Point<d>& p : points) link_new(*try_locate(box, p), p);
-    rt.set_context(&program);
-    rt.run([&post, with_tree](sac::Engine& e) {
-      if (with_tree) Program::main(e);
-      post(e);
-    });
-    compact_mark = dir.size();
+    for (const Point<d>& p : points) link_new(rt, *try_locate(box, p), p);
   }
-
-  struct NoHook {
-    void operator()(sac::Engine&) const noexcept {}
-  };
-  /// Applies validated edits and propagates once; returns the ids of the insertions.
-  /// `before(engine)` runs after the points are linked, before the propagation: a program
-  /// that shares the trace relinks its own inputs there.
-  template <class Before = NoHook>
-  std::vector<PointId> update(std::span<const Edit<d>> edits, Before&& before = {}) {
+  /// Applies validated edits to the list, in order: returns the ids of the insertions, and
+  /// appends the unlinked nodes to `gone` (for release() after the propagation).
+  std::vector<PointId> link_edits(sac::Engine& rt, std::span<const Edit<d>> edits, std::vector<Node*>& gone) {
     std::vector<PointId> ids;
-    std::vector<Node*> gone;
     for (const Edit<d>& e : edits) {
       const Position<d> q = *try_locate(box, e.point);
       if (e.op == EditOp::Insert) {
-        ids.push_back(link_new(q, e.point)->id);
+        ids.push_back(link_new(rt, q, e.point)->id);
       } else {
         Node* n = by_pos.at(q);
-        unlink(n);
+        unlink(rt, n);
         gone.push_back(n);
       }
     }
-    before(rt);
-    propagate();
-    release(gone);
-    maybe_compact();
     return ids;
   }
+  /// After propagate(): frees the unlinked nodes, which no one reads any more.
+  /// `release_below(n)` frees what its owner keeps below n (false: still read).
+  template <class ReleaseBelow>
+  void release(sac::Engine& rt, const std::vector<Node*>& gone, ReleaseBelow&& release_below) {
+    for (Node* n : gone) {
+      if (!rt.unused(n->next) || !release_below(n))
+        throw InvariantError("dynmesh: an erased point is still read by the trace");
+      rt.retire(n->next);
+      inputs.destroy(n);
+    }
+  }
 
+  // ------------------------------------------------------------------ reading
   /// The single edit that erases the point with this id (InputError(Absent) if none).
   Edit<d> erase_edit(PointId id) const {
     auto it = by_id.find(id);
@@ -408,6 +397,112 @@ class QuadtreeCore {
     return out;
   }
 
+  /// The list, its mirror and the indexes hold the same points; every per-level list node
+  /// below a point holds that point.
+  void check_list_invariants() const {
+    std::size_t k = 0;
+    for (const Node* n = first; n; n = n->succ, ++k) {
+      if (n->succ && n->succ->prev != n) throw InvariantError("dynmesh: input list links broken");
+      if (n->next.get() != n->succ) throw InvariantError("dynmesh: input list differs from its mirror");
+      auto a = by_pos.find(n->q);
+      auto b = by_id.find(n->id);
+      if (a == by_pos.end() || a->second != n || b == by_id.end() || b->second != n)
+        throw InvariantError("dynmesh: point indexes disagree with the input list");
+      for (const PNode<d>* c = n->down; c; c = c->down)
+        if (c->q != n->q) throw InvariantError("dynmesh: a point's list node holds another point");
+    }
+    if (head.get() != first) throw InvariantError("dynmesh: list head differs from its mirror");
+    if (k != by_pos.size() || k != by_id.size())
+      throw InvariantError("dynmesh: point indexes hold points not in the input list");
+  }
+
+ private:
+  /// Appends a point to the input list. Appending, not prepending, keeps every cell's list
+  /// head unchanged unless the cell held fewer than two points, and the crowding tests read
+  /// only list heads.
+  Node* link_new(sac::Engine& rt, const Position<d>& q, const Point<d>& x) {
+    Node* n = inputs.create(q, x, next_id++);
+    rt.set(n->next, static_cast<PNode<d>*>(nullptr));
+    rt.set(tail ? tail->next : head, static_cast<PNode<d>*>(n));
+    n->prev = tail;
+    if (tail) tail->succ = n;
+    else first = n;
+    tail = n;
+    by_pos.emplace(q, n);
+    by_id.emplace(n->id, n);
+    return n;
+  }
+  void unlink(sac::Engine& rt, Node* n) {
+    PNode<d>* after = n->next.get();
+    if (n->prev) rt.set(n->prev->next, after);
+    else rt.set(head, after);
+    if (n->prev) n->prev->succ = n->succ;
+    else first = n->succ;
+    if (n->succ) n->succ->prev = n->prev;
+    else tail = n->prev;
+    by_pos.erase(n->q);
+    by_id.erase(n->id);
+  }
+};
+
+template <std::size_t d>
+class QuadtreeCore : public InputPoints<d> {
+  using Base = InputPoints<d>;
+
+ public:
+  using Node = InputNode<d>;
+  using Program = Refine<d, Directory<d>>;
+  using Base::box;
+  using Base::by_id;
+  using Base::by_pos;
+  using Base::first;
+  using Base::head;
+  using Base::inputs;
+
+  explicit QuadtreeCore(const Box<d>& b) : Base(b) {
+    rt.set(head, static_cast<PNode<d>*>(nullptr));
+    program.dir = &dir;
+    program.input = &head;
+  }
+
+  Directory<d> dir;
+  UpdateStats last;
+  std::size_t compact_mark = 0;
+  Program program{};
+  // Declared last, destroyed first: its records point into the slots and input nodes.
+  sac::Engine rt;
+
+  // ------------------------------------------------------------------ building and updating
+  /// Links the (validated) points and runs QuadTreeRefine, then `post(rt)` in the same run.
+  /// Ids are the input indices.
+  template <class Post>
+  void build(std::span<const Point<d>> points, Post&& post) {
+    this->link_all(rt, points);
+    rt.set_context(&program);
+    rt.run([&post](sac::Engine& rt2) {
+      Program::main(rt2);
+      post(rt2);
+    });
+    compact_mark = dir.size();
+  }
+
+  struct NoHook {
+    void operator()(sac::Engine&) const noexcept {}
+  };
+  /// Applies validated edits and propagates once; returns the ids of the insertions.
+  /// `before(engine)` runs after the points are linked, before the propagation: a program
+  /// that shares the trace relinks its own inputs there.
+  template <class Before = NoHook>
+  std::vector<PointId> update(std::span<const Edit<d>> edits, Before&& before = {}) {
+    std::vector<Node*> gone;
+    std::vector<PointId> ids = this->link_edits(rt, edits, gone);
+    before(rt);
+    propagate();
+    this->release(rt, gone, [this](Node* n) { return dir.release_below(rt, n, true); });
+    maybe_compact();
+    return ids;
+  }
+
   std::size_t bytes() const {
     return rt.trace_bytes() + rt.input_bytes() + dir.bytes() + inputs.bytes();
   }
@@ -427,20 +522,7 @@ class QuadtreeCore {
   /// check_invariants() but the engine's: for SAC_DEBUG_CHECKS after an update, whose
   /// propagate() has just checked the engine.
   void check_own_invariants() const {
-    std::size_t k = 0;
-    for (const Node* n = first; n; n = n->succ, ++k) {
-      if (n->succ && n->succ->prev != n) throw InvariantError("dynmesh: input list links broken");
-      if (n->next.get() != n->succ) throw InvariantError("dynmesh: input list differs from its mirror");
-      auto a = by_pos.find(n->q);
-      auto b = by_id.find(n->id);
-      if (a == by_pos.end() || a->second != n || b == by_id.end() || b->second != n)
-        throw InvariantError("dynmesh: point indexes disagree with the input list");
-      for (const PNode<d>* c = n->down; c; c = c->down)
-        if (c->q != n->q) throw InvariantError("dynmesh: a point's list node holds another point");
-    }
-    if (head.get() != first) throw InvariantError("dynmesh: list head differs from its mirror");
-    if (k != by_pos.size() || k != by_id.size())
-      throw InvariantError("dynmesh: point indexes hold points not in the input list");
+    this->check_list_invariants();
     dir.check_invariants();
     check_cell_lists();
   }
@@ -498,41 +580,6 @@ class QuadtreeCore {
   }
 
  private:
-  /// Appends a point to the input list. Appending, not prepending, keeps every cell's list
-  /// head unchanged unless the cell held fewer than two points, and the crowding tests read
-  /// only list heads.
-  Node* link_new(const Position<d>& q, const Point<d>& x) {
-    Node* n = inputs.create(q, x, next_id++);
-    rt.set(n->next, static_cast<PNode<d>*>(nullptr));
-    rt.set(tail ? tail->next : head, static_cast<PNode<d>*>(n));
-    n->prev = tail;
-    if (tail) tail->succ = n;
-    else first = n;
-    tail = n;
-    by_pos.emplace(q, n);
-    by_id.emplace(n->id, n);
-    return n;
-  }
-  void unlink(Node* n) {
-    PNode<d>* after = n->next.get();
-    if (n->prev) rt.set(n->prev->next, after);
-    else rt.set(head, after);
-    if (n->prev) n->prev->succ = n->succ;
-    else first = n->succ;
-    if (n->succ) n->succ->prev = n->prev;
-    else tail = n->prev;
-    by_pos.erase(n->q);
-    by_id.erase(n->id);
-  }
-  /// After propagate(): the unlinked nodes are no longer read by anyone.
-  void release(const std::vector<Node*>& gone) {
-    for (Node* n : gone) {
-      if (!rt.unused(n->next) || !dir.release_below(rt, n, true))
-        throw InvariantError("dynmesh: an erased point is still read by the trace");
-      rt.retire(n->next);
-      inputs.destroy(n);
-    }
-  }
   void propagate() {
     const auto t0 = std::chrono::steady_clock::now();
     rt.propagate();
