@@ -46,7 +46,7 @@
 // appended as before, and a class's tail copies up to the next block that holds it.
 // Paper: Acar & Hudson, Figure 5 and Appendix A (DynHPU), Section 4; Har-Peled & Üngör (2005);
 // Üngör, "Off-centers" (2004); Acar, Ahmed & Blume (2008) for keyed allocation and
-// destination passing; docs/DESIGN.md, "DynHPU"; docs/HPU_ON_CELLS.md, "Stage 2: the
+// destination passing; docs/DESIGN.md, "DynHPU"; docs/HPU_ON_CELLS.md, "The
 // self-adjusting program".
 #pragma once
 
