@@ -30,9 +30,9 @@ namespace {
 
 using sac::Engine;
 using sac::Mod;
-using sac::OrderList;
-using sac::Stamp;
-using sac::StampKind;
+using sac::detail::OrderList;
+using sac::detail::Stamp;
+using sac::detail::StampKind;
 
 // ------------------------------------------------------------------------- OrderList
 
@@ -114,7 +114,7 @@ BENCHMARK(BM_OrderListLess)->Arg(1 << 12)->Arg(1 << 20);
 
 struct QElem {
   Stamp stamp;
-  std::uint32_t qpos = sac::kNotQueued;
+  std::uint32_t qpos = sac::detail::kNotQueued;
 };
 struct QTraits {
   static const Stamp* stamp(const QElem* e) { return &e->stamp; }
@@ -134,7 +134,7 @@ void BM_StampQueuePushPop(benchmark::State& state) {
   std::vector<QElem*> order;
   for (QElem& e : elems) order.push_back(&e);
   std::shuffle(order.begin(), order.end(), std::mt19937_64(4));
-  sac::StampQueue<QElem, QTraits> q(ol);
+  sac::detail::StampQueue<QElem, QTraits> q(ol);
   for (auto _ : state) {
     for (QElem* e : order) q.push(e);
     while (!q.empty()) benchmark::DoNotOptimize(q.pop());

@@ -23,6 +23,14 @@
 namespace sac {
 
 using detail::AllocNode;
+using detail::Stamp;
+using detail::StampKind;
+using detail::attach;
+using detail::attach_timed;
+using detail::attach_unordered;
+using detail::default_head;
+using detail::detach;
+using detail::kNotQueued;
 using detail::Kind;
 using detail::MemoNode;
 using detail::ReaderLink;

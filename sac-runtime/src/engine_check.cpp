@@ -18,6 +18,10 @@
 namespace sac {
 
 using detail::AllocNode;
+using detail::Stamp;
+using detail::StampKind;
+using detail::default_head;
+using detail::kNotQueued;
 using detail::Kind;
 using detail::MemoNode;
 using detail::ReaderLink;

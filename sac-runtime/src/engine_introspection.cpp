@@ -22,6 +22,9 @@
 namespace sac {
 
 using detail::AllocNode;
+using detail::Stamp;
+using detail::StampKind;
+using detail::default_head;
 using detail::Kind;
 using detail::MemoNode;
 using detail::ReaderLink;

@@ -7,7 +7,7 @@
 
 #include "sac/errors.hpp"
 
-namespace sac {
+namespace sac::detail {
 
 namespace {
 // Bender et al.'s density threshold: a label range of size 2^i may hold at most (2/T)^i groups.
@@ -245,4 +245,4 @@ void OrderList::check_invariants() const {
   if (ngroups != group_count_) fail("group count total mismatch");
 }
 
-}  // namespace sac
+}  // namespace sac::detail

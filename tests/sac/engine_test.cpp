@@ -42,16 +42,16 @@ constexpr std::size_t kIntInput = (sizeof(detail::Version<int>) + 7) & ~std::siz
 /// The test-only hook declared in Engine: the private trace, so that the checker tests below
 /// can corrupt one part of it and see check_invariants() fail.
 struct EngineTestAccess {
-  static OrderList& order(Engine& e) { return e.order_; }
+  static detail::OrderList& order(Engine& e) { return e.order_; }
   static Stats& stats(Engine& e) { return e.stats_; }
   static auto& queue(Engine& e) { return e.queue_; }
   static auto& allocs(Engine& e) { return e.allocs_; }
   static auto& memos(Engine& e) { return e.memos_; }
-  static void attach(detail::ReadNode* r, detail::VersionBase* v) { Engine::attach(&r->link, v); }
-  static void detach(detail::ReadNode* r) { Engine::detach(&r->link); }
+  static void attach(detail::ReadNode* r, detail::VersionBase* v) { detail::attach(&r->link, v); }
+  static void detach(detail::ReadNode* r) { detail::detach(&r->link); }
   static void attach_default(detail::ReadNode* r, const ModBase& m) { Engine::attach_default(&r->link, m); }
-  static void attach(detail::ReaderLink* l, detail::VersionBase* v) { Engine::attach(l, v); }
-  static void detach(detail::ReaderLink* l) { Engine::detach(l); }
+  static void attach(detail::ReaderLink* l, detail::VersionBase* v) { detail::attach(l, v); }
+  static void detach(detail::ReaderLink* l) { detail::detach(l); }
 };
 
 }  // namespace sac
@@ -1734,8 +1734,8 @@ TEST(EngineDebug, CheckInvariantsAfterMultipleRuns) {
 // and repairs the trace before the engine is destroyed.
 
 using sac::EngineTestAccess;
-using sac::Stamp;
-using sac::StampKind;
+using sac::detail::Stamp;
+using sac::detail::StampKind;
 using sac::detail::AllocNode;
 using sac::detail::MemoNode;
 using sac::detail::ReadNode;
@@ -2275,7 +2275,7 @@ TEST(EngineChecker, MultiReadSlotDetachedOrOnAnotherModifiable) {
   EXPECT_NO_THROW(e.check_invariants());
   h->read.link.qpos = 0;
   EXPECT_THAT(invariant_message(e), HasSubstr("still queued"));
-  h->read.link.qpos = sac::kNotQueued;
+  h->read.link.qpos = sac::detail::kNotQueued;
   EXPECT_NO_THROW(e.check_invariants());
 }
 

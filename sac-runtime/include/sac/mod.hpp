@@ -37,7 +37,7 @@ class ModBase {
   friend class Engine;
   /// Marks head_ when init_default() gave m a default and no version exists yet; the rest
   /// of head_ is then the first of the reads that see the default (or null).
-  static constexpr std::uintptr_t kDefaultOnly = 2;
+  static constexpr std::uintptr_t kDefaultOnly = detail::kDefaultOnlyMark;
   /// True when m has a default and no version (the default is a version's flag once one
   /// exists).
   bool default_only() const { return (head_ & kDefaultOnly) != 0; }

@@ -27,7 +27,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace sac {
+namespace sac::detail {
 
 /// What a stamp marks in the trace; stored in the low bits of the stamp's link.
 enum class StampKind : std::uint8_t {
@@ -182,4 +182,4 @@ class OrderList {
   std::uint64_t top_relabels_ = 0;
 };
 
-}  // namespace sac
+}  // namespace sac::detail

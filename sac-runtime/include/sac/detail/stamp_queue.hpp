@@ -21,7 +21,7 @@
 #include "sac/detail/order_list.hpp"
 #include "sac/errors.hpp"
 
-namespace sac {
+namespace sac::detail {
 
 inline constexpr std::uint32_t kNotQueued = 0xffffffffu;
 
@@ -119,4 +119,4 @@ class StampQueue {
   std::vector<Entry> heap_;
 };
 
-}  // namespace sac
+}  // namespace sac::detail
