@@ -83,14 +83,17 @@ class AddressSet {
 
 void Engine::check_invariants() const {
   if (in_computation_) throw UsageError("sac::Engine::check_invariants: not inside the computation");
+  // Every message starts with the number of the invariant it breaks (sac/engine.hpp).
   auto fail = [](const std::string& what) { throw InvariantError("Engine trace: " + what); };
+  // I1: the order list and the queue (the tables are checked at the end).
   order_.check_invariants();
   queue_.check_invariants();
-  if (!queue_.empty()) fail("queue not empty outside propagate()");
-  if (!deferred_.empty()) fail("deferred frees left after propagate()");
-  if (!dead_versions_.empty() || !seen_.empty()) fail("undone versions or seen lists left after propagate()");
+  // I7: nothing left over from the last propagate().
+  if (!queue_.empty()) fail("I7: queue not empty outside propagate()");
+  if (!deferred_.empty()) fail("I7: deferred frees left after propagate()");
+  if (!dead_versions_.empty() || !seen_.empty()) fail("I7: undone versions or seen lists left after propagate()");
 
-  // Walk the trace: nesting, per-record checks, counts.
+  // Walk the trace: nesting (I2), per-record checks, counts (I6).
   struct Open {
     const Stamp* close;   // stamp that closes this interval
     bool is_memo;
@@ -106,21 +109,21 @@ void Engine::check_invariants() const {
       if constexpr (K == StampKind::ReadStart) {
         const ReadNode* r = rec;
         ++events;
-        if (!r->end.linked()) fail("read without end stamp");
-        if (!order_.less(&r->start, &r->end)) fail("read end not after start");
+        if (!r->end.linked()) fail("I2: read without end stamp");
+        if (!order_.less(&r->start, &r->end)) fail("I2: read end not after start");
         // Attachment to the version visible at its start is checked below, from the
         // version side (a read record does not name its modifiable; scanning the visible
         // version's readers here would also be quadratic in a modifiable's fan-out).
-        if (r->link.qpos != kNotQueued) fail("read still queued");
+        if (r->link.qpos != kNotQueued) fail("I7: read still queued");
         if (r->many()) {
           // A multi-read hangs on versions through its slots only; each slot is checked
           // below, with its modifiable, like a read.
           const detail::ReadManyHeader* h = detail::many_of(r);
-          if (r->link.rpprev) fail("a multi-read's own link is attached");
-          if (h->k == 0 || h->k > detail::kMaxReadMany) fail("a multi-read with a bad slot count");
+          if (r->link.rpprev) fail("I4: a multi-read's own link is attached");
+          if (h->k == 0 || h->k > detail::kMaxReadMany) fail("I4: a multi-read with a bad slot count");
           for (std::uint32_t i = 0; i < h->k; ++i) {
             const ReaderLink* l = &h->slots()[i].link;
-            if (!detail::is_slot(l) || l->qpos != i || owner_of(l) != r) fail("a multi-read's slot is malformed");
+            if (!detail::is_slot(l) || l->qpos != i || owner_of(l) != r) fail("I4: a multi-read's slot is malformed");
             reads.insert(l);
             if (const ModBase* m = default_head(l)) default_mods.push_back(m);
           }
@@ -131,7 +134,7 @@ void Engine::check_invariants() const {
         stack.push_back({&r->end, false});
       } else if constexpr (K == StampKind::ReadEnd) {
         if (stack.empty() || stack.back().close != s || stack.back().is_memo)
-          fail("read intervals not well nested");
+          fail("I2: read intervals not well nested");
         stack.pop_back();
       } else if constexpr (K == StampKind::Write) {
         const VersionBase* v = rec;
@@ -140,7 +143,7 @@ void Engine::check_invariants() const {
         bool found = false;
         for (const VersionBase* x = v->mod()->newest(); x; x = x->older())
           if (x == v) found = true;
-        if (!found) fail("write not in its modifiable's version list");
+        if (!found) fail("I3: write not in its modifiable's version list");
       } else if constexpr (K == StampKind::Alloc) {
         ++events;
         if (rec->ops->key_equal) ++nkeyed;
@@ -150,25 +153,26 @@ void Engine::check_invariants() const {
         ++nmemo;
         if (!n->end.linked() ||
             !order_.less(&n->start, &n->end))
-          fail("memo entry without a proper end stamp");
+          fail("I2: memo entry without a proper end stamp");
         stack.push_back({&n->end, true});
       } else if constexpr (K == StampKind::MemoEnd) {
         if (stack.empty() || stack.back().close != s || !stack.back().is_memo)
-          fail("memo intervals not well nested");
+          fail("I2: memo intervals not well nested");
         stack.pop_back();
       } else {
-        fail("unexpected stamp kind");
+        fail("I2: unexpected stamp kind");
       }
     });
   }
-  if (!stack.empty()) fail("unclosed intervals at the end of the trace");
-  if (events != stats_.live_events) fail("live event count mismatch");
-  if (nkeyed != allocs_.size()) fail("allocation table size mismatch");
-  if (nmemo != memos_.size()) fail("memo table size mismatch");
+  if (!stack.empty()) fail("I2: unclosed intervals at the end of the trace");
+  if (events != stats_.live_events) fail("I6: live event count mismatch");
+  if (nkeyed != allocs_.size()) fail("I6: allocation table size mismatch");
+  if (nmemo != memos_.size()) fail("I6: memo table size mismatch");
 
-  // Versions of every written or read modifiable: strictly decreasing time, base last,
+  // Versions of every written or read modifiable: strictly decreasing time, base last (I3);
   // readers between this version and the next newer one (so each reader hangs on the version
-  // visible at its time), and every reader a live read of the trace, each exactly once.
+  // visible at its time), and every reader a live read of the trace, each exactly once (I4);
+  // each list in the order its flag says (I5).
   // A live read hangs on a computation's version, a base version or (below) a default with
   // no version; so these cover every read.
   for (const VersionBase* b : bases_) mods.insert(b->mod());
@@ -177,30 +181,30 @@ void Engine::check_invariants() const {
     const auto* m = static_cast<const ModBase*>(mod);
     const VersionBase* newer = nullptr;
     for (const VersionBase* v = m->newest(); v; v = v->older()) {
-      if (v->mod() != m) fail("version chain does not end at its modifiable");
+      if (v->mod() != m) fail("I3: version chain does not end at its modifiable");
       if (v->is_base()) {
-        if (v->older()) fail("base version is not the oldest");
+        if (v->older()) fail("I3: base version is not the oldest");
       } else {
-        if (!v->stamp.linked()) fail("version with unlinked stamp");
-        if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("versions out of order");
+        if (!v->stamp.linked()) fail("I3: version with unlinked stamp");
+        if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("I3: versions out of order");
       }
       for (int list = 0; list < 2; ++list) {
         const ReaderLink* const* back = list == 0 ? &v->readers : &v->unordered_readers;
         const Stamp* last_ordered = nullptr;  // the time of the last ordered reader seen
         for (const ReaderLink* r = *back; r; back = &r->rnext, r = r->rnext) {
-          if (r->rpprev != back) fail("a version's reader list has a broken back link");
+          if (r->rpprev != back) fail("I4: a version's reader list has a broken back link");
           // Membership first: only then may r be decoded (a slot's owner from its index).
-          if (!reads.contains(r)) fail("a version's reader is not a live read of the trace");
+          if (!reads.contains(r)) fail("I4: a version's reader is not a live read of the trace");
           if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
-            fail("a multi-read's slot hangs on another modifiable's version");
+            fail("I4: a multi-read's slot hangs on another modifiable's version");
           const Stamp* t = &owner_of(r)->start;
-          if (!v->is_base() && !order_.less(&v->stamp, t)) fail("reader before its version");
-          if (newer && !order_.less(t, &newer->stamp)) fail("reader after the next version");
+          if (!v->is_base() && !order_.less(&v->stamp, t)) fail("I4: reader before its version");
+          if (newer && !order_.less(t, &newer->stamp)) fail("I4: reader after the next version");
           if (r->unordered != list)
-            fail("a version's reader is on the other list than its flag says");
+            fail("I5: a version's reader is on the other list than its flag says");
           if (list == 0) {
             if (last_ordered && order_.less(last_ordered, t))
-              fail("a version's ordered readers are not newest first");
+              fail("I5: a version's ordered readers are not newest first");
             last_ordered = t;
           }
           ++attached;
@@ -209,27 +213,28 @@ void Engine::check_invariants() const {
       newer = v;
     }
   });
-  // Reads of a default with no version hang on the modifiable; it has no version then.
+  // I4: reads of a default with no version hang on the modifiable; it has no version then.
   for (const ModBase* m : default_mods) {
-    if (!m->default_only()) fail("a read hangs on the default of a modifiable that has versions");
+    if (!m->default_only()) fail("I4: a read hangs on the default of a modifiable that has versions");
     const ReaderLink* first = m->default_readers();
-    if (!first || default_head(first) != m) fail("a modifiable's default readers do not start at its head");
+    if (!first || default_head(first) != m) fail("I4: a modifiable's default readers do not start at its head");
     for (const ReaderLink* r = first; r; r = r->rnext) {
-      if (r->rnext && r->rnext->rpprev != &r->rnext) fail("a default reader list has a broken back link");
-      if (!reads.contains(r)) fail("a default reader is not a live read of the trace");
+      if (r->rnext && r->rnext->rpprev != &r->rnext) fail("I4: a default reader list has a broken back link");
+      if (!reads.contains(r)) fail("I4: a default reader is not a live read of the trace");
       if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
-        fail("a multi-read's slot hangs on another modifiable's default");
+        fail("I4: a multi-read's slot hangs on another modifiable's default");
       ++attached;
     }
   }
-  if (attached != reads.size()) fail("read not attached to the version visible at its time");
+  if (attached != reads.size()) fail("I4: read not attached to the version visible at its time");
+  // I1 and I6: the tables' own structure, and that they hold only live records.
   allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops->hash(n); },
                            [&](const AllocNode* n) {
-                             if (!n->stamp.linked()) fail("allocation table holds an undone record");
+                             if (!n->stamp.linked()) fail("I6: allocation table holds an undone record");
                            });
   memos_.check_invariants("memo table", [](const MemoNode* n) { return n->ops->hash(n); },
                           [&](const MemoNode* n) {
-                            if (!n->start.linked()) fail("memo table holds an undone record");
+                            if (!n->start.linked()) fail("I6: memo table holds an undone record");
                           });
 }
 

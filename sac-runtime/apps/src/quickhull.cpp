@@ -188,7 +188,7 @@ void QuickhullApp::run_conventional() { conventional_ = quickhull_conventional(p
 void QuickhullApp::run_self_adjusting() {
   begin_run();
   out_ = std::make_unique<PointList>();
-  engine_->run([this](sac::Engine& rt) { quickhull(rt, input_->head(), out_.get()); });
+  rt_->run([this](sac::Engine& rt) { quickhull(rt, input_->head(), out_.get()); });
 }
 
 bool QuickhullApp::verify() {

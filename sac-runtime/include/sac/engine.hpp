@@ -304,7 +304,7 @@ class Engine {
   /// whole computation (a program object and its tables). One per engine; the mutator sets
   /// it, before run(), and it must not change while the trace depends on it.
   template <class T>
-  void set_context(T* c) noexcept;
+  void set_context(T* ctx) noexcept;
 
   /// The time of a read whose closure follow() is asked (read_many): the values there.
   class At {

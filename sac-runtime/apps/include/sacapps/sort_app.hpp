@@ -77,7 +77,7 @@ class SortApp : public InputListApp<std::int64_t> {
   void run_self_adjusting() override {
     begin_run();
     out_ = std::make_unique<List<Value>>();
-    engine_->run([this](sac::Engine& rt) { sort_self_adjusting(rt, input_->head(), out_.get()); });
+    rt_->run([this](sac::Engine& rt) { sort_self_adjusting(rt, input_->head(), out_.get()); });
   }
 
   bool verify() override {

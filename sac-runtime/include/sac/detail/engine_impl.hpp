@@ -244,8 +244,8 @@ void Engine::read_many(std::initializer_list<const Mod<T>*> mods, F&& body) {
 // ------------------------------------------------------------------ context
 
 template <class T>
-void Engine::set_context(T* c) noexcept {
-  context_ = c;
+void Engine::set_context(T* ctx) noexcept {
+  context_ = ctx;
   context_type_ = &detail::kTypeTag<T>;
 }
 
