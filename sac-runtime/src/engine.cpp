@@ -790,10 +790,9 @@ void Engine::undo(Stamp* s) {
           // touched but the first (none more when the value is the same).
           ReaderLink* rest = older->readers;
           if (!rest && !older->unordered_readers) {
-            // Both lists go over whole: those that re-execution attached stay unordered (a
-            // cell that the steps of every class read has a thousand readers, and merging
-            // them relinked every one: bench/RESULTS.md, "Clusters far below the box's
-            // scale").
+            // Both lists go over whole: those that re-execution attached stay unordered, as
+            // merging them into order would relink every reader of a cell that many reads
+            // share (docs/DESIGN.md, "Change propagation").
             if ((older->readers = v->readers)) older->readers->rpprev = &older->readers;
             if ((older->unordered_readers = v->unordered_readers))
               older->unordered_readers->rpprev = &older->unordered_readers;

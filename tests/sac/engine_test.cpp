@@ -77,9 +77,8 @@ constexpr int kScale = SAC_ENGINE_TEST_SANITIZED ? 5 : 1;
 
 // ------------------------------------------------------------------ read bodies
 //
-// Read bodies are plain lambdas, the documented way to write them. (body() once wrapped them
-// while Engine::read() failed to compile for closures without operator==; it is kept as the
-// identity so that the tests read the same either way.)
+// Read bodies are plain lambdas, the documented way to write them; body() is the identity,
+// a marker that reads as "this lambda is a read body".
 template <class F>
 std::decay_t<F> body(F&& f) {
   return std::forward<F>(f);
@@ -1499,10 +1498,10 @@ TEST(EngineMisuse, BodyThrowingInPropagatePropagatesAndPoisons) {
 // body performs after a call must land after that call's whole interval (engine.hpp: "the
 // events happen in program order, exactly as if every call ran on the spot").
 
-// Regression (fixed): when a body issued a read and then wrote, flush() ran the read and its
-// close was chained onto the *running* parent's pending close, so the parent's later write
-// was recorded inside the nested read's interval; re-running the nested read then undid it
-// (out2 below lost its only version). Same for alloc/make after a call, and for memo().
+// A body that issues a read and then writes: flush() runs the read, and its close must not
+// be chained onto the *running* parent's pending close, or the parent's later write would be
+// recorded inside the nested read's interval and re-running the nested read would undo it
+// (out2 below would lose its only version). Same for alloc/make after a call, and for memo().
 TEST(EngineOrder, WriteAfterANestedReadStaysOutsideIt) {
   Engine rt;
   Mod<int> a, b, out1, out2;
@@ -1571,8 +1570,8 @@ TEST(EngineOrder, AllocAndMakeAfterNestedCallsStayOutsideThem) {
 // ================================================================ regressions
 
 TEST(EngineClosures, PlainLambdaReadBodies) {
-  // Regression: read() once failed to compile for lambdas (no operator==). The documented
-  // pattern, verbatim: a lambda capturing by value as a read body.
+  // read() accepts lambdas (no operator==): the documented pattern, verbatim, a lambda
+  // capturing by value as a read body.
   Engine rt;
   Mod<int> in, out;
   rt.set(in, 1);
@@ -1696,8 +1695,8 @@ TEST(EngineDebug, DumpDotOfASmallTrace) {
   rt.propagate();
   std::ostringstream os2;
   rt.dump_dot(os2);
-  // Regression: an alloc issued after the memo call once landed inside the memo entry and
-  // was duplicated by each update.
+  // An alloc issued after the memo call lands outside the memo entry, so an update does not
+  // duplicate it.
   EXPECT_EQ(os2.str(), dot) << "same trace shape after an update";
   expect_healthy(rt);
 }
@@ -2158,8 +2157,8 @@ TEST(EngineReaderOrder, AnUndoneVersionsUnorderedReadersMoveWithoutARelinkOfTheO
   // change of pick[i] re-executes that inner read of m, which hangs on m's version among
   // its unordered readers. A change of sel then re-executes the write: the old version is
   // undone onto the new one, which has no readers yet, and both of its lists move over
-  // whole. Merging them into order relinked all 2,000 (a cell read by the steps of every
-  // class: bench/RESULTS.md, "Clusters far below the box's scale"). Outputs, re-runs and
+  // whole, rather than being merged into order, which would relink all 2,000 (a cell read by
+  // the steps of every class: docs/DESIGN.md, "Change propagation"). Outputs, re-runs and
   // the checker are tested after every change (seed printed).
   constexpr int kReaders = 2000;
   Mod<int> sel, m;
@@ -2221,7 +2220,7 @@ TEST(EngineDifferential, PrefixSumsWithMemoRead) {
     differential<PsumProgram>(seed, 100 / kScale, 200 / kScale);
 }
 
-// Writes after reads in the same body (regression for the close-chaining bug above).
+// Writes after reads in the same body (the close chaining of WriteAfterANestedReadStaysOutsideIt).
 TEST(EngineDifferential, PrefixSumsWithWritesAfterReads) {
   for (std::uint64_t seed : {15u, 16u, 17u})
     differential<PsumLateProgram>(seed, 100 / kScale, 200 / kScale);

@@ -13,7 +13,8 @@
 // a default; a modifiable has default readers only while it has no version. Only the
 // engine that wrote a Mod may touch it.
 // Complexity: get() O(1); reads and writes at time t are O(number of versions after t).
-// Follows Acar, Ahmed, Blume, "Imperative self-adjusting computation" (POPL'08).
+// Paper: Acar, Ahmed, Blume, "Imperative self-adjusting computation" (POPL'08);
+// docs/DESIGN.md, "Modifiables, reads and versions".
 #pragma once
 
 #include <cstdint>

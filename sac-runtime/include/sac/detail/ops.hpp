@@ -8,6 +8,7 @@
 // called on records that carry that same table, so the casts are exact; an ops table with
 // key_equal set is the `ops` member of a KeyedAllocOps.
 // Complexity: every entry O(1) plus the user's operator==, Hash and body.
+// Paper: docs/DESIGN.md, "The runtime".
 #pragma once
 
 #include <concepts>

@@ -21,6 +21,7 @@
 // Complexity: less O(1); insert_after O(1) amortized (group relabel/split O(kGroupCap),
 //             top-level relabel O(log n) amortized, spread over Theta(kGroupCap) inserts);
 //             erase O(kGroupCap); erase_between O(number erased).
+// Paper: Dietz, Sleator (STOC'87); Bender et al. (ESA'02); docs/DESIGN.md, "The runtime".
 #pragma once
 
 #include <cstddef>

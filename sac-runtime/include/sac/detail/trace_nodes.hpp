@@ -1,6 +1,7 @@
 // sac/detail/trace_nodes.hpp — the records the trace is made of.
 //
-// Every record embeds its Stamp(s) at a fixed offset so that a stamp met while walking the
+// Purpose: the layout of reads, versions, allocations and memo entries. Every record embeds
+// its Stamp(s) at a fixed offset so that a stamp met while walking the
 // order list leads back to its record (container_of by kind). Records come from the engine's
 // Pool; their type-specific behaviour (destroy, compare, hash, invoke) sits in a static ops
 // table per instantiated type, so a record costs one pointer for it and no vtable — a read,
