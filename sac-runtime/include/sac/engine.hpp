@@ -495,7 +495,7 @@ class Engine {
   /// Hangs r on what it sees, v (from visible_or_default).
   static void attach_seen(detail::ReaderLink* r, const ModBase& m, const detail::VersionBase* v) {
     if (m.default_only()) attach_default(r, m);
-    else attach_timed(r, const_cast<detail::VersionBase*>(v));
+    else detail::attach_timed(r, const_cast<detail::VersionBase*>(v));
   }
   /// m's default made into its base version, if m has a default (init_default) and no base
   /// version yet (m's default readers move onto it); else null. `defaulted`: whether m has
