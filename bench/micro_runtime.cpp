@@ -30,9 +30,9 @@ namespace {
 
 using sac::Engine;
 using sac::Mod;
-using sac::OrderList;
-using sac::Stamp;
-using sac::StampKind;
+using sac::detail::OrderList;
+using sac::detail::Stamp;
+using sac::detail::StampKind;
 
 // ------------------------------------------------------------------------- OrderList
 
@@ -114,7 +114,7 @@ BENCHMARK(BM_OrderListLess)->Arg(1 << 12)->Arg(1 << 20);
 
 struct QElem {
   Stamp stamp;
-  std::uint32_t qpos = sac::kNotQueued;
+  std::uint32_t qpos = sac::detail::kNotQueued;
 };
 struct QTraits {
   static const Stamp* stamp(const QElem* e) { return &e->stamp; }
@@ -134,7 +134,7 @@ void BM_StampQueuePushPop(benchmark::State& state) {
   std::vector<QElem*> order;
   for (QElem& e : elems) order.push_back(&e);
   std::shuffle(order.begin(), order.end(), std::mt19937_64(4));
-  sac::StampQueue<QElem, QTraits> q(ol);
+  sac::detail::StampQueue<QElem, QTraits> q(ol);
   for (auto _ : state) {
     for (QElem* e : order) q.push(e);
     while (!q.empty()) benchmark::DoNotOptimize(q.pop());
@@ -149,7 +149,7 @@ BENCHMARK(BM_StampQueuePushPop)->Arg(1 << 10)->Arg(1 << 16);
 // operator== on the closure; see tests/sac/engine_test.cpp, PlainLambdaReadBodies_Bug).
 struct AddOne {
   Mod<int>* out;
-  void operator()(Engine& e, int v) const { e.write(*out, v + 1); }
+  void operator()(Engine& rt, int v) const { rt.write(*out, v + 1); }
   bool operator==(const AddOne&) const = default;
 };
 
@@ -163,16 +163,16 @@ void BM_EngineReadWriteFromScratch(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
   for (auto _ : state) {
     state.PauseTiming();
-    auto e = std::make_unique<Engine>();
+    auto rt = std::make_unique<Engine>();
     auto f = std::make_unique<Flat>(n);
-    for (std::size_t i = 0; i < n; ++i) e->set(f->in[i], static_cast<int>(i));
+    for (std::size_t i = 0; i < n; ++i) rt->set(f->in[i], static_cast<int>(i));
     state.ResumeTiming();
-    e->run([&](Engine& en) {
-      for (std::size_t i = 0; i < n; ++i) en.read(f->in[i], AddOne{&f->out[i]});
+    rt->run([&](Engine& rt2) {
+      for (std::size_t i = 0; i < n; ++i) rt2.read(f->in[i], AddOne{&f->out[i]});
     });
     benchmark::DoNotOptimize(f->out[n - 1].get());
     state.PauseTiming();
-    e.reset();
+    rt.reset();
     f.reset();
     state.ResumeTiming();
   }
@@ -184,15 +184,15 @@ void BM_EngineWrite(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
   for (auto _ : state) {
     state.PauseTiming();
-    auto e = std::make_unique<Engine>();
+    auto rt = std::make_unique<Engine>();
     auto f = std::make_unique<Flat>(n);
     state.ResumeTiming();
-    e->run([&](Engine& en) {
-      for (std::size_t i = 0; i < n; ++i) en.write(f->out[i], static_cast<int>(i));
+    rt->run([&](Engine& rt2) {
+      for (std::size_t i = 0; i < n; ++i) rt2.write(f->out[i], static_cast<int>(i));
     });
     benchmark::DoNotOptimize(f->out[n - 1].get());
     state.PauseTiming();
-    e.reset();
+    rt.reset();
     f.reset();
     state.ResumeTiming();
   }
@@ -215,43 +215,43 @@ struct OutCell {
   explicit OutCell(int v) : value(v) {}
 };
 
-void map_step(Engine& e, Cell* c, Mod<OutCell*>* dst) {
+void map_step(Engine& rt, Cell* c, Mod<OutCell*>* dst) {
   if (!c) {
-    e.write(*dst, static_cast<OutCell*>(nullptr));
+    rt.write(*dst, static_cast<OutCell*>(nullptr));
     return;
   }
-  OutCell* o = e.alloc<OutCell>(c->id, 2 * c->value);
-  e.write(*dst, o);
-  e.memo_read(c->next, sac::fn<map_step>(&o->next));
+  OutCell* o = rt.alloc<OutCell>(c->id, 2 * c->value);
+  rt.write(*dst, o);
+  rt.memo_read(c->next, sac::fn<map_step>(&o->next));
 }
 
 void BM_EngineMemoMapPropagate(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
-  Engine e;
+  Engine rt;
   Mod<Cell*> head;
   Mod<OutCell*> out;
   std::vector<std::unique_ptr<Cell>> cells;
   for (std::size_t i = 0; i < n; ++i) cells.push_back(std::make_unique<Cell>(static_cast<int>(i), i));
-  for (std::size_t i = 0; i < n; ++i) e.set(cells[i]->next, i + 1 < n ? cells[i + 1].get() : nullptr);
-  e.set(head, cells[0].get());
-  e.run([&](Engine& en) { en.memo_read(head, sac::fn<map_step>(&out)); });
+  for (std::size_t i = 0; i < n; ++i) rt.set(cells[i]->next, i + 1 < n ? cells[i + 1].get() : nullptr);
+  rt.set(head, cells[0].get());
+  rt.run([&](Engine& rt2) { rt2.memo_read(head, sac::fn<map_step>(&out)); });
   std::mt19937_64 rng(5);
-  const std::uint64_t hits0 = e.stats().memo_hits;
+  const std::uint64_t hits0 = rt.stats().memo_hits;
   std::uint64_t propagations = 0;
   for (auto _ : state) {
     // Remove element i (1 <= i < n-1) and put it back: two propagations.
     const std::size_t i = 1 + static_cast<std::size_t>(rng() % (n - 2));
     Cell* c = cells[i].get();
-    e.set(cells[i - 1]->next, c->next.get());
-    e.propagate();
-    e.set(cells[i - 1]->next, c);
-    e.propagate();
+    rt.set(cells[i - 1]->next, c->next.get());
+    rt.propagate();
+    rt.set(cells[i - 1]->next, c);
+    rt.propagate();
     propagations += 2;
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(propagations));
   state.counters["memo_hits_per_propagate"] =
-      propagations ? static_cast<double>(e.stats().memo_hits - hits0) / static_cast<double>(propagations) : 0.0;
-  state.counters["live_events"] = static_cast<double>(e.live_events());
+      propagations ? static_cast<double>(rt.stats().memo_hits - hits0) / static_cast<double>(propagations) : 0.0;
+  state.counters["live_events"] = static_cast<double>(rt.live_events());
 }
 BENCHMARK(BM_EngineMemoMapPropagate)->Arg(1 << 10)->Arg(1 << 16);
 
@@ -264,27 +264,27 @@ struct NearOut {
   Mod<long> work;
   Mod<NearOut*> next;
 };
-void near_work(Engine& e, Cell* c, NearOut* o) {
+void near_work(Engine& rt, Cell* c, NearOut* o) {
   long x = c->value;
   for (int k = 0; k < 64; ++k) x = x * 6364136223846793005L + 1442695040888963407L;
-  e.write(o->work, x);
+  rt.write(o->work, x);
 }
 // pred, grand: the two elements before c (the key of the read of c->next holds c and pred).
 template <bool Near>
-void near_step(Engine& e, Cell* c, Mod<NearOut*>* dst, Cell* pred, Cell* grand) {
+void near_step(Engine& rt, Cell* c, Mod<NearOut*>* dst, Cell* pred, Cell* grand) {
   (void)grand;
-  if (!c) return e.write(*dst, static_cast<NearOut*>(nullptr));
-  NearOut* o = e.alloc<NearOut>(c->id);
-  e.write(*dst, o);
-  if constexpr (Near) e.memo_near(16, sac::fn<near_work>(c, o));
-  else e.memo(sac::fn<near_work>(c, o));
-  e.memo_read(c->next, sac::fn<near_step<Near>>(&o->next, c, pred));
+  if (!c) return rt.write(*dst, static_cast<NearOut*>(nullptr));
+  NearOut* o = rt.alloc<NearOut>(c->id);
+  rt.write(*dst, o);
+  if constexpr (Near) rt.memo_near(16, sac::fn<near_work>(c, o));
+  else rt.memo(sac::fn<near_work>(c, o));
+  rt.memo_read(c->next, sac::fn<near_step<Near>>(&o->next, c, pred));
 }
 
 template <bool Near>
 void BM_EngineMemoNearMove(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
-  Engine e;
+  Engine rt;
   Mod<Cell*> head;
   Mod<NearOut*> out;
   std::vector<std::unique_ptr<Cell>> cells;
@@ -294,20 +294,20 @@ void BM_EngineMemoNearMove(benchmark::State& state) {
     order.push_back(cells.back().get());
   }
   const auto relink = [&] {
-    e.set(head, order.front());
-    for (std::size_t i = 0; i < n; ++i) e.set(order[i]->next, i + 1 < n ? order[i + 1] : nullptr);
+    rt.set(head, order.front());
+    for (std::size_t i = 0; i < n; ++i) rt.set(order[i]->next, i + 1 < n ? order[i + 1] : nullptr);
   };
   relink();
   // After a move between places a and b, only the links around them can differ.
   const auto fix = [&](std::size_t a, std::size_t b) {
-    e.set(head, order.front());
+    rt.set(head, order.front());
     for (const std::size_t p : {a, b})
       for (std::size_t i = p >= 2 ? p - 2 : 0; i < std::min(n, p + 2); ++i)
-        e.set(order[i]->next, i + 1 < n ? order[i + 1] : nullptr);
+        rt.set(order[i]->next, i + 1 < n ? order[i + 1] : nullptr);
   };
-  e.run([&](Engine& en) { en.memo_read(head, sac::fn<near_step<Near>>(&out, static_cast<Cell*>(nullptr), static_cast<Cell*>(nullptr))); });
+  rt.run([&](Engine& rt2) { rt2.memo_read(head, sac::fn<near_step<Near>>(&out, static_cast<Cell*>(nullptr), static_cast<Cell*>(nullptr))); });
   std::mt19937_64 rng(5);
-  const std::uint64_t d0 = e.stats().events_created + e.stats().events_undone;
+  const std::uint64_t d0 = rt.stats().events_created + rt.stats().events_undone;
   std::uint64_t propagations = 0;
   for (auto _ : state) {
     const std::size_t from = rng() % n, to = rng() % n;
@@ -315,16 +315,16 @@ void BM_EngineMemoNearMove(benchmark::State& state) {
     order.erase(order.begin() + static_cast<long>(from));
     order.insert(order.begin() + static_cast<long>(to), c);
     fix(from, to);
-    e.propagate();
+    rt.propagate();
     order.erase(order.begin() + static_cast<long>(to));
     order.insert(order.begin() + static_cast<long>(from), c);
     fix(from, to);
-    e.propagate();
+    rt.propagate();
     propagations += 2;
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(propagations));
   state.counters["distance_per_propagate"] =
-      propagations ? static_cast<double>(e.stats().events_created + e.stats().events_undone - d0) /
+      propagations ? static_cast<double>(rt.stats().events_created + rt.stats().events_undone - d0) /
                          static_cast<double>(propagations)
                    : 0.0;
 }
@@ -337,10 +337,10 @@ constexpr int kManyK = 4;
 
 struct SumMany {
   Mod<int>* out;
-  void operator()(Engine& e, std::span<const int* const> v) const {
+  void operator()(Engine& rt, std::span<const int* const> v) const {
     int s = 0;
     for (const int* x : v) s += *x;
-    e.write(*out, s);
+    rt.write(*out, s);
   }
 };
 
@@ -349,25 +349,25 @@ struct SumNested {
   Mod<int>* out;
   std::uint32_t step, j;
   int acc;
-  void operator()(Engine& e, int v) const {
+  void operator()(Engine& rt, int v) const {
     if (j + 1 == kManyK) {
-      e.write(*out, acc + v);
+      rt.write(*out, acc + v);
       return;
     }
     const std::size_t n = in->size();
-    e.read((*in)[(step + j + 1) % n], SumNested{in, out, step, j + 1, acc + v});
+    rt.read((*in)[(step + j + 1) % n], SumNested{in, out, step, j + 1, acc + v});
   }
 };
 
 template <bool kMany>
-void run_steps(Engine& en, Flat& f) {
+void run_steps(Engine& rt, Flat& f) {
   const std::size_t n = f.in.size();
   for (std::size_t i = 0; i < n; ++i) {
     if constexpr (kMany) {
-      en.read_many({&f.in[i], &f.in[(i + 1) % n], &f.in[(i + 2) % n], &f.in[(i + 3) % n]},
+      rt.read_many({&f.in[i], &f.in[(i + 1) % n], &f.in[(i + 2) % n], &f.in[(i + 3) % n]},
                    SumMany{&f.out[i]});
     } else {
-      en.read(f.in[i], SumNested{&f.in, &f.out[i], static_cast<std::uint32_t>(i), 0, 0});
+      rt.read(f.in[i], SumNested{&f.in, &f.out[i], static_cast<std::uint32_t>(i), 0, 0});
     }
   }
 }
@@ -378,16 +378,16 @@ void BM_EngineRead4FromScratch(benchmark::State& state) {
   double bytes = 0, events = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    auto e = std::make_unique<Engine>();
+    auto rt = std::make_unique<Engine>();
     auto f = std::make_unique<Flat>(n);
-    for (std::size_t i = 0; i < n; ++i) e->set(f->in[i], static_cast<int>(i));
+    for (std::size_t i = 0; i < n; ++i) rt->set(f->in[i], static_cast<int>(i));
     state.ResumeTiming();
-    e->run([&](Engine& en) { run_steps<kMany>(en, *f); });
+    rt->run([&](Engine& rt2) { run_steps<kMany>(rt2, *f); });
     benchmark::DoNotOptimize(f->out[n - 1].get());
     state.PauseTiming();
-    bytes = static_cast<double>(e->record_bytes()) / static_cast<double>(n);
-    events = static_cast<double>(e->live_events()) / static_cast<double>(n);
-    e.reset();
+    bytes = static_cast<double>(rt->record_bytes()) / static_cast<double>(n);
+    events = static_cast<double>(rt->live_events()) / static_cast<double>(n);
+    rt.reset();
     f.reset();
     state.ResumeTiming();
   }
@@ -400,16 +400,16 @@ BENCHMARK_TEMPLATE(BM_EngineRead4FromScratch, false)->Arg(1 << 10)->Arg(1 << 18)
 
 /// The timed loop of the propagate benchmarks: each iteration adds delta to a random input
 /// and propagates.
-void propagate_changes(benchmark::State& state, Engine& e, Flat& f, int delta) {
+void propagate_changes(benchmark::State& state, Engine& rt, Flat& f, int delta) {
   const std::size_t n = f.in.size();
   std::mt19937_64 rng(7);
   std::uint64_t propagations = 0, reexecuted = 0;
   for (auto _ : state) {
     const std::size_t i = static_cast<std::size_t>(rng() % n);
-    e.set(f.in[i], f.in[i].get() + delta);
-    e.propagate();
+    rt.set(f.in[i], f.in[i].get() + delta);
+    rt.propagate();
     ++propagations;
-    reexecuted += e.stats().last_reexecuted;
+    reexecuted += rt.stats().last_reexecuted;
   }
   state.SetItemsProcessed(static_cast<std::int64_t>(propagations));
   state.counters["reexecuted_per_propagate"] =
@@ -419,13 +419,13 @@ void propagate_changes(benchmark::State& state, Engine& e, Flat& f, int delta) {
 template <bool kMany>
 void BM_EngineRead4Propagate(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
-  Engine e;
+  Engine rt;
   Flat f(n);
-  for (std::size_t i = 0; i < n; ++i) e.set(f.in[i], static_cast<int>(i));
-  e.run([&](Engine& en) { run_steps<kMany>(en, f); });
-  propagate_changes(state, e, f, 1);  // always a change: 4 steps read it
-  state.counters["trace_bytes_per_step"] = static_cast<double>(e.trace_bytes()) / static_cast<double>(n);
-  state.counters["record_bytes_per_step"] = static_cast<double>(e.record_bytes()) / static_cast<double>(n);
+  for (std::size_t i = 0; i < n; ++i) rt.set(f.in[i], static_cast<int>(i));
+  rt.run([&](Engine& rt2) { run_steps<kMany>(rt2, f); });
+  propagate_changes(state, rt, f, 1);  // always a change: 4 steps read it
+  state.counters["trace_bytes_per_step"] = static_cast<double>(rt.trace_bytes()) / static_cast<double>(n);
+  state.counters["record_bytes_per_step"] = static_cast<double>(rt.record_bytes()) / static_cast<double>(n);
 }
 BENCHMARK_TEMPLATE(BM_EngineRead4Propagate, true)->Arg(1 << 10)->Arg(1 << 16);
 BENCHMARK_TEMPLATE(BM_EngineRead4Propagate, false)->Arg(1 << 10)->Arg(1 << 16);
@@ -437,10 +437,10 @@ BENCHMARK_TEMPLATE(BM_EngineRead4Propagate, false)->Arg(1 << 10)->Arg(1 << 16);
 template <bool kProjected>
 struct SumLow {
   Mod<int>* out;
-  void operator()(Engine& e, std::span<const int* const> v) const {
+  void operator()(Engine& rt, std::span<const int* const> v) const {
     int s = 0;
     for (const int* x : v) s += *x & 15;
-    e.write(*out, s);
+    rt.write(*out, s);
   }
 };
 template <>
@@ -452,15 +452,15 @@ template <bool kProjected>
 void BM_EngineRead4ProjectionPropagate(benchmark::State& state) {
   const auto n = static_cast<std::size_t>(state.range(0));
   const int delta = static_cast<int>(state.range(1));
-  Engine e;
+  Engine rt;
   Flat f(n);
-  for (std::size_t i = 0; i < n; ++i) e.set(f.in[i], static_cast<int>(i));
-  e.run([&](Engine& en) {
+  for (std::size_t i = 0; i < n; ++i) rt.set(f.in[i], static_cast<int>(i));
+  rt.run([&](Engine& rt2) {
     for (std::size_t i = 0; i < n; ++i)
-      en.read_many({&f.in[i], &f.in[(i + 1) % n], &f.in[(i + 2) % n], &f.in[(i + 3) % n]},
+      rt2.read_many({&f.in[i], &f.in[(i + 1) % n], &f.in[(i + 2) % n], &f.in[(i + 3) % n]},
                    SumLow<kProjected>{{&f.out[i]}});
   });
-  propagate_changes(state, e, f, delta);
+  propagate_changes(state, rt, f, delta);
 }
 BENCHMARK_TEMPLATE(BM_EngineRead4ProjectionPropagate, true)->Args({1 << 16, 16})->Args({1 << 16, 1});
 BENCHMARK_TEMPLATE(BM_EngineRead4ProjectionPropagate, false)->Args({1 << 16, 16})->Args({1 << 16, 1});

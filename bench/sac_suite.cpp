@@ -121,8 +121,8 @@ std::vector<std::string> split(const std::string& s) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Engines are built one after another: keep their freed chunks warm, as the figures in
-  // RESULTS.md were measured (sac/chunk_cache.hpp; a user's default is 64 MiB).
+  // Engines are built one after another: keep their freed chunks warm (sac/chunk_cache.hpp),
+  // so that an engine's run does not pay for fresh pages of memory its predecessor freed.
   sac::set_chunk_cache_limit(std::size_t{1} << 30);
   CLI::App cli{"sac_suite: the classic self-adjusting computation benchmarks"};
   std::string apps_arg;

@@ -27,8 +27,8 @@ void running_sum(sac::Engine& rt, Cell* c, const sac::Mod<long>* before, sac::Mo
   }
   Out* o = rt.alloc<Out>(c);  // keyed by the input cell: re-executions get the same cell back
   rt.write(*dst, o);
-  rt.read(*before, [=](sac::Engine& e, long s) {
-    e.read(c->value, [=](sac::Engine& e2, long v) { e2.write(o->sum, s + v); });
+  rt.read(*before, [=](sac::Engine& rt2, long s) {
+    rt2.read(c->value, [=](sac::Engine& rt3, long v) { rt3.write(o->sum, s + v); });
   });
   rt.memo_read(c->next, sac::fn<running_sum>(static_cast<const sac::Mod<long>*>(&o->sum), &o->next));
 }
@@ -72,8 +72,8 @@ int main() {
 
   // Run once from scratch.
   sac::Mod<Out*> out;
-  rt.run([&](sac::Engine& e) {
-    e.memo_read(head, sac::fn<running_sum>(static_cast<const sac::Mod<long>*>(&zero), &out));
+  rt.run([&](sac::Engine& rt2) {
+    rt2.memo_read(head, sac::fn<running_sum>(static_cast<const sac::Mod<long>*>(&zero), &out));
   });
   print("from scratch:", outputs(out), rt);
   bool ok = outputs(out) == expected(head);

@@ -1,129 +1,44 @@
-// The engine's non-template machinery: change propagation, undo, memo matching, checks.
+// engine.cpp — the engine's hot, non-template machinery.
+//
+// Purpose: versions (visibility, linking a write, moving readers), the trampoline, change
+// propagation, memo matching and undo. They stay in one translation unit so that the
+// compiler can inline across them without LTO; the cold code is elsewhere (the checker in
+// engine_check.cpp, the introspection in engine_introspection.cpp, the stamp decoder in
+// records.hpp).
+// Invariants: those numbered in sac/engine.hpp (I1 ...), which every function here
+// preserves between the engine's public calls.
+// Complexity: see sac/engine.hpp.
+// Paper: docs/DESIGN.md, "Change propagation".
 #include "sac/engine.hpp"
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <map>
-#include <ostream>
 #include <string>
 #include <type_traits>
-#include <unordered_map>
 #include <utility>
 #include <vector>
 
-#include "sac/hash.hpp"
+#include "records.hpp"
 
 namespace sac {
 
 using detail::AllocNode;
+using detail::Stamp;
+using detail::StampKind;
+using detail::attach;
+using detail::attach_timed;
+using detail::attach_unordered;
+using detail::default_head;
+using detail::detach;
+using detail::kNotQueued;
+using detail::Kind;
 using detail::MemoNode;
 using detail::ReaderLink;
 using detail::ReadNode;
 using detail::ReadSlot;
 using detail::VersionBase;
 using detail::owner_of;
-
-namespace {
-
-/// The record whose stamp at `offset` is s (container_of), const when s is.
-template <class N, class S>
-N* record_at(S* s, std::size_t offset) {
-  using Byte = std::conditional_t<std::is_const_v<S>, const char, char>;
-  return reinterpret_cast<N*>(reinterpret_cast<Byte*>(s) - offset);
-}
-
-/// A stamp kind as a type: the first argument visit_record passes.
-template <StampKind K>
-using Kind = std::integral_constant<StampKind, K>;
-
-/// The one decoder of stamp kinds: calls f(Kind<k>{}, record) for k = s->kind(), with the
-/// record s belongs to typed by k (ReadNode for ReadStart/ReadEnd, VersionBase for Write,
-/// AllocNode for Alloc, MemoNode for MemoStart/MemoEnd; s itself for Sentinel and User),
-/// const when s is. f is typically [&]<StampKind K>(Kind<K>, auto* rec) { if constexpr ... }.
-template <class S, class F>
-void visit_record(S* s, F&& f) {
-  constexpr bool c = std::is_const_v<S>;
-  using Read = std::conditional_t<c, const ReadNode, ReadNode>;
-  using Version = std::conditional_t<c, const VersionBase, VersionBase>;
-  using Alloc = std::conditional_t<c, const AllocNode, AllocNode>;
-  using Memo = std::conditional_t<c, const MemoNode, MemoNode>;
-  switch (s->kind()) {
-    case StampKind::ReadStart:
-      f(Kind<StampKind::ReadStart>{}, record_at<Read>(s, offsetof(ReadNode, start)));
-      break;
-    case StampKind::ReadEnd:
-      f(Kind<StampKind::ReadEnd>{}, record_at<Read>(s, offsetof(ReadNode, end)));
-      break;
-    case StampKind::Write:
-      f(Kind<StampKind::Write>{}, record_at<Version>(s, offsetof(VersionBase, stamp)));
-      break;
-    case StampKind::Alloc:
-      f(Kind<StampKind::Alloc>{}, record_at<Alloc>(s, offsetof(AllocNode, stamp)));
-      break;
-    case StampKind::MemoStart:
-      f(Kind<StampKind::MemoStart>{}, record_at<Memo>(s, offsetof(MemoNode, start)));
-      break;
-    case StampKind::MemoEnd:
-      f(Kind<StampKind::MemoEnd>{}, record_at<Memo>(s, offsetof(MemoNode, end)));
-      break;
-    case StampKind::Sentinel:
-      f(Kind<StampKind::Sentinel>{}, s);
-      break;
-    case StampKind::User:
-      f(Kind<StampKind::User>{}, s);
-      break;
-  }
-}
-
-/// The checker's set of record addresses: open addressing in one array. A node-based hash
-/// set allocated per element, which dominated check_invariants() in the sanitizer build,
-/// where SAC_DEBUG_CHECKS runs it after every propagation.
-class AddressSet {
- public:
-  explicit AddressSet(std::size_t expected) {
-    std::size_t n = 64;
-    while (n < 2 * expected) n *= 2;
-    slots_.assign(n, nullptr);
-  }
-  /// Adds p (not null); false if it was there already.
-  bool insert(const void* p) {
-    if (2 * (size_ + 1) > slots_.size()) grow();
-    const std::size_t i = slot_of(p);
-    if (slots_[i]) return false;
-    slots_[i] = p;
-    ++size_;
-    return true;
-  }
-  bool contains(const void* p) const { return slots_[slot_of(p)] != nullptr; }
-  std::size_t size() const { return size_; }
-  template <class F>
-  void for_each(F&& f) const {
-    for (const void* p : slots_)
-      if (p) f(p);
-  }
-
- private:
-  /// p's slot, or the empty slot where it would go (linear probing).
-  std::size_t slot_of(const void* p) const {
-    const std::size_t mask = slots_.size() - 1;
-    std::size_t i = static_cast<std::size_t>(mix64(reinterpret_cast<std::uintptr_t>(p))) & mask;
-    while (slots_[i] && slots_[i] != p) i = (i + 1) & mask;
-    return i;
-  }
-  void grow() {
-    std::vector<const void*> old(slots_.size() * 2, nullptr);
-    old.swap(slots_);
-    size_ = 0;
-    for (const void* p : old)
-      if (p) insert(p);
-  }
-
-  std::vector<const void*> slots_;
-  std::size_t size_ = 0;
-};
-
-}  // namespace
+using detail::visit_record;
 
 Engine::Engine() { tail_ = order_.base(); }
 
@@ -875,10 +790,9 @@ void Engine::undo(Stamp* s) {
           // touched but the first (none more when the value is the same).
           ReaderLink* rest = older->readers;
           if (!rest && !older->unordered_readers) {
-            // Both lists go over whole: those that re-execution attached stay unordered (a
-            // cell that the steps of every class read has a thousand readers, and merging
-            // them relinked every one: bench/RESULTS.md, "Clusters far below the box's
-            // scale").
+            // Both lists go over whole: those that re-execution attached stay unordered, as
+            // merging them into order would relink every reader of a cell that many reads
+            // share (docs/DESIGN.md, "Change propagation").
             if ((older->readers = v->readers)) older->readers->rpprev = &older->readers;
             if ((older->unordered_readers = v->unordered_readers))
               older->unordered_readers->rpprev = &older->unordered_readers;
@@ -962,288 +876,6 @@ void Engine::destroy_all() noexcept {
   }
   bases_.clear();
   input_bytes_ = 0;
-}
-
-// ------------------------------------------------------------------ introspection
-
-std::size_t Engine::trace_bytes() const {
-  return record_bytes() + order_.memory_bytes() + queue_.memory_bytes() +
-         allocs_.memory_bytes() + memos_.memory_bytes() +
-         deferred_.capacity() * sizeof(AllocNode*) + dead_versions_.capacity() * sizeof(VersionBase*) +
-         seen_.capacity() * sizeof(Seen);
-}
-
-MemoryBreakdown Engine::memory_breakdown() const {
-  if (in_computation_) throw UsageError("sac::Engine::memory_breakdown: not inside the computation");
-  MemoryBreakdown b;
-  // A record of `size` bytes (its ops->size, i.e. sizeof) is a pool block of the size rounded
-  // to the grain; the fixed `header` and the `key` come first, the rest is the payload.
-  auto block_of = [](std::size_t size) {
-    constexpr std::size_t g = detail::Pool::kGrain;
-    return size < g ? g : (size + g - 1) & ~(g - 1);
-  };
-  auto add = [&](RecordBytes& kind, std::size_t size, std::size_t header, std::size_t key) {
-    const std::size_t block = block_of(size);
-    if (block > detail::Pool::kMaxSmall) b.pool_large += block;
-    b.size_class_rounding += block - size;
-    ++kind.count;
-    kind.header += header;
-    kind.key += key;
-    kind.payload += block - header - key;
-  };
-  std::map<std::size_t, std::uint64_t> read_sizes;  // a few closure types: a few sizes
-  // Each record once, at its first stamp (a read's or memo entry's end stamp is in the
-  // same record).
-  for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
-    visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
-      if constexpr (K == StampKind::ReadStart) {
-        const std::size_t size = read_size(rec);
-        const std::size_t header =
-            rec->many() ? detail::ReadManyHeader::closure_offset(detail::many_of(rec)->k) : sizeof(ReadNode);
-        add(b.reads, size, header, 0);
-        ++read_sizes[block_of(size)];
-      } else if constexpr (K == StampKind::Write) {
-        add(b.versions, rec->ops->size, sizeof(VersionBase), 0);
-      } else if constexpr (K == StampKind::Alloc) {
-        if (rec->ops->key_equal)
-          add(b.keyed_allocs, rec->ops->size, sizeof(AllocNode),
-              reinterpret_cast<const detail::KeyedAllocOps*>(rec->ops)->key_bytes);
-        else
-          add(b.plain_allocs, rec->ops->size, sizeof(AllocNode), 0);
-      } else if constexpr (K == StampKind::MemoStart) {
-        add(b.memos, rec->ops->size, sizeof(MemoNode), 0);
-      }
-    });
-  }
-  for (const VersionBase* v : bases_) add(b.inputs, v->ops->size, sizeof(VersionBase), 0);
-  b.read_sizes.assign(read_sizes.begin(), read_sizes.end());
-  b.unaccounted = static_cast<std::int64_t>(record_bytes()) - static_cast<std::int64_t>(b.records());
-  b.order_groups = order_.group_count();
-  b.order_bytes = order_.memory_bytes();
-  b.queue_bytes = queue_.memory_bytes();
-  b.alloc_table_bytes = allocs_.memory_bytes();
-  b.memo_table_bytes = memos_.memory_bytes();
-  b.deferred_bytes = deferred_.capacity() * sizeof(AllocNode*) + dead_versions_.capacity() * sizeof(VersionBase*) +
-                     seen_.capacity() * sizeof(Seen);
-  b.engine_vectors = bases_.capacity() * sizeof(VersionBase*) + tasks_.capacity() * sizeof(Task) +
-                     reruns_.capacity() * sizeof(RerunContext) + issued_.capacity() * sizeof(Task) +
-                     pending_.directory_bytes();
-  b.pool_reserved = pool_.reserved_bytes();
-  return b;
-}
-
-void Engine::check_invariants() const {
-  if (in_computation_) throw UsageError("sac::Engine::check_invariants: not inside the computation");
-  auto fail = [](const std::string& what) { throw InvariantError("Engine trace: " + what); };
-  order_.check_invariants();
-  queue_.check_invariants();
-  if (!queue_.empty()) fail("queue not empty outside propagate()");
-  if (!deferred_.empty()) fail("deferred frees left after propagate()");
-  if (!dead_versions_.empty() || !seen_.empty()) fail("undone versions or seen lists left after propagate()");
-
-  // Walk the trace: nesting, per-record checks, counts.
-  struct Open {
-    const Stamp* close;   // stamp that closes this interval
-    bool is_memo;
-  };
-  std::vector<Open> stack;
-  std::uint64_t events = 0;
-  std::size_t nkeyed = 0, nmemo = 0;
-  AddressSet mods(stats_.live_events / 2);  // the modifiables written (then: or read)
-  AddressSet reads(stats_.live_events / 2);  // the reader list entries: links and slots
-  std::vector<const ModBase*> default_mods;  // one per modifiable whose default reads hang on it
-  for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
-    visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
-      if constexpr (K == StampKind::ReadStart) {
-        const ReadNode* r = rec;
-        ++events;
-        if (!r->end.linked()) fail("read without end stamp");
-        if (!order_.less(&r->start, &r->end)) fail("read end not after start");
-        // Attachment to the version visible at its start is checked below, from the
-        // version side (a read record does not name its modifiable; scanning the visible
-        // version's readers here would also be quadratic in a modifiable's fan-out).
-        if (r->link.qpos != kNotQueued) fail("read still queued");
-        if (r->many()) {
-          // A multi-read hangs on versions through its slots only; each slot is checked
-          // below, with its modifiable, like a read.
-          const detail::ReadManyHeader* h = detail::many_of(r);
-          if (r->link.rpprev) fail("a multi-read's own link is attached");
-          if (h->k == 0 || h->k > detail::kMaxReadMany) fail("a multi-read with a bad slot count");
-          for (std::uint32_t i = 0; i < h->k; ++i) {
-            const ReaderLink* l = &h->slots()[i].link;
-            if (!detail::is_slot(l) || l->qpos != i || owner_of(l) != r) fail("a multi-read's slot is malformed");
-            reads.insert(l);
-            if (const ModBase* m = default_head(l)) default_mods.push_back(m);
-          }
-        } else {
-          reads.insert(&r->link);
-          if (const ModBase* m = default_head(&r->link)) default_mods.push_back(m);
-        }
-        stack.push_back({&r->end, false});
-      } else if constexpr (K == StampKind::ReadEnd) {
-        if (stack.empty() || stack.back().close != s || stack.back().is_memo)
-          fail("read intervals not well nested");
-        stack.pop_back();
-      } else if constexpr (K == StampKind::Write) {
-        const VersionBase* v = rec;
-        ++events;
-        mods.insert(v->mod());
-        bool found = false;
-        for (const VersionBase* x = v->mod()->newest(); x; x = x->older())
-          if (x == v) found = true;
-        if (!found) fail("write not in its modifiable's version list");
-      } else if constexpr (K == StampKind::Alloc) {
-        ++events;
-        if (rec->ops->key_equal) ++nkeyed;
-      } else if constexpr (K == StampKind::MemoStart) {
-        const MemoNode* n = rec;
-        ++events;
-        ++nmemo;
-        if (!n->end.linked() ||
-            !order_.less(&n->start, &n->end))
-          fail("memo entry without a proper end stamp");
-        stack.push_back({&n->end, true});
-      } else if constexpr (K == StampKind::MemoEnd) {
-        if (stack.empty() || stack.back().close != s || !stack.back().is_memo)
-          fail("memo intervals not well nested");
-        stack.pop_back();
-      } else {
-        fail("unexpected stamp kind");
-      }
-    });
-  }
-  if (!stack.empty()) fail("unclosed intervals at the end of the trace");
-  if (events != stats_.live_events) fail("live event count mismatch");
-  if (nkeyed != allocs_.size()) fail("allocation table size mismatch");
-  if (nmemo != memos_.size()) fail("memo table size mismatch");
-
-  // Versions of every written or read modifiable: strictly decreasing time, base last,
-  // readers between this version and the next newer one (so each reader hangs on the version
-  // visible at its time), and every reader a live read of the trace, each exactly once.
-  // A live read hangs on a computation's version, a base version or (below) a default with
-  // no version; so these cover every read.
-  for (const VersionBase* b : bases_) mods.insert(b->mod());
-  std::size_t attached = 0;
-  mods.for_each([&](const void* mod) {
-    const auto* m = static_cast<const ModBase*>(mod);
-    const VersionBase* newer = nullptr;
-    for (const VersionBase* v = m->newest(); v; v = v->older()) {
-      if (v->mod() != m) fail("version chain does not end at its modifiable");
-      if (v->is_base()) {
-        if (v->older()) fail("base version is not the oldest");
-      } else {
-        if (!v->stamp.linked()) fail("version with unlinked stamp");
-        if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("versions out of order");
-      }
-      for (int list = 0; list < 2; ++list) {
-        const ReaderLink* const* back = list == 0 ? &v->readers : &v->unordered_readers;
-        const Stamp* last_ordered = nullptr;  // the time of the last ordered reader seen
-        for (const ReaderLink* r = *back; r; back = &r->rnext, r = r->rnext) {
-          if (r->rpprev != back) fail("a version's reader list has a broken back link");
-          // Membership first: only then may r be decoded (a slot's owner from its index).
-          if (!reads.contains(r)) fail("a version's reader is not a live read of the trace");
-          if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
-            fail("a multi-read's slot hangs on another modifiable's version");
-          const Stamp* t = &owner_of(r)->start;
-          if (!v->is_base() && !order_.less(&v->stamp, t)) fail("reader before its version");
-          if (newer && !order_.less(t, &newer->stamp)) fail("reader after the next version");
-          if (r->unordered != list)
-            fail("a version's reader is on the other list than its flag says");
-          if (list == 0) {
-            if (last_ordered && order_.less(last_ordered, t))
-              fail("a version's ordered readers are not newest first");
-            last_ordered = t;
-          }
-          ++attached;
-        }
-      }
-      newer = v;
-    }
-  });
-  // Reads of a default with no version hang on the modifiable; it has no version then.
-  for (const ModBase* m : default_mods) {
-    if (!m->default_only()) fail("a read hangs on the default of a modifiable that has versions");
-    const ReaderLink* first = m->default_readers();
-    if (!first || default_head(first) != m) fail("a modifiable's default readers do not start at its head");
-    for (const ReaderLink* r = first; r; r = r->rnext) {
-      if (r->rnext && r->rnext->rpprev != &r->rnext) fail("a default reader list has a broken back link");
-      if (!reads.contains(r)) fail("a default reader is not a live read of the trace");
-      if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
-        fail("a multi-read's slot hangs on another modifiable's default");
-      ++attached;
-    }
-  }
-  if (attached != reads.size()) fail("read not attached to the version visible at its time");
-  allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops->hash(n); },
-                           [&](const AllocNode* n) {
-                             if (!n->stamp.linked()) fail("allocation table holds an undone record");
-                           });
-  memos_.check_invariants("memo table", [](const MemoNode* n) { return n->ops->hash(n); },
-                          [&](const MemoNode* n) {
-                            if (!n->start.linked()) fail("memo table holds an undone record");
-                          });
-}
-
-void Engine::dump_dot(std::ostream& os) const {
-  // Trace tree: reads and memo entries are interior nodes, writes and allocations leaves.
-  os << "digraph trace {\n  node [fontname=\"monospace\", fontsize=10];\n  root [label=\"run\"];\n";
-  std::vector<std::pair<std::string, const Stamp*>> stack{{"root", nullptr}};
-  std::unordered_map<const ModBase*, std::string> mod_names;
-  auto mod_name = [&](const ModBase* m) {
-    auto it = mod_names.find(m);
-    if (it != mod_names.end()) return it->second;
-    std::string n = "m" + std::to_string(mod_names.size());
-    mod_names.emplace(m, n);
-    os << "  " << n << " [shape=box, label=\"" << n << "\"];\n";
-    return n;
-  };
-  // A read does not name its modifiable: find it from the versions' reader lists.
-  std::unordered_multimap<const ReadNode*, const ModBase*> read_mod;  // a multi-read: k
-  const auto note_list = [&](const ReaderLink* l, const ModBase* m) {
-    for (; l; l = l->rnext) read_mod.emplace(owner_of(l), m);
-  };
-  const auto note_readers = [&](const VersionBase* v) {
-    note_list(v->readers, v->mod());
-    note_list(v->unordered_readers, v->mod());
-  };
-  for (const VersionBase* b : bases_) note_readers(b);
-  for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
-    if (s->kind() == StampKind::Write) note_readers(detail::version_of(const_cast<Stamp*>(s)));
-    if (s->kind() == StampKind::ReadStart) {
-      ReadNode* r = detail::read_of_start(const_cast<Stamp*>(s));
-      const auto note_default = [&](const ReaderLink* l) {
-        if (const ModBase* m = default_head(l)) note_list(m->default_readers(), m);
-      };
-      if (r->many())
-        for (std::uint32_t i = 0; i < detail::many_of(r)->k; ++i) note_default(&detail::many_of(r)->slots()[i].link);
-      else
-        note_default(&r->link);
-    }
-  }
-  std::size_t id = 0;
-  for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
-    std::string name = "e" + std::to_string(id++);
-    const std::string& parent = stack.back().first;
-    visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
-      if constexpr (K == StampKind::ReadStart) {
-        os << "  " << name << " [label=\"read\"];\n  " << parent << " -> " << name << ";\n";
-        const auto [lo, hi] = read_mod.equal_range(rec);
-        for (auto it = lo; it != hi; ++it)
-          os << "  " << mod_name(it->second) << " -> " << name << " [style=dashed];\n";
-        stack.push_back({name, &rec->end});
-      } else if constexpr (K == StampKind::Write) {
-        os << "  " << name << " [shape=diamond, label=\"write\"];\n  " << parent << " -> " << name
-           << ";\n  " << name << " -> " << mod_name(rec->mod()) << " [style=dashed];\n";
-      } else if constexpr (K == StampKind::Alloc) {
-        os << "  " << name << " [shape=note, label=\"alloc\"];\n  " << parent << " -> " << name << ";\n";
-      } else if constexpr (K == StampKind::MemoStart) {
-        os << "  " << name << " [shape=octagon, label=\"memo\"];\n  " << parent << " -> " << name << ";\n";
-        stack.push_back({name, &rec->end});
-      }
-    });
-    while (stack.size() > 1 && stack.back().second == s) stack.pop_back();
-  }
-  os << "}\n";
 }
 
 }  // namespace sac

@@ -1,4 +1,11 @@
-// Order-maintenance list: the slow paths (group relabel and split, top-level relabel, erase).
+// order_list.cpp — the order-maintenance list's slow paths.
+//
+// Purpose: group relabel and split, top-level relabel, erase and the checker of
+// sac/detail/order_list.hpp (the fast paths are inline there).
+// Invariants: those of sac/detail/order_list.hpp, restored by every function here.
+// Complexity: as stated in sac/detail/order_list.hpp.
+// Paper: Dietz, Sleator (STOC'87); Bender, Cole, Demaine, Farach-Colton, Zito (ESA'02);
+// docs/DESIGN.md, "The runtime".
 #include "sac/detail/order_list.hpp"
 
 #include <cmath>
@@ -7,7 +14,7 @@
 
 #include "sac/errors.hpp"
 
-namespace sac {
+namespace sac::detail {
 
 namespace {
 // Bender et al.'s density threshold: a label range of size 2^i may hold at most (2/T)^i groups.
@@ -245,4 +252,4 @@ void OrderList::check_invariants() const {
   if (ngroups != group_count_) fail("group count total mismatch");
 }
 
-}  // namespace sac
+}  // namespace sac::detail

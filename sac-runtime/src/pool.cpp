@@ -1,4 +1,10 @@
-// Pool chunk acquisition and release (the cold path).
+// pool.cpp — the pool's chunk acquisition and release (the cold path).
+//
+// Purpose: get and give back the chunks sac/detail/pool.hpp carves blocks from, through the
+// chunk cache (sac/chunk_cache.hpp).
+// Invariants: those of sac/detail/pool.hpp; a chunk is either in use by one pool or cached.
+// Complexity: O(1) per chunk, plus the system's mapping calls.
+// Paper: docs/DESIGN.md, "The runtime".
 #include "sac/detail/pool.hpp"
 
 #include "sac/chunk_cache.hpp"

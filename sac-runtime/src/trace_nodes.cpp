@@ -1,4 +1,9 @@
 // trace_nodes.cpp — the process-wide numbering of read ops tables (see trace_nodes.hpp).
+//
+// Purpose: give each read ops table a number, so that a read stores 4 bytes for its ops.
+// Invariants: a table keeps its number for the life of the process; entry 0 is never used.
+// Complexity: O(1) per new read type.
+// Paper: docs/DESIGN.md, "The runtime".
 #include "sac/detail/trace_nodes.hpp"
 
 #include <atomic>

@@ -250,21 +250,21 @@ TEST(AppsWork, FilterWorkIsBoundedByTheFollowingDroppedRun) {
   std::vector<V> values(n);
   std::mt19937_64 rng(23);
   for (V& v : values) v = static_cast<V>(rng() % 1000);
-  sac::Engine e;
-  sacapps::InputList<V> in(e, values);
+  sac::Engine rt;
+  sacapps::InputList<V> in(rt, values);
   sacapps::List<V> out;
-  e.run([&](sac::Engine& rt) { sacapps::filter::filter_list<keep>(rt, in.head(), &out); });
+  rt.run([&](sac::Engine& rt2) { sacapps::filter::filter_list<keep>(rt2, in.head(), &out); });
   for (std::size_t i = 1; i + 1 < n && !HasFailure(); i += 7) {
     std::uint64_t run = 0;  // dropped cells right after i
     for (std::size_t j = i + 1; j < n && !keep(values[j]); ++j) ++run;
     in.remove(i);
-    e.propagate();
-    EXPECT_EQ(e.stats().last_reexecuted, 1u);
-    EXPECT_LE(e.stats().last_trace_distance, 6 + 2 * run) << "removing " << i;
+    rt.propagate();
+    EXPECT_EQ(rt.stats().last_reexecuted, 1u);
+    EXPECT_LE(rt.stats().last_trace_distance, 6 + 2 * run) << "removing " << i;
     in.reinsert(i);
-    e.propagate();
-    EXPECT_EQ(e.stats().last_reexecuted, 1u);
-    EXPECT_LE(e.stats().last_trace_distance, 6 + 2 * run) << "reinserting " << i;
+    rt.propagate();
+    EXPECT_EQ(rt.stats().last_reexecuted, 1u);
+    EXPECT_LE(rt.stats().last_trace_distance, 6 + 2 * run) << "reinserting " << i;
   }
   std::vector<V> expect;
   for (V v : values)
@@ -345,38 +345,38 @@ sacapps::exptrees::Shape small_shape() {
 
 TEST(AppsExpTrees, RemovedLeavesAreSplicedOut) {
   using namespace sacapps::exptrees;
-  sac::Engine e;
-  ExpTree tree(e, small_shape(), {true, true, true, true});
+  sac::Engine rt;
+  ExpTree tree(rt, small_shape(), {true, true, true, true});
   sac::Mod<Value> result;
-  e.run([&](sac::Engine& rt) { eval_tree(rt, tree.root(), &result); });
+  rt.run([&](sac::Engine& rt2) { eval_tree(rt2, tree.root(), &result); });
   EXPECT_EQ(result.get(), (5 + 7) * 3 - 10);
   tree.remove(0);  // (b * c) - d: the Add node is replaced by b
-  e.propagate();
+  rt.propagate();
   EXPECT_EQ(result.get(), 7 * 3 - 10);
   tree.remove(2);  // b - d
-  e.propagate();
+  rt.propagate();
   EXPECT_EQ(result.get(), 7 - 10 + kPrime);
   tree.remove(3);  // b
-  e.propagate();
+  rt.propagate();
   EXPECT_EQ(result.get(), 7);
   tree.remove(1);  // the empty expression
-  e.propagate();
+  rt.propagate();
   EXPECT_EQ(result.get(), 0);
   tree.reinsert(2);  // c
-  e.propagate();
+  rt.propagate();
   EXPECT_EQ(result.get(), 3);
   tree.set_value(2, 4);
-  e.propagate();
+  rt.propagate();
   EXPECT_EQ(result.get(), 4);
   tree.reinsert(0);  // (a * c)
   tree.reinsert(3);  // (a * c) - d
-  e.propagate();
+  rt.propagate();
   EXPECT_EQ(result.get(), 5 * 4 - 10);
   tree.reinsert(1);
-  e.propagate();
+  rt.propagate();
   EXPECT_EQ(result.get(), (5 + 7) * 4 - 10);
   EXPECT_EQ(result.get(), evaluate_conventional(tree.shape(), tree.presence()));
-  EXPECT_NO_THROW(e.check_invariants());
+  EXPECT_NO_THROW(rt.check_invariants());
 }
 
 TEST(AppsExpTrees, RandomShapesAreShallow) {

@@ -379,8 +379,8 @@ double mean_update_distance(sacapps::App& app, std::size_t updates) {
 class SacAppWork : public ::testing::TestWithParam<Variant> {};
 
 TEST_P(SacAppWork, UpdatesCostLogarithmicTraceDistance) {
-  // Measured (seed 1, -O2): about 20 log2 n per update for the sorts and 8 log2 n for the
-  // hulls at n = 20000 (more at n = 2000 for the hulls: changes of the hull itself weigh more).
+  // The distance per update grows as log n: the bound below is a constant times log2 n
+  // (changes of the hull itself weigh more at small n).
   const std::size_t small = kSanitized ? 500 : 2000;
   const std::size_t large = kSanitized ? 4000 : 20000;
   // Under SAC_DEBUG_CHECKS each propagation checks the whole trace.

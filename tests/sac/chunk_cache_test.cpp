@@ -26,14 +26,14 @@ class ChunkCache : public ::testing::Test {
 
 /// An engine holding a trace of n reads (tens of MiB: several huge chunks).
 struct BigTrace {
-  explicit BigTrace(std::size_t n) : mods(n), engine(std::make_unique<sac::Engine>()) {
-    for (std::size_t i = 0; i < n; ++i) engine->set(mods[i], static_cast<int>(i));
-    engine->run([this](sac::Engine& r) {
-      for (auto& m : mods) r.read(m, [](int) {});
+  explicit BigTrace(std::size_t n) : mods(n), rt(std::make_unique<sac::Engine>()) {
+    for (std::size_t i = 0; i < n; ++i) rt->set(mods[i], static_cast<int>(i));
+    rt->run([this](sac::Engine& rt2) {
+      for (auto& m : mods) rt2.read(m, [](int) {});
     });
   }
   std::vector<sac::Mod<int>> mods;  // declared first: outlives the engine's records
-  std::unique_ptr<sac::Engine> engine;
+  std::unique_ptr<sac::Engine> rt;
 };
 
 constexpr std::size_t kReads = 400'000;
@@ -56,7 +56,7 @@ TEST_F(ChunkCache, HoldsFreedChunksUpToItsBound) {
   sac::set_chunk_cache_limit(std::size_t{1} << 30);
   sac::trim_chunk_cache();
   auto big = std::make_unique<BigTrace>(kReads);
-  const std::size_t trace = big->engine->trace_bytes();
+  const std::size_t trace = big->rt->trace_bytes();
   ASSERT_GT(trace, std::size_t{8} << 20);
   big.reset();
   EXPECT_GT(sac::chunk_cache_bytes(), trace / 2);  // most of the trace sat in huge chunks
@@ -71,9 +71,9 @@ TEST_F(ChunkCache, HoldsFreedChunksUpToItsBound) {
 TEST_F(ChunkCache, ABoundOfZeroGivesTheMemoryBack) {
   sac::set_chunk_cache_limit(0);
   BigTrace big(kReads);
-  const std::size_t trace = big.engine->trace_bytes();
+  const std::size_t trace = big.rt->trace_bytes();
   const std::size_t before = resident_bytes();
-  big.engine.reset();  // the engine alone, so the mods' vector does not blur the figure
+  big.rt.reset();  // the engine alone, so the mods' vector does not blur the figure
   const std::size_t after = resident_bytes();
   EXPECT_EQ(sac::chunk_cache_bytes(), 0u);
   if (before != 0) {

@@ -42,16 +42,16 @@ constexpr std::size_t kIntInput = (sizeof(detail::Version<int>) + 7) & ~std::siz
 /// The test-only hook declared in Engine: the private trace, so that the checker tests below
 /// can corrupt one part of it and see check_invariants() fail.
 struct EngineTestAccess {
-  static OrderList& order(Engine& e) { return e.order_; }
-  static Stats& stats(Engine& e) { return e.stats_; }
-  static auto& queue(Engine& e) { return e.queue_; }
-  static auto& allocs(Engine& e) { return e.allocs_; }
-  static auto& memos(Engine& e) { return e.memos_; }
-  static void attach(detail::ReadNode* r, detail::VersionBase* v) { Engine::attach(&r->link, v); }
-  static void detach(detail::ReadNode* r) { Engine::detach(&r->link); }
+  static detail::OrderList& order(Engine& rt) { return rt.order_; }
+  static Stats& stats(Engine& rt) { return rt.stats_; }
+  static auto& queue(Engine& rt) { return rt.queue_; }
+  static auto& allocs(Engine& rt) { return rt.allocs_; }
+  static auto& memos(Engine& rt) { return rt.memos_; }
+  static void attach(detail::ReadNode* r, detail::VersionBase* v) { detail::attach(&r->link, v); }
+  static void detach(detail::ReadNode* r) { detail::detach(&r->link); }
   static void attach_default(detail::ReadNode* r, const ModBase& m) { Engine::attach_default(&r->link, m); }
-  static void attach(detail::ReaderLink* l, detail::VersionBase* v) { Engine::attach(l, v); }
-  static void detach(detail::ReaderLink* l) { Engine::detach(l); }
+  static void attach(detail::ReaderLink* l, detail::VersionBase* v) { detail::attach(l, v); }
+  static void detach(detail::ReaderLink* l) { detail::detach(l); }
 };
 
 }  // namespace sac
@@ -77,9 +77,8 @@ constexpr int kScale = SAC_ENGINE_TEST_SANITIZED ? 5 : 1;
 
 // ------------------------------------------------------------------ read bodies
 //
-// Read bodies are plain lambdas, the documented way to write them. (body() once wrapped them
-// while Engine::read() failed to compile for closures without operator==; it is kept as the
-// identity so that the tests read the same either way.)
+// Read bodies are plain lambdas, the documented way to write them; body() is the identity,
+// a marker that reads as "this lambda is a read body".
 template <class F>
 std::decay_t<F> body(F&& f) {
   return std::forward<F>(f);
@@ -88,13 +87,13 @@ std::decay_t<F> body(F&& f) {
 // ----------------------------------------------------------------------------- helpers
 
 /// Invariants hold and the counters agree with each other.
-void expect_healthy(const Engine& e) {
-  EXPECT_FALSE(e.poisoned());
-  EXPECT_FALSE(e.in_computation());
-  EXPECT_NO_THROW(e.check_invariants());
-  const Stats& s = e.stats();
+void expect_healthy(const Engine& rt) {
+  EXPECT_FALSE(rt.poisoned());
+  EXPECT_FALSE(rt.in_computation());
+  EXPECT_NO_THROW(rt.check_invariants());
+  const Stats& s = rt.stats();
   EXPECT_EQ(s.live_events, s.events_created - s.events_undone) << s;
-  EXPECT_EQ(e.live_events(), s.live_events);
+  EXPECT_EQ(rt.live_events(), s.live_events);
 }
 
 struct Figures {
@@ -102,7 +101,7 @@ struct Figures {
   std::size_t record_bytes = 0;
   bool operator==(const Figures&) const = default;
 };
-Figures figures(const Engine& e) { return {e.live_events(), e.record_bytes()}; }
+Figures figures(const Engine& rt) { return {rt.live_events(), rt.record_bytes()}; }
 std::ostream& operator<<(std::ostream& os, const Figures& f) {
   return os << "{live_events=" << f.live_events << ", record_bytes=" << f.record_bytes << "}";
 }
@@ -136,23 +135,23 @@ struct Cell {
 /// reinsert relink element i at its original position.
 class Input {
  public:
-  Input(Engine& e, const std::vector<long>& values, std::vector<bool> present)
-      : e_(&e), present_(std::move(present)) {
+  Input(Engine& rt, const std::vector<long>& values, std::vector<bool> present)
+      : rt_(&rt), present_(std::move(present)) {
     for (std::size_t i = 0; i < values.size(); ++i)
       cells_.push_back(std::make_unique<Cell>(values[i], i));
     Cell* nx = nullptr;
     for (std::size_t i = values.size(); i-- > 0;) {
       if (present_[i]) {
-        e.set(cells_[i]->next, nx);
+        rt.set(cells_[i]->next, nx);
         nx = cells_[i].get();
       } else {
-        e.set(cells_[i]->next, static_cast<Cell*>(nullptr));
+        rt.set(cells_[i]->next, static_cast<Cell*>(nullptr));
       }
     }
-    e.set(head, nx);
+    rt.set(head, nx);
   }
-  Input(Engine& e, const std::vector<long>& values)
-      : Input(e, values, std::vector<bool>(values.size(), true)) {}
+  Input(Engine& rt, const std::vector<long>& values)
+      : Input(rt, values, std::vector<bool>(values.size(), true)) {}
 
   Mod<Cell*> head;
 
@@ -163,14 +162,14 @@ class Input {
 
   void remove(std::size_t i) {
     Cell* c = cells_.at(i).get();
-    e_->set(link_before(i), c->next.get());
+    rt_->set(link_before(i), c->next.get());
     present_[i] = false;
   }
   void reinsert(std::size_t i) {
     Cell* c = cells_.at(i).get();
     Mod<Cell*>& before = link_before(i);
-    e_->set(c->next, before.get());
-    e_->set(before, c);
+    rt_->set(c->next, before.get());
+    rt_->set(before, c);
     present_[i] = true;
   }
   void toggle(std::size_t i) {
@@ -192,7 +191,7 @@ class Input {
     return head;
   }
 
-  Engine* e_;
+  Engine* rt_;
   std::vector<std::unique_ptr<Cell>> cells_;
   std::vector<bool> present_;
 };
@@ -209,21 +208,21 @@ struct MapOut {
 
 int g_map_steps = 0;  // how many times map_step really ran
 
-void map_step(Engine& e, Cell* c, Mod<MapOut*>* dst) {
+void map_step(Engine& rt, Cell* c, Mod<MapOut*>* dst) {
   ++g_map_steps;
   if (!c) {
-    e.write(*dst, static_cast<MapOut*>(nullptr));
+    rt.write(*dst, static_cast<MapOut*>(nullptr));
     return;
   }
-  MapOut* o = e.alloc<MapOut>(c->id, 2 * c->value);
-  e.write(*dst, o);
-  e.memo_read(c->next, sac::fn<map_step>(&o->next));
+  MapOut* o = rt.alloc<MapOut>(c->id, 2 * c->value);
+  rt.write(*dst, o);
+  rt.memo_read(c->next, sac::fn<map_step>(&o->next));
 }
 
 struct MapProgram {
   Mod<MapOut*> out;
-  void start(Engine& e, Input& in) {
-    e.run([&](Engine& en) { en.memo_read(in.head, sac::fn<map_step>(&out)); });
+  void start(Engine& rt, Input& in) {
+    rt.run([&](Engine& rt2) { rt2.memo_read(in.head, sac::fn<map_step>(&out)); });
   }
   std::vector<long> result() const {
     std::vector<long> r;
@@ -244,37 +243,37 @@ struct SumOut {
   Mod<SumOut*> next;
 };
 
-void psum_step(Engine& e, Cell* c, Mod<long>* prev, Mod<SumOut*>* dst) {
+void psum_step(Engine& rt, Cell* c, Mod<long>* prev, Mod<SumOut*>* dst) {
   if (!c) {
-    e.write(*dst, static_cast<SumOut*>(nullptr));
+    rt.write(*dst, static_cast<SumOut*>(nullptr));
     return;
   }
-  SumOut* o = e.alloc<SumOut>(c->id);
-  e.write(*dst, o);
-  e.read(*prev, body([o, v = c->value](Engine& en, long s) { en.write(o->sum, s + v); }));
-  e.memo_read(c->next, sac::fn<psum_step>(&o->sum, &o->next));
+  SumOut* o = rt.alloc<SumOut>(c->id);
+  rt.write(*dst, o);
+  rt.read(*prev, body([o, v = c->value](Engine& rt2, long s) { rt2.write(o->sum, s + v); }));
+  rt.memo_read(c->next, sac::fn<psum_step>(&o->sum, &o->next));
 }
 
 // The same prefix sums with the events of a step in another program order: the read of the
 // previous sum is issued before the write of the destination and the allocation of the next
 // cell, so the engine must run the read (and close its interval) before that write.
-void psum_late_step(Engine& e, Cell* c, Mod<long>* prev, Mod<SumOut*>* dst) {
+void psum_late_step(Engine& rt, Cell* c, Mod<long>* prev, Mod<SumOut*>* dst) {
   if (!c) {
-    e.write(*dst, static_cast<SumOut*>(nullptr));
+    rt.write(*dst, static_cast<SumOut*>(nullptr));
     return;
   }
-  SumOut* o = e.alloc<SumOut>(c->id);
-  e.read(*prev, body([o, v = c->value](Engine& en, long s) { en.write(o->sum, s + v); }));
-  e.write(*dst, o);
-  e.memo_read(c->next, sac::fn<psum_late_step>(&o->sum, &o->next));
+  SumOut* o = rt.alloc<SumOut>(c->id);
+  rt.read(*prev, body([o, v = c->value](Engine& rt2, long s) { rt2.write(o->sum, s + v); }));
+  rt.write(*dst, o);
+  rt.memo_read(c->next, sac::fn<psum_late_step>(&o->sum, &o->next));
 }
 
 struct PsumProgram {
   Mod<long> zero;
   Mod<SumOut*> out;
-  void start(Engine& e, Input& in) {
-    e.set(zero, 0L);
-    e.run([&](Engine& en) { en.memo_read(in.head, sac::fn<psum_step>(&zero, &out)); });
+  void start(Engine& rt, Input& in) {
+    rt.set(zero, 0L);
+    rt.run([&](Engine& rt2) { rt2.memo_read(in.head, sac::fn<psum_step>(&zero, &out)); });
   }
   std::vector<long> result() const {
     std::vector<long> r;
@@ -290,9 +289,9 @@ struct PsumProgram {
 };
 
 struct PsumLateProgram : PsumProgram {
-  void start(Engine& e, Input& in) {
-    e.set(zero, 0L);
-    e.run([&](Engine& en) { en.memo_read(in.head, sac::fn<psum_late_step>(&zero, &out)); });
+  void start(Engine& rt, Input& in) {
+    rt.set(zero, 0L);
+    rt.run([&](Engine& rt2) { rt2.memo_read(in.head, sac::fn<psum_late_step>(&zero, &out)); });
   }
 };
 
@@ -301,28 +300,28 @@ struct PsumLateProgram : PsumProgram {
 // its predecessors left. Outputs: the final acc and the final mx.
 constexpr long kMinStart = -1000;
 
-void acc_step(Engine& e, Cell* c, Mod<long>* acc, Mod<long>* mx, Mod<long>* out) {
+void acc_step(Engine& rt, Cell* c, Mod<long>* acc, Mod<long>* mx, Mod<long>* out) {
   if (!c) {
-    e.read(*acc, body([out](Engine& en, long a) { en.write(*out, a); }));
+    rt.read(*acc, body([out](Engine& rt2, long a) { rt2.write(*out, a); }));
     return;
   }
-  e.read(*acc, body([acc, v = c->value](Engine& en, long a) {
-    if (v % 3 != 0) en.write(*acc, a + v);
+  rt.read(*acc, body([acc, v = c->value](Engine& rt2, long a) {
+    if (v % 3 != 0) rt2.write(*acc, a + v);
   }));
-  e.read(*mx, body([mx, v = c->value](Engine& en, long m) {
-    if (v > m) en.write(*mx, v);
+  rt.read(*mx, body([mx, v = c->value](Engine& rt2, long m) {
+    if (v > m) rt2.write(*mx, v);
   }));
-  e.memo_read(c->next, sac::fn<acc_step>(acc, mx, out));
+  rt.memo_read(c->next, sac::fn<acc_step>(acc, mx, out));
 }
 
 struct AccProgram {
   Mod<long> acc, mx, out, out_max;
-  void start(Engine& e, Input& in) {
-    e.run([&](Engine& en) {
-      en.write(acc, 0L);
-      en.write(mx, kMinStart);
-      en.memo_read(in.head, sac::fn<acc_step>(&acc, &mx, &out));
-      en.read(mx, body([p = &out_max](Engine& x, long m) { x.write(*p, m); }));
+  void start(Engine& rt, Input& in) {
+    rt.run([&](Engine& rt2) {
+      rt2.write(acc, 0L);
+      rt2.write(mx, kMinStart);
+      rt2.memo_read(in.head, sac::fn<acc_step>(&acc, &mx, &out));
+      rt2.read(mx, body([p = &out_max](Engine& rt3, long m) { rt3.write(*p, m); }));
     });
   }
   std::vector<long> result() const { return {out.get(), out_max.get()}; }
@@ -340,13 +339,13 @@ struct AccProgram {
 template <class Program>
 Figures fresh_figures(const std::vector<long>& values, const std::vector<bool>& present,
                       std::vector<long>* result = nullptr) {
-  Engine f;
-  Input in(f, values, present);
+  Engine rt;
+  Input in(rt, values, present);
   Program p;
-  p.start(f, in);
-  EXPECT_NO_THROW(f.check_invariants());
+  p.start(rt, in);
+  EXPECT_NO_THROW(rt.check_invariants());
   if (result) *result = p.result();
-  return figures(f);
+  return figures(rt);
 }
 
 std::vector<long> random_values(std::mt19937_64& rng, int n) {
@@ -359,19 +358,19 @@ std::vector<long> random_values(std::mt19937_64& rng, int n) {
 // ================================================================ versioned reads
 
 TEST(EngineVersions, EachReadSeesTheLatestVersionBeforeIt) {
-  Engine e;
+  Engine rt;
   Mod<int> in, m, o1, o2, o3;
   int c1 = 0, c2 = 0, c3 = 0;
-  e.set(in, 1);
-  e.run([&](Engine& en) {
-    en.read(in, body([pm = &m](Engine& x, int v) { x.write(*pm, v * 10); }));
-    en.read(m, body([po = &o1, pc = &c1](Engine& x, int v) { ++*pc; x.write(*po, v); }));
-    en.write(m, 100);
-    en.read(m, body([po = &o2, pc = &c2](Engine& x, int v) { ++*pc; x.write(*po, v); }));
-    en.write(m, 200);
-    en.read(m, body([po = &o3, pc = &c3](Engine& x, int v) { ++*pc; x.write(*po, v); }));
+  rt.set(in, 1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([pm = &m](Engine& rt3, int v) { rt3.write(*pm, v * 10); }));
+    rt2.read(m, body([po = &o1, pc = &c1](Engine& rt3, int v) { ++*pc; rt3.write(*po, v); }));
+    rt2.write(m, 100);
+    rt2.read(m, body([po = &o2, pc = &c2](Engine& rt3, int v) { ++*pc; rt3.write(*po, v); }));
+    rt2.write(m, 200);
+    rt2.read(m, body([po = &o3, pc = &c3](Engine& rt3, int v) { ++*pc; rt3.write(*po, v); }));
   });
-  expect_healthy(e);
+  expect_healthy(rt);
   EXPECT_EQ(o1.get(), 10);
   EXPECT_EQ(o2.get(), 100);
   EXPECT_EQ(o3.get(), 200);
@@ -380,9 +379,9 @@ TEST(EngineVersions, EachReadSeesTheLatestVersionBeforeIt) {
 
   // The early write depends on `in`: only it and the read between it and the next write
   // re-run; the reads after the later (unchanged) writes do not.
-  e.set(in, 2);
-  e.propagate();
-  expect_healthy(e);
+  rt.set(in, 2);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(o1.get(), 20);
   EXPECT_EQ(o2.get(), 100);
   EXPECT_EQ(o3.get(), 200);
@@ -390,37 +389,37 @@ TEST(EngineVersions, EachReadSeesTheLatestVersionBeforeIt) {
   EXPECT_EQ(c1, 2);
   EXPECT_EQ(c2, 1);
   EXPECT_EQ(c3, 1);
-  EXPECT_EQ(e.stats().last_reexecuted, 2u);
-  EXPECT_EQ(e.stats().propagations, 1u);
+  EXPECT_EQ(rt.stats().last_reexecuted, 2u);
+  EXPECT_EQ(rt.stats().propagations, 1u);
 
   // Nothing changed: nothing re-runs.
-  e.propagate();
-  expect_healthy(e);
-  EXPECT_EQ(e.stats().last_reexecuted, 0u);
-  EXPECT_EQ(e.stats().last_trace_distance, 0u);
+  rt.propagate();
+  expect_healthy(rt);
+  EXPECT_EQ(rt.stats().last_reexecuted, 0u);
+  EXPECT_EQ(rt.stats().last_trace_distance, 0u);
 }
 
 TEST(EngineVersions, WritesAndReadsInsideAReexecutedBody) {
-  Engine e;
+  Engine rt;
   Mod<int> in, m, a, b, c;
-  e.set(in, 3);
-  e.run([&](Engine& en) {
-    en.read(in, body([pm = &m, pa = &a, pb = &b](Engine& x, int v) {
-      x.write(*pm, v);
-      x.read(*pm, body([pa](Engine& y, int w) { y.write(*pa, w + 1); }));
-      x.write(*pm, v * 2);
-      x.read(*pm, body([pb](Engine& y, int w) { y.write(*pb, w + 1); }));
+  rt.set(in, 3);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([pm = &m, pa = &a, pb = &b](Engine& rt3, int v) {
+      rt3.write(*pm, v);
+      rt3.read(*pm, body([pa](Engine& rt4, int w) { rt4.write(*pa, w + 1); }));
+      rt3.write(*pm, v * 2);
+      rt3.read(*pm, body([pb](Engine& rt4, int w) { rt4.write(*pb, w + 1); }));
     }));
-    en.read(m, body([pc = &c](Engine& x, int w) { x.write(*pc, w); }));
+    rt2.read(m, body([pc = &c](Engine& rt3, int w) { rt3.write(*pc, w); }));
   });
-  expect_healthy(e);
+  expect_healthy(rt);
   EXPECT_EQ(a.get(), 4);
   EXPECT_EQ(b.get(), 7);
   EXPECT_EQ(c.get(), 6);
   for (int v : {5, -2, 0, 5, 5, 100}) {
-    e.set(in, v);
-    e.propagate();
-    expect_healthy(e);
+    rt.set(in, v);
+    rt.propagate();
+    expect_healthy(rt);
     EXPECT_EQ(a.get(), v + 1);
     EXPECT_EQ(b.get(), 2 * v + 1);
     EXPECT_EQ(c.get(), 2 * v);
@@ -431,34 +430,34 @@ TEST(EngineVersions, WritesAndReadsInsideAReexecutedBody) {
 TEST(EngineVersions, ANewWriteTakesOverTheReadersAfterIt) {
   // A write inserted by re-execution between an old version and its readers: the readers
   // after it now see it; removing it again gives them back the older version.
-  Engine e;
+  Engine rt;
   Mod<int> in, m, before, after;
   int runs_after = 0;
-  e.set(in, 0);
-  e.run([&](Engine& en) {
-    en.write(m, 1);
-    en.read(m, body([p = &before](Engine& x, int w) { x.write(*p, w); }));
-    en.read(in, body([pm = &m](Engine& x, int v) {
-      if (v > 0) x.write(*pm, v);
+  rt.set(in, 0);
+  rt.run([&](Engine& rt2) {
+    rt2.write(m, 1);
+    rt2.read(m, body([p = &before](Engine& rt3, int w) { rt3.write(*p, w); }));
+    rt2.read(in, body([pm = &m](Engine& rt3, int v) {
+      if (v > 0) rt3.write(*pm, v);
     }));
-    en.read(m, body([p = &after, r = &runs_after](Engine& x, int w) { ++*r; x.write(*p, w); }));
+    rt2.read(m, body([p = &after, r = &runs_after](Engine& rt3, int w) { ++*r; rt3.write(*p, w); }));
   });
-  expect_healthy(e);
+  expect_healthy(rt);
   EXPECT_EQ(after.get(), 1);
-  e.set(in, 7);
-  e.propagate();
-  expect_healthy(e);
+  rt.set(in, 7);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(before.get(), 1);
   EXPECT_EQ(after.get(), 7);
   EXPECT_EQ(runs_after, 2);
   EXPECT_EQ(m.get(), 7);
-  e.set(in, 9);
-  e.propagate();
-  expect_healthy(e);
+  rt.set(in, 9);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(after.get(), 9);
-  e.set(in, 0);
-  e.propagate();
-  expect_healthy(e);
+  rt.set(in, 0);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(after.get(), 1);
   EXPECT_EQ(before.get(), 1);
   EXPECT_EQ(m.get(), 1);
@@ -468,82 +467,82 @@ TEST(EngineVersions, ANewWriteTakesOverTheReadersAfterIt) {
 // ================================================================ cut-off
 
 TEST(EngineCutOff, EqualWriteDoesNotReexecuteReaders) {
-  Engine e;
+  Engine rt;
   Mod<int> in, half, out;
   int downstream = 0;
-  e.set(in, 4);
-  e.run([&](Engine& en) {
-    en.read(in, body([ph = &half](Engine& x, int v) { x.write(*ph, v / 2); }));
-    en.read(half, body([po = &out, pd = &downstream](Engine& x, int h) { ++*pd; x.write(*po, h + 1); }));
+  rt.set(in, 4);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([ph = &half](Engine& rt3, int v) { rt3.write(*ph, v / 2); }));
+    rt2.read(half, body([po = &out, pd = &downstream](Engine& rt3, int h) { ++*pd; rt3.write(*po, h + 1); }));
   });
-  expect_healthy(e);
+  expect_healthy(rt);
   EXPECT_EQ(out.get(), 3);
   EXPECT_EQ(downstream, 1);
 
-  e.set(in, 5);  // half stays 2
-  e.propagate();
-  expect_healthy(e);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  rt.set(in, 5);  // half stays 2
+  rt.propagate();
+  expect_healthy(rt);
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
   EXPECT_EQ(downstream, 1);
   EXPECT_EQ(out.get(), 3);
 
-  e.set(in, 6);  // half becomes 3
-  e.propagate();
-  expect_healthy(e);
-  EXPECT_EQ(e.stats().last_reexecuted, 2u);
+  rt.set(in, 6);  // half becomes 3
+  rt.propagate();
+  expect_healthy(rt);
+  EXPECT_EQ(rt.stats().last_reexecuted, 2u);
   EXPECT_EQ(downstream, 2);
   EXPECT_EQ(out.get(), 4);
 }
 
 TEST(EngineCutOff, SettingAnEqualInputChangesNothing) {
-  Engine e;
+  Engine rt;
   Mod<int> in, out;
   Mod<std::string> s, sout;
-  e.set(in, 4);
-  e.set(s, std::string("same"));
-  e.run([&](Engine& en) {
-    en.read(in, body([po = &out](Engine& x, int v) { x.write(*po, v); }));
-    en.read(s, body([po = &sout](Engine& x, const std::string& v) { x.write(*po, v + "!"); }));
+  rt.set(in, 4);
+  rt.set(s, std::string("same"));
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([po = &out](Engine& rt3, int v) { rt3.write(*po, v); }));
+    rt2.read(s, body([po = &sout](Engine& rt3, const std::string& v) { rt3.write(*po, v + "!"); }));
   });
-  const std::uint64_t pushes = e.stats().queue_pushes;
-  e.set(in, 4);
-  e.set(s, std::string("same"));
-  EXPECT_EQ(e.stats().queue_pushes, pushes);
-  e.propagate();
-  expect_healthy(e);
-  EXPECT_EQ(e.stats().last_reexecuted, 0u);
-  EXPECT_EQ(e.stats().last_trace_distance, 0u);
-  e.set(s, std::string("other"));
-  e.propagate();
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  const std::uint64_t pushes = rt.stats().queue_pushes;
+  rt.set(in, 4);
+  rt.set(s, std::string("same"));
+  EXPECT_EQ(rt.stats().queue_pushes, pushes);
+  rt.propagate();
+  expect_healthy(rt);
+  EXPECT_EQ(rt.stats().last_reexecuted, 0u);
+  EXPECT_EQ(rt.stats().last_trace_distance, 0u);
+  rt.set(s, std::string("other"));
+  rt.propagate();
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
   EXPECT_EQ(sout.get(), "other!");
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
 TEST(EngineCutOff, InsertedOrRemovedVersionEqualToTheOlderOne) {
   // A write that appears (or disappears) with the same value as the version before it does
   // not affect the readers after it.
-  Engine e;
+  Engine rt;
   Mod<int> in, m, out;
   int runs = 0;
-  e.set(in, 0);
-  e.run([&](Engine& en) {
-    en.write(m, 1);
-    en.read(in, body([pm = &m](Engine& x, int v) {
-      if (v) x.write(*pm, 1);
+  rt.set(in, 0);
+  rt.run([&](Engine& rt2) {
+    rt2.write(m, 1);
+    rt2.read(in, body([pm = &m](Engine& rt3, int v) {
+      if (v) rt3.write(*pm, 1);
     }));
-    en.read(m, body([po = &out, r = &runs](Engine& x, int w) { ++*r; x.write(*po, w); }));
+    rt2.read(m, body([po = &out, r = &runs](Engine& rt3, int w) { ++*r; rt3.write(*po, w); }));
   });
-  expect_healthy(e);
-  e.set(in, 1);
-  e.propagate();
-  expect_healthy(e);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  expect_healthy(rt);
+  rt.set(in, 1);
+  rt.propagate();
+  expect_healthy(rt);
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
   EXPECT_EQ(runs, 1);
-  e.set(in, 0);
-  e.propagate();
-  expect_healthy(e);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  rt.set(in, 0);
+  rt.propagate();
+  expect_healthy(rt);
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
   EXPECT_EQ(runs, 1);
   EXPECT_EQ(out.get(), 1);
 }
@@ -554,13 +553,13 @@ TEST(EngineMemo, MemoReadHitReusesTheRestOfAList) {
   const int n = 1000 / kScale;
   std::mt19937_64 rng(5);
   std::vector<long> values = random_values(rng, n);
-  Engine e;
-  Input in(e, values);
+  Engine rt;
+  Input in(rt, values);
   MapProgram p;
-  p.start(e, in);
-  expect_healthy(e);
+  p.start(rt, in);
+  expect_healthy(rt);
   ASSERT_EQ(p.result(), MapProgram::expected(in.sequence()));
-  const Figures scratch = figures(e);
+  const Figures scratch = figures(rt);
 
   // Output cell of element k (its address must survive updates: keyed allocation).
   auto out_cell = [&](std::size_t k) {
@@ -572,217 +571,217 @@ TEST(EngineMemo, MemoReadHitReusesTheRestOfAList) {
   MapOut* const after = out_cell(i + 1);
   MapOut* const far = out_cell(static_cast<std::size_t>(n - 1));
 
-  Stats s0 = e.stats();
+  Stats s0 = rt.stats();
   const int steps0 = g_map_steps;
   in.remove(i);
-  e.propagate();
-  expect_healthy(e);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(p.result(), MapProgram::expected(in.sequence()));
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 1u) << e.stats();
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 1u) << rt.stats();
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
   EXPECT_EQ(g_map_steps - steps0, 1) << "only the step of the predecessor re-runs";
-  EXPECT_LE(e.stats().last_trace_distance, 10u) << "O(1) work expected";
+  EXPECT_LE(rt.stats().last_trace_distance, 10u) << "O(1) work expected";
   EXPECT_EQ(out_cell(i), after) << "the successor's output cell is reused";
   EXPECT_EQ(out_cell(static_cast<std::size_t>(n - 2)), far);
-  EXPECT_EQ(figures(e), fresh_figures<MapProgram>(values, in.presence()));
+  EXPECT_EQ(figures(rt), fresh_figures<MapProgram>(values, in.presence()));
 
-  s0 = e.stats();
+  s0 = rt.stats();
   in.reinsert(i);
-  e.propagate();
-  expect_healthy(e);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(p.result(), MapProgram::expected(in.sequence()));
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 1u) << e.stats();
-  EXPECT_EQ(e.stats().memo_misses - s0.memo_misses, 1u) << e.stats();
-  EXPECT_LE(e.stats().last_reexecuted, 2u);
-  EXPECT_LE(e.stats().last_trace_distance, 12u);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 1u) << rt.stats();
+  EXPECT_EQ(rt.stats().memo_misses - s0.memo_misses, 1u) << rt.stats();
+  EXPECT_LE(rt.stats().last_reexecuted, 2u);
+  EXPECT_LE(rt.stats().last_trace_distance, 12u);
   EXPECT_EQ(out_cell(i + 1), after);
-  EXPECT_EQ(figures(e), scratch);
+  EXPECT_EQ(figures(rt), scratch);
 }
 
 TEST(EngineMemo, MemoHitInsideTheWindowSkipsTheCall) {
-  Engine e;
+  Engine rt;
   Mod<int> in, o;
   int calls = 0;
-  e.set(in, 1);
-  e.run([&](Engine& en) {
-    en.read(in, body([po = &o, pc = &calls](Engine& x, int v) {
-      x.write(*po, v);
-      x.memo(sac::fn<bump>(pc, 7));
-      x.memo(sac::fn<bump>(pc, 7));  // equal key twice: each call matches its own entry
+  rt.set(in, 1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([po = &o, pc = &calls](Engine& rt3, int v) {
+      rt3.write(*po, v);
+      rt3.memo(sac::fn<bump>(pc, 7));
+      rt3.memo(sac::fn<bump>(pc, 7));  // equal key twice: each call matches its own entry
     }));
   });
-  expect_healthy(e);
+  expect_healthy(rt);
   EXPECT_EQ(calls, 2);
-  const Figures scratch = figures(e);
+  const Figures scratch = figures(rt);
   for (int v = 2; v < 6; ++v) {
-    const Stats s0 = e.stats();
-    e.set(in, v);
-    e.propagate();
-    expect_healthy(e);
+    const Stats s0 = rt.stats();
+    rt.set(in, v);
+    rt.propagate();
+    expect_healthy(rt);
     EXPECT_EQ(o.get(), v);
     EXPECT_EQ(calls, 2) << "memoized calls must not re-run";
-    EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 2u);
-    EXPECT_EQ(e.stats().memo_misses - s0.memo_misses, 0u);
-    EXPECT_EQ(figures(e), scratch);
+    EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 2u);
+    EXPECT_EQ(rt.stats().memo_misses - s0.memo_misses, 0u);
+    EXPECT_EQ(figures(rt), scratch);
   }
 }
 
 TEST(EngineMemo, EntryBeforeTheWindowIsNotReused) {
-  Engine e;
+  Engine rt;
   Mod<int> in;
   int calls = 0;
-  e.set(in, 0);
-  e.run([&](Engine& en) {
-    en.memo(sac::fn<bump>(&calls, 1));
-    en.read(in, body([pc = &calls](Engine& x, int v) {
-      if (v) x.memo(sac::fn<bump>(pc, 1));
+  rt.set(in, 0);
+  rt.run([&](Engine& rt2) {
+    rt2.memo(sac::fn<bump>(&calls, 1));
+    rt2.read(in, body([pc = &calls](Engine& rt3, int v) {
+      if (v) rt3.memo(sac::fn<bump>(pc, 1));
     }));
   });
   EXPECT_EQ(calls, 1);
-  const Stats s0 = e.stats();
-  e.set(in, 1);
-  e.propagate();
-  expect_healthy(e);
+  const Stats s0 = rt.stats();
+  rt.set(in, 1);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(calls, 2);
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 0u);
-  EXPECT_EQ(e.stats().memo_misses - s0.memo_misses, 1u);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 0u);
+  EXPECT_EQ(rt.stats().memo_misses - s0.memo_misses, 1u);
 }
 
 TEST(EngineMemo, EntryAfterTheWindowIsNotReused) {
-  Engine e;
+  Engine rt;
   Mod<int> in;
   int calls = 0;
-  e.set(in, 0);
-  e.run([&](Engine& en) {
-    en.read(in, body([pc = &calls](Engine& x, int v) {
-      if (v) x.memo(sac::fn<bump>(pc, 1));
+  rt.set(in, 0);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([pc = &calls](Engine& rt3, int v) {
+      if (v) rt3.memo(sac::fn<bump>(pc, 1));
     }));
-    en.memo(sac::fn<bump>(&calls, 1));
+    rt2.memo(sac::fn<bump>(&calls, 1));
   });
   EXPECT_EQ(calls, 1);
-  const Stats s0 = e.stats();
-  e.set(in, 1);
-  e.propagate();
-  expect_healthy(e);
+  const Stats s0 = rt.stats();
+  rt.set(in, 1);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(calls, 2);
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 0u);
-  EXPECT_EQ(e.stats().memo_misses - s0.memo_misses, 1u);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 0u);
+  EXPECT_EQ(rt.stats().memo_misses - s0.memo_misses, 1u);
 }
 
 TEST(EngineMemo, EntryInAnEnclosingReadButOutsideTheInnerWindowIsNotReused) {
   // The entry lies inside the outer read's interval, before the inner read that re-runs.
-  Engine e;
+  Engine rt;
   Mod<int> a, b;
   int calls = 0;
-  e.set(a, 0);
-  e.set(b, 0);
-  e.run([&](Engine& en) {
-    en.read(a, body([pc = &calls, pb = &b](Engine& x, int) {
-      x.memo(sac::fn<bump>(pc, 3));
-      x.read(*pb, body([pc](Engine& y, int v) {
-        if (v) y.memo(sac::fn<bump>(pc, 3));
+  rt.set(a, 0);
+  rt.set(b, 0);
+  rt.run([&](Engine& rt2) {
+    rt2.read(a, body([pc = &calls, pb = &b](Engine& rt3, int) {
+      rt3.memo(sac::fn<bump>(pc, 3));
+      rt3.read(*pb, body([pc](Engine& rt4, int v) {
+        if (v) rt4.memo(sac::fn<bump>(pc, 3));
       }));
     }));
   });
   EXPECT_EQ(calls, 1);
-  Stats s0 = e.stats();
-  e.set(b, 1);
-  e.propagate();
-  expect_healthy(e);
+  Stats s0 = rt.stats();
+  rt.set(b, 1);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(calls, 2);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 0u);
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 0u);
   // Re-running the outer read: both entries are inside its window and are reused.
-  s0 = e.stats();
-  e.set(a, 1);
-  e.propagate();
-  expect_healthy(e);
+  s0 = rt.stats();
+  rt.set(a, 1);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(calls, 2);
   // Both entries lie in the outer read's window: the first call matches the first entry and
   // the call made by the (new) inner read matches the old inner read's entry.
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 2u);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 2u);
 }
 
-void reader_of(Engine& e, const int& v, int* runs, Mod<int>* dst) {
+void reader_of(Engine& rt, const int& v, int* runs, Mod<int>* dst) {
   ++*runs;
-  e.write(*dst, v);
+  rt.write(*dst, v);
 }
 
 TEST(EngineMemo, MemoReadOutsideTheWindowIsNotReused) {
-  Engine e;
+  Engine rt;
   Mod<int> in, m, d1;
   int runs = 0;
-  e.set(in, 0);
-  e.set(m, 5);
-  e.run([&](Engine& en) {
-    en.memo_read(m, sac::fn<reader_of>(&runs, &d1));
-    en.read(in, body([pm = &m, pr = &runs, pd = &d1](Engine& x, int v) {
-      if (v) x.memo_read(*pm, sac::fn<reader_of>(pr, pd));
+  rt.set(in, 0);
+  rt.set(m, 5);
+  rt.run([&](Engine& rt2) {
+    rt2.memo_read(m, sac::fn<reader_of>(&runs, &d1));
+    rt2.read(in, body([pm = &m, pr = &runs, pd = &d1](Engine& rt3, int v) {
+      if (v) rt3.memo_read(*pm, sac::fn<reader_of>(pr, pd));
     }));
   });
   EXPECT_EQ(runs, 1);
-  const Stats s0 = e.stats();
-  e.set(in, 1);
-  e.propagate();
-  expect_healthy(e);
+  const Stats s0 = rt.stats();
+  rt.set(in, 1);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(runs, 2);
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 0u);
-  EXPECT_EQ(e.stats().memo_misses - s0.memo_misses, 1u);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 0u);
+  EXPECT_EQ(rt.stats().memo_misses - s0.memo_misses, 1u);
   EXPECT_EQ(d1.get(), 5);
 }
 
-void triple(Engine& e, Mod<int>* src, Mod<int>* dst, int* runs) {
-  e.read(*src, body([dst, runs](Engine& en, int x) {
+void triple(Engine& rt, Mod<int>* src, Mod<int>* dst, int* runs) {
+  rt.read(*src, body([dst, runs](Engine& rt2, int x) {
     ++*runs;
-    en.write(*dst, 3 * x);
+    rt2.write(*dst, 3 * x);
   }));
 }
 
 TEST(EngineMemo, AffectedReadsInsideAReusedEntryArePropagated) {
-  Engine e;
+  Engine rt;
   Mod<int> in, mid, out, in2, out2;
   int runs = 0, runs2 = 0;
-  e.set(in, 1);
-  e.set(in2, 10);
-  e.run([&](Engine& en) {
-    en.read(in, body([pmid = &mid, pout = &out, pr = &runs, pin2 = &in2, pout2 = &out2,
-                 pr2 = &runs2](Engine& x, int v) {
-      x.write(*pmid, v);
+  rt.set(in, 1);
+  rt.set(in2, 10);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([pmid = &mid, pout = &out, pr = &runs, pin2 = &in2, pout2 = &out2,
+                 pr2 = &runs2](Engine& rt3, int v) {
+      rt3.write(*pmid, v);
       // Reused on re-execution, but the read inside depends on the new `mid`...
-      x.memo(sac::fn<triple>(pmid, pout, pr));
+      rt3.memo(sac::fn<triple>(pmid, pout, pr));
       // ... and this one on an input changed in the same batch.
-      x.memo(sac::fn<triple>(pin2, pout2, pr2));
+      rt3.memo(sac::fn<triple>(pin2, pout2, pr2));
     }));
   });
-  expect_healthy(e);
+  expect_healthy(rt);
   EXPECT_EQ(out.get(), 3);
   EXPECT_EQ(out2.get(), 30);
-  const Figures scratch = figures(e);
+  const Figures scratch = figures(rt);
 
-  Stats s0 = e.stats();
-  e.set(in, 5);
-  e.propagate();
-  expect_healthy(e);
+  Stats s0 = rt.stats();
+  rt.set(in, 5);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(out.get(), 15);
   EXPECT_EQ(out2.get(), 30);
   EXPECT_EQ(runs, 2);
   EXPECT_EQ(runs2, 1);
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 2u);
-  EXPECT_EQ(e.stats().last_reexecuted, 2u);
-  EXPECT_EQ(figures(e), scratch);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 2u);
+  EXPECT_EQ(rt.stats().last_reexecuted, 2u);
+  EXPECT_EQ(figures(rt), scratch);
 
-  s0 = e.stats();
-  e.set(in, 6);
-  e.set(in2, 11);
-  e.propagate();
-  expect_healthy(e);
+  s0 = rt.stats();
+  rt.set(in, 6);
+  rt.set(in2, 11);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(out.get(), 18);
   EXPECT_EQ(out2.get(), 33);
   EXPECT_EQ(runs, 3);
   EXPECT_EQ(runs2, 2);
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 2u);
-  EXPECT_EQ(e.stats().last_reexecuted, 3u);
-  EXPECT_EQ(figures(e), scratch);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 2u);
+  EXPECT_EQ(rt.stats().last_reexecuted, 3u);
+  EXPECT_EQ(figures(rt), scratch);
 }
 
 // ================================================================ keyed allocation
@@ -790,34 +789,34 @@ TEST(EngineMemo, AffectedReadsInsideAReusedEntryArePropagated) {
 TEST(EngineAlloc, SameKeyInTheWindowReturnsTheSameObject) {
   Counted::reset();
   {
-    Engine e;
+    Engine rt;
     Mod<int> in;
     Mod<Counted*> out;
-    e.set(in, 1);
-    e.run([&](Engine& en) {
-      en.read(in, body([po = &out](Engine& x, int v) {
-        Counted* c = x.alloc<Counted>(42, v);
-        x.write(c->m, v);
-        x.write(*po, c);
+    rt.set(in, 1);
+    rt.run([&](Engine& rt2) {
+      rt2.read(in, body([po = &out](Engine& rt3, int v) {
+        Counted* c = rt3.alloc<Counted>(42, v);
+        rt3.write(c->m, v);
+        rt3.write(*po, c);
       }));
     });
-    expect_healthy(e);
+    expect_healthy(rt);
     Counted* const first = out.get();
     ASSERT_NE(first, nullptr);
     EXPECT_EQ(Counted::ctor, 1);
-    const Figures scratch = figures(e);
+    const Figures scratch = figures(rt);
     for (int v = 2; v <= 5; ++v) {
-      const Stats s0 = e.stats();
-      e.set(in, v);
-      e.propagate();
-      expect_healthy(e);
+      const Stats s0 = rt.stats();
+      rt.set(in, v);
+      rt.propagate();
+      expect_healthy(rt);
       EXPECT_EQ(out.get(), first) << "same key, same object";
       EXPECT_EQ(Counted::ctor, 1) << "the constructor must not run again";
       EXPECT_EQ(Counted::dtor, 0);
       EXPECT_EQ(first->v, 1) << "a reused object keeps its state";
       EXPECT_EQ(first->m.get(), v);
-      EXPECT_EQ(e.stats().alloc_reuses - s0.alloc_reuses, 1u);
-      EXPECT_EQ(figures(e), scratch);
+      EXPECT_EQ(rt.stats().alloc_reuses - s0.alloc_reuses, 1u);
+      EXPECT_EQ(figures(rt), scratch);
     }
   }
   EXPECT_EQ(Counted::dtor, Counted::ctor);
@@ -826,27 +825,27 @@ TEST(EngineAlloc, SameKeyInTheWindowReturnsTheSameObject) {
 TEST(EngineAlloc, EqualKeysInOneRunAreDistinctAndReusedInOrder) {
   Counted::reset();
   {
-    Engine e;
+    Engine rt;
     Mod<int> in;
     Mod<Counted*> o1, o2;
-    e.set(in, 1);
-    e.run([&](Engine& en) {
-      en.read(in, body([p1 = &o1, p2 = &o2](Engine& x, int v) {
-        Counted* a = x.alloc<Counted>(7, v);
-        Counted* b = x.alloc<Counted>(7, v + 100);
-        x.write(*p1, a);
-        x.write(*p2, b);
+    rt.set(in, 1);
+    rt.run([&](Engine& rt2) {
+      rt2.read(in, body([p1 = &o1, p2 = &o2](Engine& rt3, int v) {
+        Counted* a = rt3.alloc<Counted>(7, v);
+        Counted* b = rt3.alloc<Counted>(7, v + 100);
+        rt3.write(*p1, a);
+        rt3.write(*p2, b);
       }));
     });
-    expect_healthy(e);
+    expect_healthy(rt);
     Counted* const a = o1.get();
     Counted* const b = o2.get();
     EXPECT_NE(a, b) << "a from-scratch run never shares keyed objects";
     EXPECT_EQ(a->v, 1);
     EXPECT_EQ(b->v, 101);
-    e.set(in, 2);
-    e.propagate();
-    expect_healthy(e);
+    rt.set(in, 2);
+    rt.propagate();
+    expect_healthy(rt);
     EXPECT_EQ(o1.get(), a);
     EXPECT_EQ(o2.get(), b);
     EXPECT_EQ(Counted::ctor, 2);
@@ -856,11 +855,11 @@ TEST(EngineAlloc, EqualKeysInOneRunAreDistinctAndReusedInOrder) {
 }
 
 /// read(in, v -> out = alloc<Counted>(key v)); one closure type for every engine.
-void run_keyed_by_value(Engine& e, Mod<int>& in, Mod<Counted*>& out) {
-  e.run([&](Engine& en) {
-    en.read(in, body([po = &out](Engine& x, int v) {
-      Counted* c = x.alloc<Counted>(v, v);  // the key follows the input
-      x.write(*po, c);
+void run_keyed_by_value(Engine& rt, Mod<int>& in, Mod<Counted*>& out) {
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([po = &out](Engine& rt3, int v) {
+      Counted* c = rt3.alloc<Counted>(v, v);  // the key follows the input
+      rt3.write(*po, c);
     }));
   });
 }
@@ -868,29 +867,29 @@ void run_keyed_by_value(Engine& e, Mod<int>& in, Mod<Counted*>& out) {
 TEST(EngineAlloc, DifferentKeyGivesANewObjectAndTheOldOneIsDestroyed) {
   Counted::reset();
   {
-    Engine e;
+    Engine rt;
     Mod<int> in;
     Mod<Counted*> out;
-    e.set(in, 1);
-    run_keyed_by_value(e, in, out);
-    expect_healthy(e);
+    rt.set(in, 1);
+    run_keyed_by_value(rt, in, out);
+    expect_healthy(rt);
     for (int v = 2; v <= 6; ++v) {
       Counted* const old = out.get();
       const int c0 = Counted::ctor, d0 = Counted::dtor;
-      e.set(in, v);
-      e.propagate();
-      expect_healthy(e);
+      rt.set(in, v);
+      rt.propagate();
+      expect_healthy(rt);
       EXPECT_NE(out.get(), old);
       EXPECT_EQ(out.get()->v, v);
       EXPECT_EQ(Counted::ctor - c0, 1);
       EXPECT_EQ(Counted::dtor - d0, 1) << "undone allocations are destroyed by propagate()";
       // Same live trace as a fresh engine running the same program on the same input.
-      Engine f;
+      Engine rt2;
       Mod<int> fin;
       Mod<Counted*> fout;
-      f.set(fin, v);
-      run_keyed_by_value(f, fin, fout);
-      EXPECT_EQ(figures(e), figures(f));
+      rt2.set(fin, v);
+      run_keyed_by_value(rt2, fin, fout);
+      EXPECT_EQ(figures(rt), figures(rt2));
     }
   }
   EXPECT_EQ(Counted::dtor, Counted::ctor);
@@ -899,26 +898,26 @@ TEST(EngineAlloc, DifferentKeyGivesANewObjectAndTheOldOneIsDestroyed) {
 TEST(EngineAlloc, UnkeyedMakeIsFreedWhenUndone) {
   Counted::reset();
   {
-    Engine e;
+    Engine rt;
     Mod<int> in;
     Mod<Counted*> out;
-    e.set(in, 0);
-    e.run([&](Engine& en) {
-      en.read(in, body([po = &out](Engine& x, int v) {
-        Counted* c = x.make<Counted>(v);
-        x.make<std::vector<int>>(100, v);  // an object owning heap memory (leak check)
-        x.write(*po, c);
+    rt.set(in, 0);
+    rt.run([&](Engine& rt2) {
+      rt2.read(in, body([po = &out](Engine& rt3, int v) {
+        Counted* c = rt3.make<Counted>(v);
+        rt3.make<std::vector<int>>(100, v);  // an object owning heap memory (leak check)
+        rt3.write(*po, c);
       }));
     });
-    const Figures scratch = figures(e);
+    const Figures scratch = figures(rt);
     for (int v = 1; v <= 20; ++v) {
-      e.set(in, v);
-      e.propagate();
-      expect_healthy(e);
+      rt.set(in, v);
+      rt.propagate();
+      expect_healthy(rt);
       EXPECT_EQ(out.get()->v, v);
       EXPECT_EQ(Counted::ctor, v + 1);
       EXPECT_EQ(Counted::dtor, v);
-      EXPECT_EQ(figures(e), scratch);
+      EXPECT_EQ(figures(rt), scratch);
     }
   }
   EXPECT_EQ(Counted::dtor, Counted::ctor);
@@ -929,55 +928,55 @@ TEST(EngineAlloc, UnkeyedMakeIsFreedWhenUndone) {
 TEST(EngineUndo, RemovedWriteRestoresTheOlderVersionAndDropsItsTrace) {
   Counted::reset();
   int calls = 0;
-  auto program = [&calls](Engine& en, Mod<int>& in, Mod<int>& m, Mod<int>& out) {
-    en.run([&](Engine& x) {
-      x.write(m, 1);
-      x.read(in, body([pm = &m, pc = &calls](Engine& y, int v) {
+  auto program = [&calls](Engine& rt, Mod<int>& in, Mod<int>& m, Mod<int>& out) {
+    rt.run([&](Engine& rt2) {
+      rt2.write(m, 1);
+      rt2.read(in, body([pm = &m, pc = &calls](Engine& rt3, int v) {
         if (v) {
-          y.write(*pm, 2);
-          y.memo(sac::fn<bump>(pc, v));
-          y.make<Counted>(v);
-          y.read(*pm, body([](Engine&, int) {}));
+          rt3.write(*pm, 2);
+          rt3.memo(sac::fn<bump>(pc, v));
+          rt3.make<Counted>(v);
+          rt3.read(*pm, body([](Engine&, int) {}));
         }
       }));
-      x.read(m, body([po = &out](Engine& y, int w) { y.write(*po, w); }));
+      rt2.read(m, body([po = &out](Engine& rt3, int w) { rt3.write(*po, w); }));
     });
   };
   auto fresh = [&](int v) {
-    Engine f;
+    Engine rt;
     Mod<int> in, m, out;
-    f.set(in, v);
-    program(f, in, m, out);
+    rt.set(in, v);
+    program(rt, in, m, out);
     EXPECT_EQ(out.get(), v ? 2 : 1);
-    return figures(f);
+    return figures(rt);
   };
   {
-    Engine e;
+    Engine rt;
     Mod<int> in, m, out;
-    e.set(in, 1);
-    program(e, in, m, out);
-    expect_healthy(e);
+    rt.set(in, 1);
+    program(rt, in, m, out);
+    expect_healthy(rt);
     EXPECT_EQ(out.get(), 2);
-    const Figures with_write = figures(e);
+    const Figures with_write = figures(rt);
     EXPECT_EQ(with_write, fresh(1));
 
-    e.set(in, 0);
-    e.propagate();
-    expect_healthy(e);
+    rt.set(in, 0);
+    rt.propagate();
+    expect_healthy(rt);
     EXPECT_EQ(out.get(), 1) << "the later reader sees the older version again";
     EXPECT_EQ(m.get(), 1);
-    EXPECT_EQ(figures(e), fresh(0)) << "write, memo entry, allocation and read all undone";
-    EXPECT_LT(figures(e).record_bytes, with_write.record_bytes);
+    EXPECT_EQ(figures(rt), fresh(0)) << "write, memo entry, allocation and read all undone";
+    EXPECT_LT(figures(rt).record_bytes, with_write.record_bytes);
 
-    e.set(in, 1);
-    e.propagate();
-    expect_healthy(e);
+    rt.set(in, 1);
+    rt.propagate();
+    expect_healthy(rt);
     EXPECT_EQ(out.get(), 2);
-    EXPECT_EQ(figures(e), with_write);
-    e.set(in, 0);
-    e.propagate();
-    expect_healthy(e);
-    EXPECT_EQ(figures(e), fresh(0));
+    EXPECT_EQ(figures(rt), with_write);
+    rt.set(in, 0);
+    rt.propagate();
+    expect_healthy(rt);
+    EXPECT_EQ(figures(rt), fresh(0));
   }
   EXPECT_EQ(Counted::dtor, Counted::ctor);
 }
@@ -986,264 +985,264 @@ TEST(EngineUndo, RemovedWriteRestoresTheOlderVersionAndDropsItsTrace) {
 
 TEST(EngineBatch, SeveralSetsThenOnePropagateEqualsFromScratch) {
   const int n = 50;
-  Engine e;
+  Engine rt;
   std::vector<Mod<int>> xs(n);
   std::vector<Mod<int>> ys(n);
-  for (int i = 0; i < n; ++i) e.set(xs[static_cast<std::size_t>(i)], i);
-  e.run([&](Engine& en) {
+  for (int i = 0; i < n; ++i) rt.set(xs[static_cast<std::size_t>(i)], i);
+  rt.run([&](Engine& rt2) {
     for (int i = 0; i < n; ++i)
-      en.read(xs[static_cast<std::size_t>(i)],
-              body([py = &ys[static_cast<std::size_t>(i)]](Engine& x, int v) { x.write(*py, v * v); }));
+      rt2.read(xs[static_cast<std::size_t>(i)],
+              body([py = &ys[static_cast<std::size_t>(i)]](Engine& rt3, int v) { rt3.write(*py, v * v); }));
   });
-  const Figures scratch = figures(e);
-  e.set(xs[3], 30);
-  e.set(xs[40], 400);
-  e.set(xs[17], 170);
-  e.set(xs[17], 17);  // back to the original value inside the batch
-  e.set(xs[3], 31);
-  e.propagate();
-  expect_healthy(e);
-  EXPECT_EQ(e.stats().last_reexecuted, 3u);  // 3, 40 and 17 (17 was enqueued, then restored)
+  const Figures scratch = figures(rt);
+  rt.set(xs[3], 30);
+  rt.set(xs[40], 400);
+  rt.set(xs[17], 170);
+  rt.set(xs[17], 17);  // back to the original value inside the batch
+  rt.set(xs[3], 31);
+  rt.propagate();
+  expect_healthy(rt);
+  EXPECT_EQ(rt.stats().last_reexecuted, 3u);  // 3, 40 and 17 (17 was enqueued, then restored)
   for (int i = 0; i < n; ++i) {
     const int x = i == 3 ? 31 : i == 40 ? 400 : i;
     EXPECT_EQ(ys[static_cast<std::size_t>(i)].get(), x * x);
   }
-  EXPECT_EQ(figures(e), scratch);
+  EXPECT_EQ(figures(rt), scratch);
 }
 
 TEST(EngineBatch, ListBatchesMatchAFreshRun) {
   std::mt19937_64 rng(77);
   const int n = 200 / kScale;
   std::vector<long> values = random_values(rng, n);
-  Engine e;
-  Input in(e, values);
+  Engine rt;
+  Input in(rt, values);
   PsumProgram p;
-  p.start(e, in);
+  p.start(rt, in);
   for (int round = 0; round < 20; ++round) {
     const int k = 2 + static_cast<int>(rng() % 12);
     for (int j = 0; j < k; ++j) in.toggle(rng() % static_cast<std::size_t>(n));
-    e.propagate();
-    expect_healthy(e);
+    rt.propagate();
+    expect_healthy(rt);
     std::vector<long> scratch_result;
     const Figures scratch = fresh_figures<PsumProgram>(values, in.presence(), &scratch_result);
     ASSERT_EQ(p.result(), PsumProgram::expected(in.sequence())) << "round " << round;
     ASSERT_EQ(p.result(), scratch_result);
-    ASSERT_EQ(figures(e), scratch) << "round " << round;
+    ASSERT_EQ(figures(rt), scratch) << "round " << round;
   }
 }
 
 // ================================================================ misuse
 
 TEST(EngineMisuse, ReadingANeverWrittenModifiablePoisons) {
-  Engine e;
+  Engine rt;
   Mod<int> never, in;
-  e.set(in, 1);
-  EXPECT_THROW(e.run([&](Engine& en) { en.read(never, body([](int) {})); }), sac::UsageError);
-  EXPECT_TRUE(e.poisoned());
-  EXPECT_FALSE(e.in_computation());
-  EXPECT_THROW(e.run([](Engine&) {}), sac::PoisonedError);
-  EXPECT_THROW(e.propagate(), sac::PoisonedError);
-  EXPECT_THROW(e.set(in, 2), sac::PoisonedError);
-  EXPECT_THROW(e.read(in, body([](int) {})), sac::PoisonedError);
-  EXPECT_THROW(e.write(in, 3), sac::PoisonedError);
+  rt.set(in, 1);
+  EXPECT_THROW(rt.run([&](Engine& rt2) { rt2.read(never, body([](int) {})); }), sac::UsageError);
+  EXPECT_TRUE(rt.poisoned());
+  EXPECT_FALSE(rt.in_computation());
+  EXPECT_THROW(rt.run([](Engine&) {}), sac::PoisonedError);
+  EXPECT_THROW(rt.propagate(), sac::PoisonedError);
+  EXPECT_THROW(rt.set(in, 2), sac::PoisonedError);
+  EXPECT_THROW(rt.read(in, body([](int) {})), sac::PoisonedError);
+  EXPECT_THROW(rt.write(in, 3), sac::PoisonedError);
   EXPECT_THROW(never.get(), sac::UsageError);
 }
 
 TEST(EngineMisuse, ReadingANeverWrittenModifiableNestedInsideAReadPoisons) {
-  Engine e;
+  Engine rt;
   Mod<int> never, in;
   Mod<std::string> keep;
-  e.set(in, 1);
-  EXPECT_THROW(e.run([&](Engine& en) {
-    en.write(keep, std::string(200, 'k'));
-    en.read(in, body([pn = &never, s = std::string(300, 's')](Engine& x, int) {
-      x.make<std::string>(s);
-      x.read(*pn, body([s](int) {}));
+  rt.set(in, 1);
+  EXPECT_THROW(rt.run([&](Engine& rt2) {
+    rt2.write(keep, std::string(200, 'k'));
+    rt2.read(in, body([pn = &never, s = std::string(300, 's')](Engine& rt3, int) {
+      rt3.make<std::string>(s);
+      rt3.read(*pn, body([s](int) {}));
     }));
   }),
                sac::UsageError);
-  EXPECT_TRUE(e.poisoned());
+  EXPECT_TRUE(rt.poisoned());
 }  // destroying the poisoned engine must not leak (LeakSanitizer)
 
 TEST(EngineMisuse, AReadLosingItsOnlyVersionFailsInPropagate) {
-  Engine e;
+  Engine rt;
   Mod<int> in, m, out;
-  e.set(in, 1);
-  e.run([&](Engine& en) {
-    en.read(in, body([pm = &m](Engine& x, int v) {
-      if (v) x.write(*pm, v);
+  rt.set(in, 1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([pm = &m](Engine& rt3, int v) {
+      if (v) rt3.write(*pm, v);
     }));
-    en.read(m, body([po = &out](Engine& x, int w) { x.write(*po, w); }));
+    rt2.read(m, body([po = &out](Engine& rt3, int w) { rt3.write(*po, w); }));
   });
-  expect_healthy(e);
-  e.set(in, 0);  // m is no longer written before its reader
-  EXPECT_THROW(e.propagate(), sac::UsageError);
-  EXPECT_TRUE(e.poisoned());
-  EXPECT_THROW(e.propagate(), sac::PoisonedError);
+  expect_healthy(rt);
+  rt.set(in, 0);  // m is no longer written before its reader
+  EXPECT_THROW(rt.propagate(), sac::UsageError);
+  EXPECT_TRUE(rt.poisoned());
+  EXPECT_THROW(rt.propagate(), sac::PoisonedError);
 }
 
 TEST(EngineMisuse, MutatorCallsFromInsideABodyAreRejected) {
-  Engine e;
+  Engine rt;
   Mod<int> in, x, out;
   int rejected = 0;
-  e.set(in, 1);
-  e.set(x, 1);
-  auto probe = [&](Engine& en) {
-    EXPECT_THROW(en.propagate(), sac::UsageError);
-    EXPECT_THROW(en.run([](Engine&) {}), sac::UsageError);
-    EXPECT_THROW(en.set(x, 5), sac::UsageError);
-    EXPECT_THROW(en.check_invariants(), sac::UsageError);
-    EXPECT_TRUE(en.in_computation());
+  rt.set(in, 1);
+  rt.set(x, 1);
+  auto probe = [&](Engine& rt2) {
+    EXPECT_THROW(rt2.propagate(), sac::UsageError);
+    EXPECT_THROW(rt2.run([](Engine&) {}), sac::UsageError);
+    EXPECT_THROW(rt2.set(x, 5), sac::UsageError);
+    EXPECT_THROW(rt2.check_invariants(), sac::UsageError);
+    EXPECT_TRUE(rt2.in_computation());
     ++rejected;
   };
-  e.run([&](Engine& en) {
-    probe(en);
-    en.read(in, body([&probe, po = &out](Engine& y, int v) {
+  rt.run([&](Engine& rt2) {
+    probe(rt2);
+    rt2.read(in, body([&probe, po = &out](Engine& rt3, int v) {
       // (The probe lambda lives in this test's frame, which outlives the engine's use.)
-      probe(y);
-      y.write(*po, v);
+      probe(rt3);
+      rt3.write(*po, v);
     }));
   });
   EXPECT_EQ(rejected, 2);
-  EXPECT_FALSE(e.poisoned()) << "errors caught inside a body leave the engine usable";
-  expect_healthy(e);
-  e.set(in, 2);
-  e.propagate();
+  EXPECT_FALSE(rt.poisoned()) << "errors caught inside a body leave the engine usable";
+  expect_healthy(rt);
+  rt.set(in, 2);
+  rt.propagate();
   EXPECT_EQ(rejected, 3);
   EXPECT_EQ(out.get(), 2);
   EXPECT_EQ(x.get(), 1);
-  expect_healthy(e);
+  expect_healthy(rt);
 
   // Uncaught, the error leaves run() and poisons the engine.
-  EXPECT_THROW(e.run([&](Engine& en) {
-    en.read(in, body([px = &x](Engine& y, int) { y.set(*px, 9); }));
+  EXPECT_THROW(rt.run([&](Engine& rt2) {
+    rt2.read(in, body([px = &x](Engine& rt3, int) { rt3.set(*px, 9); }));
   }),
                sac::UsageError);
-  EXPECT_TRUE(e.poisoned());
+  EXPECT_TRUE(rt.poisoned());
 }
 
 TEST(EngineMisuse, ComputationCallsOutsideTheComputationAreRejected) {
-  Engine e;
+  Engine rt;
   Mod<int> m, out;
-  e.set(m, 1);
-  EXPECT_THROW(e.read(m, body([](int) {})), sac::UsageError);
-  EXPECT_THROW(e.write(m, 2), sac::UsageError);
-  EXPECT_THROW(e.alloc<int>(1, 2), sac::UsageError);
-  EXPECT_THROW(e.make<int>(2), sac::UsageError);
+  rt.set(m, 1);
+  EXPECT_THROW(rt.read(m, body([](int) {})), sac::UsageError);
+  EXPECT_THROW(rt.write(m, 2), sac::UsageError);
+  EXPECT_THROW(rt.alloc<int>(1, 2), sac::UsageError);
+  EXPECT_THROW(rt.make<int>(2), sac::UsageError);
   int calls = 0;
-  EXPECT_THROW(e.memo(sac::fn<bump>(&calls, 1)), sac::UsageError);
-  EXPECT_THROW(e.memo_read(m, sac::fn<reader_of>(&calls, &out)), sac::UsageError);
+  EXPECT_THROW(rt.memo(sac::fn<bump>(&calls, 1)), sac::UsageError);
+  EXPECT_THROW(rt.memo_read(m, sac::fn<reader_of>(&calls, &out)), sac::UsageError);
   EXPECT_EQ(calls, 0);
-  EXPECT_FALSE(e.poisoned()) << "a rejected call changes nothing";
+  EXPECT_FALSE(rt.poisoned()) << "a rejected call changes nothing";
   EXPECT_EQ(m.get(), 1);
-  EXPECT_EQ(e.live_events(), 0u);
-  e.run([&](Engine& en) { en.read(m, body([po = &out](Engine& x, int v) { x.write(*po, v); })); });
+  EXPECT_EQ(rt.live_events(), 0u);
+  rt.run([&](Engine& rt2) { rt2.read(m, body([po = &out](Engine& rt3, int v) { rt3.write(*po, v); })); });
   EXPECT_EQ(out.get(), 1);
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
 TEST(EngineMisuse, RetireRules) {
-  Engine e;
+  Engine rt;
   Mod<int> m, n, out;
-  e.set(m, 1);
-  e.set(n, 2);
-  e.run([&](Engine& en) { en.read(m, body([po = &out](Engine& x, int v) { x.write(*po, v); })); });
-  EXPECT_THROW(e.retire(m), sac::UsageError);  // still read
-  EXPECT_THROW(e.retire(out), sac::UsageError);  // written by the computation
-  const std::size_t input = e.input_bytes();
-  const std::size_t records = e.record_bytes();
-  e.retire(n);
+  rt.set(m, 1);
+  rt.set(n, 2);
+  rt.run([&](Engine& rt2) { rt2.read(m, body([po = &out](Engine& rt3, int v) { rt3.write(*po, v); })); });
+  EXPECT_THROW(rt.retire(m), sac::UsageError);  // still read
+  EXPECT_THROW(rt.retire(out), sac::UsageError);  // written by the computation
+  const std::size_t input = rt.input_bytes();
+  const std::size_t records = rt.record_bytes();
+  rt.retire(n);
   EXPECT_FALSE(n.written());
-  EXPECT_LT(e.input_bytes(), input);
-  EXPECT_EQ(e.record_bytes(), records) << "base versions are not trace records";
-  e.set(n, 3);
+  EXPECT_LT(rt.input_bytes(), input);
+  EXPECT_EQ(rt.record_bytes(), records) << "base versions are not trace records";
+  rt.set(n, 3);
   EXPECT_EQ(n.get(), 3);
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
 // init() names a modifiable lazily, inside the computation, with a default that every run
 // would see; a later write before an earlier reader re-runs that reader.
 TEST(EngineInit, LazilyNamedDefaultsBehaveLikeInputs) {
-  Engine e;
+  Engine rt;
   Mod<int> flag, lazy, out, src;
-  e.set(src, 0);
-  e.set(flag, 0);
-  e.run([&](Engine& en) {
+  rt.set(src, 0);
+  rt.set(flag, 0);
+  rt.run([&](Engine& rt2) {
     // The reader of `lazy` comes first; the write (when src is 1) comes after it.
-    en.read(flag, body([pl = &lazy, po = &out](Engine& x, int) {
-      if (!pl->written()) x.init(*pl, 7);
-      x.read(*pl, body([po](Engine& y, int v) { y.write(*po, v); }));
+    rt2.read(flag, body([pl = &lazy, po = &out](Engine& rt3, int) {
+      if (!pl->written()) rt3.init(*pl, 7);
+      rt3.read(*pl, body([po](Engine& rt4, int v) { rt4.write(*po, v); }));
     }));
-    en.read(src, body([pl = &lazy](Engine& x, int v) {
-      if (!pl->written()) x.init(*pl, 7);
-      if (v) x.write(*pl, 9);
+    rt2.read(src, body([pl = &lazy](Engine& rt3, int v) {
+      if (!pl->written()) rt3.init(*pl, 7);
+      if (v) rt3.write(*pl, 9);
     }));
   });
   EXPECT_EQ(out.get(), 7);
-  EXPECT_FALSE(e.unused(lazy)) << "it is read";
-  EXPECT_THROW(e.init(lazy, 1), sac::UsageError) << "already written";
-  e.set(src, 1);
-  e.propagate();
+  EXPECT_FALSE(rt.unused(lazy)) << "it is read";
+  EXPECT_THROW(rt.init(lazy, 1), sac::UsageError) << "already written";
+  rt.set(src, 1);
+  rt.propagate();
   EXPECT_EQ(out.get(), 7) << "the write comes after the read";
   EXPECT_EQ(lazy.get(), 9);
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
 TEST(EngineInit, UnusedOnceNothingInTheTraceRefersToIt) {
-  Engine e;
+  Engine rt;
   Mod<int> sel, a, b, out;
-  e.set(sel, 0);
-  e.run([&](Engine& en) {
-    en.read(sel, body([pa = &a, pb = &b, po = &out](Engine& x, int v) {
+  rt.set(sel, 0);
+  rt.run([&](Engine& rt2) {
+    rt2.read(sel, body([pa = &a, pb = &b, po = &out](Engine& rt3, int v) {
       Mod<int>* m = v ? pb : pa;
-      if (!m->written()) x.init(*m, v ? 20 : 10);
-      x.read(*m, body([po](Engine& y, int w) { y.write(*po, w); }));
+      if (!m->written()) rt3.init(*m, v ? 20 : 10);
+      rt3.read(*m, body([po](Engine& rt4, int w) { rt4.write(*po, w); }));
     }));
   });
   EXPECT_EQ(out.get(), 10);
-  EXPECT_FALSE(e.unused(a));
-  EXPECT_TRUE(e.unused(b)) << "never named";
-  e.set(sel, 1);
-  e.propagate();
+  EXPECT_FALSE(rt.unused(a));
+  EXPECT_TRUE(rt.unused(b)) << "never named";
+  rt.set(sel, 1);
+  rt.propagate();
   EXPECT_EQ(out.get(), 20);
-  EXPECT_TRUE(e.unused(a)) << "its only reader was undone";
-  EXPECT_FALSE(e.unused(b));
-  EXPECT_FALSE(e.unused(out)) << "written by the computation";
-  e.retire(a);
+  EXPECT_TRUE(rt.unused(a)) << "its only reader was undone";
+  EXPECT_FALSE(rt.unused(b));
+  EXPECT_FALSE(rt.unused(out)) << "written by the computation";
+  rt.retire(a);
   EXPECT_FALSE(a.written());
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
 // ---- init_default(): a default that costs nothing until a read sees it
 
 TEST(EngineInitDefault, ReadsTheDefaultAndBehavesAsAWrittenModifiable) {
-  Engine e;
+  Engine rt;
   Mod<int> d, out;
   Mod<const int*> p;
-  e.init_default(d);
-  e.init_default(p);
+  rt.init_default(d);
+  rt.init_default(p);
   EXPECT_TRUE(d.written()) << "a default is a value";
   EXPECT_EQ(d.get(), 0);
   EXPECT_EQ(p.get(), nullptr);
-  EXPECT_TRUE(e.unused(d));
-  EXPECT_EQ(e.input_bytes(), 0u) << "nothing is made before a read";
-  EXPECT_THROW(e.init_default(d), sac::UsageError) << "already has a value";
-  EXPECT_THROW(e.init(d, 1), sac::UsageError) << "already has a value";
-  e.run([&](Engine& en) { en.read(d, body([po = &out](Engine& x, int v) { x.write(*po, v + 1); })); });
+  EXPECT_TRUE(rt.unused(d));
+  EXPECT_EQ(rt.input_bytes(), 0u) << "nothing is made before a read";
+  EXPECT_THROW(rt.init_default(d), sac::UsageError) << "already has a value";
+  EXPECT_THROW(rt.init(d, 1), sac::UsageError) << "already has a value";
+  rt.run([&](Engine& rt2) { rt2.read(d, body([po = &out](Engine& rt3, int v) { rt3.write(*po, v + 1); })); });
   EXPECT_EQ(out.get(), 1);
-  EXPECT_EQ(e.input_bytes(), 0u) << "the read hangs on the modifiable: no version is made";
-  EXPECT_FALSE(e.unused(d));
-  EXPECT_THROW(e.retire(d), sac::UsageError) << "still read";
-  EXPECT_TRUE(e.unused(p));
-  e.retire(p);
+  EXPECT_EQ(rt.input_bytes(), 0u) << "the read hangs on the modifiable: no version is made";
+  EXPECT_FALSE(rt.unused(d));
+  EXPECT_THROW(rt.retire(d), sac::UsageError) << "still read";
+  EXPECT_TRUE(rt.unused(p));
+  rt.retire(p);
   EXPECT_FALSE(p.written());
-  expect_healthy(e);
+  expect_healthy(rt);
   // set() on a default that a read saw: the default becomes a base version, then changes.
-  e.set(d, 4);
-  EXPECT_EQ(e.input_bytes(), sac::kIntInput);
-  e.propagate();
+  rt.set(d, 4);
+  EXPECT_EQ(rt.input_bytes(), sac::kIntInput);
+  rt.propagate();
   EXPECT_EQ(out.get(), 5);
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
 // Reads of a default with no version hang on the modifiable (no version is made); a write
@@ -1251,81 +1250,81 @@ TEST(EngineInitDefault, ReadsTheDefaultAndBehavesAsAWrittenModifiable) {
 // them the default back, cut off when the value is the same; a memo_read of such a default
 // is found and reused by a re-execution.
 TEST(EngineInitDefault, ReadsOfADefaultHangOnTheModifiableUntilItHasAVersion) {
-  Engine e;
+  Engine rt;
   Mod<int> sel, d, out1, out2, out3;
   int runs = 0;
-  e.init_default(d);
-  e.set(sel, 0);
-  e.run([&](Engine& en) {
-    en.read(sel, body([pd = &d, po = &out3, pr = &runs](Engine& x, int s) {
-      if (s == 1) x.write(*pd, 7);
-      if (s == 2) x.write(*pd, 0);  // the default's value: its readers are cut off
-      x.write(*po, s);
-      if (s != 3) x.memo_read(*pd, sac::fn<reader_of>(pr, po));
+  rt.init_default(d);
+  rt.set(sel, 0);
+  rt.run([&](Engine& rt2) {
+    rt2.read(sel, body([pd = &d, po = &out3, pr = &runs](Engine& rt3, int s) {
+      if (s == 1) rt3.write(*pd, 7);
+      if (s == 2) rt3.write(*pd, 0);  // the default's value: its readers are cut off
+      rt3.write(*po, s);
+      if (s != 3) rt3.memo_read(*pd, sac::fn<reader_of>(pr, po));
     }));
-    en.read(d, body([po = &out1](Engine& x, int v) { x.write(*po, v + 1); }));
-    en.read(d, body([po = &out2](Engine& x, int v) { x.write(*po, v + 2); }));
+    rt2.read(d, body([po = &out1](Engine& rt3, int v) { rt3.write(*po, v + 1); }));
+    rt2.read(d, body([po = &out2](Engine& rt3, int v) { rt3.write(*po, v + 2); }));
   });
   EXPECT_EQ(out1.get(), 1);
   EXPECT_EQ(out2.get(), 2);
   EXPECT_EQ(out3.get(), 0);
   EXPECT_EQ(runs, 1);
-  EXPECT_EQ(e.input_bytes(), sac::kIntInput) << "sel's base version only: the three reads of d hang on d";
-  EXPECT_FALSE(e.unused(d));
-  expect_healthy(e);
+  EXPECT_EQ(rt.input_bytes(), sac::kIntInput) << "sel's base version only: the three reads of d hang on d";
+  EXPECT_FALSE(rt.unused(d));
+  expect_healthy(rt);
 
-  e.set(sel, 3);  // the memo_read goes: one default reader fewer
-  e.propagate();
-  expect_healthy(e);
-  e.set(sel, 0);  // and comes back, run again
-  e.propagate();
-  expect_healthy(e);
+  rt.set(sel, 3);  // the memo_read goes: one default reader fewer
+  rt.propagate();
+  expect_healthy(rt);
+  rt.set(sel, 0);  // and comes back, run again
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(runs, 2);
-  EXPECT_EQ(e.input_bytes(), sac::kIntInput);
+  EXPECT_EQ(rt.input_bytes(), sac::kIntInput);
 
-  e.set(sel, 1);  // a version before the reads: the default becomes a base version
-  e.propagate();
-  expect_healthy(e);
+  rt.set(sel, 1);  // a version before the reads: the default becomes a base version
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(out1.get(), 8);
   EXPECT_EQ(out2.get(), 9);
   EXPECT_EQ(out3.get(), 7) << "the memo_read saw the write";
-  EXPECT_EQ(e.input_bytes(), 2 * sac::kIntInput);
+  EXPECT_EQ(rt.input_bytes(), 2 * sac::kIntInput);
 
-  e.set(sel, 0);  // undone: the readers see the default again
-  e.propagate();
-  expect_healthy(e);
+  rt.set(sel, 0);  // undone: the readers see the default again
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(out1.get(), 1);
   EXPECT_EQ(out2.get(), 2);
   EXPECT_EQ(out3.get(), 0);
 
-  e.set(sel, 2);  // a write equal to the default: only sel's reader runs again
-  e.propagate();
-  expect_healthy(e);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  rt.set(sel, 2);  // a write equal to the default: only sel's reader runs again
+  rt.propagate();
+  expect_healthy(rt);
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
   EXPECT_EQ(out3.get(), 0);
 }
 
 TEST(EngineInitDefault, MemoReadOfADefaultWithoutVersionIsReused) {
-  Engine e;
+  Engine rt;
   Mod<int> in, d, out, dst;
   int runs = 0;
-  e.init_default(d);
-  e.set(in, 1);
-  e.run([&](Engine& en) {
-    en.read(in, body([pd = &d, po = &out, pr = &runs, pt = &dst](Engine& x, int v) {
-      x.write(*po, v);
-      x.memo_read(*pd, sac::fn<reader_of>(pr, pt));
+  rt.init_default(d);
+  rt.set(in, 1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([pd = &d, po = &out, pr = &runs, pt = &dst](Engine& rt3, int v) {
+      rt3.write(*po, v);
+      rt3.memo_read(*pd, sac::fn<reader_of>(pr, pt));
     }));
   });
   EXPECT_EQ(runs, 1);
-  const Stats s0 = e.stats();
-  e.set(in, 2);
-  e.propagate();
-  expect_healthy(e);
+  const Stats s0 = rt.stats();
+  rt.set(in, 2);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(out.get(), 2);
   EXPECT_EQ(runs, 1) << "the old read of the default was found on d and reused";
-  EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 1u);
-  EXPECT_EQ(e.input_bytes(), sac::kIntInput);
+  EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 1u);
+  EXPECT_EQ(rt.input_bytes(), sac::kIntInput);
 }
 
 /// The program of the differential test below: for each input a[i] (in order), a value
@@ -1335,15 +1334,15 @@ struct DefaultCells {
   explicit DefaultCells(std::size_t n, std::size_t k) : a(n), out(n), cells(k) {}
   std::vector<Mod<int>> a, out, cells;
 
-  void run(Engine& e) {
-    e.run([this](Engine& en) {
+  void run(Engine& rt) {
+    rt.run([this](Engine& rt2) {
       for (std::size_t i = 0; i < a.size(); ++i)
-        en.read(a[i], body([this, i](Engine& x, int v) {
+        rt2.read(a[i], body([this, i](Engine& rt3, int v) {
           const std::size_t k = cells.size();
           Mod<int>& c = cells[static_cast<std::size_t>(v) % k];
-          if (!c.written()) x.init_default(c);
-          if (static_cast<std::size_t>(v) < k) return x.write(c, static_cast<int>(i) + 1);
-          x.read(c, body([po = &out[i]](Engine& y, int w) { y.write(*po, w); }));
+          if (!c.written()) rt3.init_default(c);
+          if (static_cast<std::size_t>(v) < k) return rt3.write(c, static_cast<int>(i) + 1);
+          rt3.read(c, body([po = &out[i]](Engine& rt4, int w) { rt4.write(*po, w); }));
           return;
         }));
     });
@@ -1361,21 +1360,21 @@ TEST(EngineInitDefault, DifferentialAgainstFromScratch) {
     std::mt19937_64 rng(seed);
     std::vector<int> in(n);
     for (int& v : in) v = static_cast<int>(rng() % (2 * k));
-    Engine e;
+    Engine rt;
     DefaultCells dyn(n, k);
-    for (std::size_t i = 0; i < n; ++i) e.set(dyn.a[i], in[i]);
-    dyn.run(e);
+    for (std::size_t i = 0; i < n; ++i) rt.set(dyn.a[i], in[i]);
+    dyn.run(rt);
     for (int step = 0; step < 150; ++step) {
       const std::size_t i = rng() % n;
       in[i] = static_cast<int>(rng() % (2 * k));
-      e.set(dyn.a[i], in[i]);
-      e.propagate();
-      ASSERT_NO_THROW(e.check_invariants()) << "step " << step;
+      rt.set(dyn.a[i], in[i]);
+      rt.propagate();
+      ASSERT_NO_THROW(rt.check_invariants()) << "step " << step;
 
-      Engine f;
+      Engine rt2;
       DefaultCells fresh(n, k);
-      for (std::size_t j = 0; j < n; ++j) f.set(fresh.a[j], in[j]);
-      fresh.run(f);
+      for (std::size_t j = 0; j < n; ++j) rt2.set(fresh.a[j], in[j]);
+      fresh.run(rt2);
       std::vector<bool> written(k), named(k), read_first(k);
       for (std::size_t j = 0; j < n; ++j) {
         const std::size_t v = static_cast<std::size_t>(in[j]), c = v % k;
@@ -1388,10 +1387,10 @@ TEST(EngineInitDefault, DifferentialAgainstFromScratch) {
       }
       std::size_t read_then_written = 0;
       for (std::size_t c = 0; c < k; ++c) read_then_written += read_first[c] && written[c];
-      ASSERT_EQ(f.input_bytes(), (n + read_then_written) * sac::kIntInput)
+      ASSERT_EQ(rt2.input_bytes(), (n + read_then_written) * sac::kIntInput)
           << "base versions: the inputs and the defaults read first and written later";
     }
-    expect_healthy(e);
+    expect_healthy(rt);
   }
 }
 
@@ -1402,28 +1401,28 @@ struct Scale {
 };
 
 TEST(EngineContext, BodiesReachTheContextAndTheTypeIsChecked) {
-  Engine e;
-  EXPECT_THROW(e.context<Scale>(), sac::UsageError) << "none set";
-  Scale s{3};
-  e.set_context(&s);
-  EXPECT_EQ(e.context<Scale>(), &s);
-  EXPECT_THROW(e.context<int>(), sac::UsageError) << "another type";
+  Engine rt;
+  EXPECT_THROW(rt.context<Scale>(), sac::UsageError) << "none set";
+  Scale ctx{3};
+  rt.set_context(&ctx);
+  EXPECT_EQ(rt.context<Scale>(), &ctx);
+  EXPECT_THROW(rt.context<int>(), sac::UsageError) << "another type";
   Mod<int> in, out;
-  e.set(in, 2);
-  e.run([&](Engine& en) {
-    en.read(in, body([po = &out](Engine& x, int v) { x.write(*po, v * x.context<Scale>()->factor); }));
+  rt.set(in, 2);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([po = &out](Engine& rt3, int v) { rt3.write(*po, v * rt3.context<Scale>()->factor); }));
   });
   EXPECT_EQ(out.get(), 6);
-  e.set(in, 5);
-  e.propagate();
+  rt.set(in, 5);
+  rt.propagate();
   EXPECT_EQ(out.get(), 15) << "a re-executed body reaches it too";
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
-void maybe_throw(Engine& e, Mod<int>* src, int bad) {
-  e.make<std::string>(std::string(100, 'm'));
-  e.read(*src, body([bad, s = std::string(64, 'q')](Engine& x, int v) {
-    x.make<Counted>(v);
+void maybe_throw(Engine& rt, Mod<int>* src, int bad) {
+  rt.make<std::string>(std::string(100, 'm'));
+  rt.read(*src, body([bad, s = std::string(64, 'q')](Engine& rt2, int v) {
+    rt2.make<Counted>(v);
     if (v == bad) throw std::runtime_error("body failed: " + s.substr(0, 4));
   }));
 }
@@ -1431,25 +1430,25 @@ void maybe_throw(Engine& e, Mod<int>* src, int bad) {
 TEST(EngineMisuse, BodyThrowingInRunPropagatesAndPoisons) {
   Counted::reset();
   {
-    Engine e;
+    Engine rt;
     Mod<int> in;
-    e.set(in, 13);
-    EXPECT_THROW(e.run([&](Engine& en) {
-      en.read(in, body([pin = &in, s = std::string(80, 'a')](Engine& x, int v) {
-        x.alloc<Counted>(1, v);
-        x.make<std::vector<std::string>>(3, s);
-        x.read(*pin, body([s](Engine& y, int w) {
-          y.make<Counted>(w);
+    rt.set(in, 13);
+    EXPECT_THROW(rt.run([&](Engine& rt2) {
+      rt2.read(in, body([pin = &in, s = std::string(80, 'a')](Engine& rt3, int v) {
+        rt3.alloc<Counted>(1, v);
+        rt3.make<std::vector<std::string>>(3, s);
+        rt3.read(*pin, body([s](Engine& rt4, int w) {
+          rt4.make<Counted>(w);
           if (w == 13) throw std::runtime_error("boom " + s.substr(0, 1));
         }));
-        x.read(*pin, body([s](Engine&, int) {}));  // issued, never run
+        rt3.read(*pin, body([s](Engine&, int) {}));  // issued, never run
       }));
     }),
                  std::runtime_error);
-    EXPECT_TRUE(e.poisoned());
-    EXPECT_FALSE(e.in_computation());
-    EXPECT_THROW(e.run([](Engine&) {}), sac::PoisonedError);
-    EXPECT_THROW(e.propagate(), sac::PoisonedError);
+    EXPECT_TRUE(rt.poisoned());
+    EXPECT_FALSE(rt.in_computation());
+    EXPECT_THROW(rt.run([](Engine&) {}), sac::PoisonedError);
+    EXPECT_THROW(rt.propagate(), sac::PoisonedError);
   }
   EXPECT_EQ(Counted::dtor, Counted::ctor) << "destroying a poisoned engine frees everything";
 }
@@ -1457,12 +1456,12 @@ TEST(EngineMisuse, BodyThrowingInRunPropagatesAndPoisons) {
 TEST(EngineMisuse, MemoBodyThrowingInRunPoisons) {
   Counted::reset();
   {
-    Engine e;
+    Engine rt;
     Mod<int> in;
-    e.set(in, 4);
-    EXPECT_THROW(e.run([&](Engine& en) { en.memo(sac::fn<maybe_throw>(&in, 4)); }),
+    rt.set(in, 4);
+    EXPECT_THROW(rt.run([&](Engine& rt2) { rt2.memo(sac::fn<maybe_throw>(&in, 4)); }),
                  std::runtime_error);
-    EXPECT_TRUE(e.poisoned());
+    EXPECT_TRUE(rt.poisoned());
   }
   EXPECT_EQ(Counted::dtor, Counted::ctor);
 }
@@ -1470,25 +1469,25 @@ TEST(EngineMisuse, MemoBodyThrowingInRunPoisons) {
 TEST(EngineMisuse, BodyThrowingInPropagatePropagatesAndPoisons) {
   Counted::reset();
   {
-    Engine e;
+    Engine rt;
     Mod<int> in, other;
     Mod<Counted*> out;
-    e.set(in, 1);
-    e.set(other, 1);
-    e.run([&](Engine& en) {
+    rt.set(in, 1);
+    rt.set(other, 1);
+    rt.run([&](Engine& rt2) {
       // Re-runs first and undoes its allocation (a deferred free) before the throw below.
-      en.read(in, body([po = &out](Engine& x, int v) { x.write(*po, x.alloc<Counted>(v, v)); }));
-      en.memo(sac::fn<maybe_throw>(&in, 13));
-      en.read(other, body([](Engine& x, int v) { x.make<std::string>(std::string(50, 'o') + std::to_string(v)); }));
+      rt2.read(in, body([po = &out](Engine& rt3, int v) { rt3.write(*po, rt3.alloc<Counted>(v, v)); }));
+      rt2.memo(sac::fn<maybe_throw>(&in, 13));
+      rt2.read(other, body([](Engine& rt3, int v) { rt3.make<std::string>(std::string(50, 'o') + std::to_string(v)); }));
     });
-    expect_healthy(e);
-    e.set(in, 13);
-    e.set(other, 2);
-    EXPECT_THROW(e.propagate(), std::runtime_error);
-    EXPECT_TRUE(e.poisoned());
-    EXPECT_FALSE(e.in_computation());
-    EXPECT_THROW(e.propagate(), sac::PoisonedError);
-    EXPECT_THROW(e.set(in, 1), sac::PoisonedError);
+    expect_healthy(rt);
+    rt.set(in, 13);
+    rt.set(other, 2);
+    EXPECT_THROW(rt.propagate(), std::runtime_error);
+    EXPECT_TRUE(rt.poisoned());
+    EXPECT_FALSE(rt.in_computation());
+    EXPECT_THROW(rt.propagate(), sac::PoisonedError);
+    EXPECT_THROW(rt.set(in, 1), sac::PoisonedError);
   }
   EXPECT_EQ(Counted::dtor, Counted::ctor);
 }
@@ -1499,70 +1498,70 @@ TEST(EngineMisuse, BodyThrowingInPropagatePropagatesAndPoisons) {
 // body performs after a call must land after that call's whole interval (engine.hpp: "the
 // events happen in program order, exactly as if every call ran on the spot").
 
-// Regression (fixed): when a body issued a read and then wrote, flush() ran the read and its
-// close was chained onto the *running* parent's pending close, so the parent's later write
-// was recorded inside the nested read's interval; re-running the nested read then undid it
-// (out2 below lost its only version). Same for alloc/make after a call, and for memo().
+// A body that issues a read and then writes: flush() runs the read, and its close must not
+// be chained onto the *running* parent's pending close, or the parent's later write would be
+// recorded inside the nested read's interval and re-running the nested read would undo it
+// (out2 below would lose its only version). Same for alloc/make after a call, and for memo().
 TEST(EngineOrder, WriteAfterANestedReadStaysOutsideIt) {
-  Engine e;
+  Engine rt;
   Mod<int> a, b, out1, out2;
-  e.set(a, 1);
-  e.set(b, 10);
-  e.run([&](Engine& en) {
-    en.read(a, body([pb = &b, p1 = &out1, p2 = &out2](Engine& x, int va) {
-      x.read(*pb, body([p1](Engine& y, int vb) { y.write(*p1, vb); }));
-      x.write(*p2, va);  // after the nested read, in the outer read's own interval
+  rt.set(a, 1);
+  rt.set(b, 10);
+  rt.run([&](Engine& rt2) {
+    rt2.read(a, body([pb = &b, p1 = &out1, p2 = &out2](Engine& rt3, int va) {
+      rt3.read(*pb, body([p1](Engine& rt4, int vb) { rt4.write(*p1, vb); }));
+      rt3.write(*p2, va);  // after the nested read, in the outer read's own interval
     }));
   });
-  expect_healthy(e);
+  expect_healthy(rt);
   ASSERT_EQ(out1.get(), 10);
   ASSERT_EQ(out2.get(), 1);
-  e.set(b, 20);  // re-runs only the nested read
-  e.propagate();
-  expect_healthy(e);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  rt.set(b, 20);  // re-runs only the nested read
+  rt.propagate();
+  expect_healthy(rt);
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
   EXPECT_EQ(out1.get(), 20);
   ASSERT_TRUE(out2.written()) << "the outer read's write was undone by the nested read";
   EXPECT_EQ(out2.get(), 1);
-  EXPECT_EQ(e.live_events(), 4u);
+  EXPECT_EQ(rt.live_events(), 4u);
 }
 
 TEST(EngineOrder, AllocAndMakeAfterNestedCallsStayOutsideThem) {
   // Failing with the bug above (the allocations land inside the memo entry / the read).
   Counted::reset();
   {
-    Engine e;
+    Engine rt;
     Mod<int> a, b;
     Mod<Counted*> keyed, plain;
     int calls = 0;
-    e.set(a, 1);
-    e.set(b, 1);
-    e.run([&](Engine& en) {
-      en.read(a, body([pb = &b, pk = &keyed, pp = &plain, pc = &calls](Engine& x, int va) {
-        x.memo(sac::fn<bump>(pc, 1));
-        x.write(*pk, x.alloc<Counted>(9, va));
-        x.read(*pb, body([](Engine&, int) {}));
-        x.write(*pp, x.make<Counted>(va));
+    rt.set(a, 1);
+    rt.set(b, 1);
+    rt.run([&](Engine& rt2) {
+      rt2.read(a, body([pb = &b, pk = &keyed, pp = &plain, pc = &calls](Engine& rt3, int va) {
+        rt3.memo(sac::fn<bump>(pc, 1));
+        rt3.write(*pk, rt3.alloc<Counted>(9, va));
+        rt3.read(*pb, body([](Engine&, int) {}));
+        rt3.write(*pp, rt3.make<Counted>(va));
       }));
     });
-    expect_healthy(e);
-    const Figures scratch = figures(e);
+    expect_healthy(rt);
+    const Figures scratch = figures(rt);
     EXPECT_EQ(scratch.live_events, 7u);  // read, memo, alloc, write, read, make, write
     Counted* const k0 = keyed.get();
     for (int v = 2; v < 5; ++v) {
-      e.set(a, v);
-      e.propagate();
-      expect_healthy(e);
+      rt.set(a, v);
+      rt.propagate();
+      expect_healthy(rt);
       EXPECT_EQ(keyed.get(), k0) << "the keyed object after the memo call is reused";
       EXPECT_EQ(plain.get()->v, v);
       EXPECT_EQ(calls, 1);
-      EXPECT_EQ(figures(e), scratch) << "the trace must not grow with updates";
-      e.set(b, v);  // re-runs the nested read alone: must not undo the make after it
-      e.propagate();
-      expect_healthy(e);
+      EXPECT_EQ(figures(rt), scratch) << "the trace must not grow with updates";
+      rt.set(b, v);  // re-runs the nested read alone: must not undo the make after it
+      rt.propagate();
+      expect_healthy(rt);
       ASSERT_TRUE(plain.written());
       EXPECT_EQ(plain.get()->v, v);
-      EXPECT_EQ(figures(e), scratch);
+      EXPECT_EQ(figures(rt), scratch);
     }
   }
   EXPECT_EQ(Counted::dtor, Counted::ctor);
@@ -1571,22 +1570,22 @@ TEST(EngineOrder, AllocAndMakeAfterNestedCallsStayOutsideThem) {
 // ================================================================ regressions
 
 TEST(EngineClosures, PlainLambdaReadBodies) {
-  // Regression: read() once failed to compile for lambdas (no operator==). The documented
-  // pattern, verbatim: a lambda capturing by value as a read body.
-  Engine e;
+  // read() accepts lambdas (no operator==): the documented pattern, verbatim, a lambda
+  // capturing by value as a read body.
+  Engine rt;
   Mod<int> in, out;
-  e.set(in, 1);
-  e.run([&](Engine& en) {
-    en.read(in, [po = &out, s = std::string(40, 'x')](Engine& x, int v) {
-      x.write(*po, v + static_cast<int>(s.size()));
+  rt.set(in, 1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, [po = &out, s = std::string(40, 'x')](Engine& rt3, int v) {
+      rt3.write(*po, v + static_cast<int>(s.size()));
     });
-    en.read(in, [](int) {});
+    rt2.read(in, [](int) {});
   });
   EXPECT_EQ(out.get(), 41);
-  e.set(in, 2);
-  e.propagate();
+  rt.set(in, 2);
+  rt.propagate();
   EXPECT_EQ(out.get(), 42);
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
 
@@ -1610,15 +1609,15 @@ struct CapturingBody {
   LiveCount lc;
   Mod<long>* out;
   Mod<int>* inner;
-  void operator()(Engine& e, const int& v) const {
+  void operator()(Engine& rt, const int& v) const {
     long s = 0;
     for (int d : data) s += d;
-    e.write(*out, static_cast<long>(label.size()) + s + v);
+    rt.write(*out, static_cast<long>(label.size()) + s + v);
     // A nested read created (and later undone) on every re-execution, with its own copies.
-    e.read(*inner, body([label2 = label + "/inner", data2 = data, o = out, lc2 = lc](Engine& x, int w) {
+    rt.read(*inner, body([label2 = label + "/inner", data2 = data, o = out, lc2 = lc](Engine& rt2, int w) {
       (void)lc2;
       if (label2.compare(0, 5, "body-") != 0 || data2.size() != 40) throw std::logic_error("corrupt");
-      if (w < 0) x.write(*o, -1L);
+      if (w < 0) rt2.write(*o, -1L);
     }));
   }
 };
@@ -1628,45 +1627,45 @@ TEST(EngineClosures, CapturedStringsAndVectorsSurviveManyReexecutions) {
   const int k = 8;
   LiveCount::live = 0;
   {
-    Engine e;
+    Engine rt;
     std::vector<Mod<int>> ins(k);
     Mod<int> inner;
     std::vector<Mod<long>> outs(k);
     std::vector<Mod<std::string>> souts(k);
-    e.set(inner, 0);
-    for (int i = 0; i < k; ++i) e.set(ins[static_cast<std::size_t>(i)], 0);
-    e.run([&](Engine& en) {
+    rt.set(inner, 0);
+    for (int i = 0; i < k; ++i) rt.set(ins[static_cast<std::size_t>(i)], 0);
+    rt.run([&](Engine& rt2) {
       for (int i = 0; i < k; ++i) {
         std::string label = "body-" + std::string(40, static_cast<char>('a' + i));
         std::vector<int> data(40, i);
-        en.read(ins[static_cast<std::size_t>(i)],
+        rt2.read(ins[static_cast<std::size_t>(i)],
                 body(CapturingBody{label, data, LiveCount{}, &outs[static_cast<std::size_t>(i)], &inner}));
         // A lambda capturing a string and a vector by value (moved-from locals afterwards).
-        en.read(ins[static_cast<std::size_t>(i)],
+        rt2.read(ins[static_cast<std::size_t>(i)],
                 body([s = std::move(label), d = std::move(data), po = &souts[static_cast<std::size_t>(i)]](
-                    Engine& x, const int& v) {
-                  x.write(*po, s + ":" + std::to_string(d.size() + static_cast<std::size_t>(v)));
+                    Engine& rt3, const int& v) {
+                  rt3.write(*po, s + ":" + std::to_string(d.size() + static_cast<std::size_t>(v)));
                 }));
       }
     });
-    expect_healthy(e);
+    expect_healthy(rt);
     const long live_after_run = LiveCount::live;
     EXPECT_EQ(live_after_run, 2 * k) << "one closure per outer read and one per inner read";
     std::mt19937_64 rng(9);
     for (int r = 0; r < reps; ++r) {
       const int i = static_cast<int>(rng() % k);
       const int v = static_cast<int>(rng() % 1000);
-      e.set(ins[static_cast<std::size_t>(i)], v);
-      if (r % 7 == 0) e.set(inner, static_cast<int>(rng() % 3));
-      e.propagate();
+      rt.set(ins[static_cast<std::size_t>(i)], v);
+      if (r % 7 == 0) rt.set(inner, static_cast<int>(rng() % 3));
+      rt.propagate();
       const long expect_out = 45 + 40L * i + v;
       EXPECT_EQ(outs[static_cast<std::size_t>(i)].get(), expect_out);
       EXPECT_EQ(souts[static_cast<std::size_t>(i)].get(),
                 "body-" + std::string(40, static_cast<char>('a' + i)) + ":" + std::to_string(40 + v));
       EXPECT_EQ(LiveCount::live, live_after_run) << "closures leaked or destroyed twice";
-      if (r % 100 == 0) expect_healthy(e);
+      if (r % 100 == 0) expect_healthy(rt);
     }
-    expect_healthy(e);
+    expect_healthy(rt);
   }
   EXPECT_EQ(LiveCount::live, 0) << "the engine destroys every stored closure";
 }
@@ -1674,57 +1673,57 @@ TEST(EngineClosures, CapturedStringsAndVectorsSurviveManyReexecutions) {
 // ================================================================ debugging aids
 
 TEST(EngineDebug, DumpDotOfASmallTrace) {
-  Engine e;
+  Engine rt;
   Mod<int> in, out;
   int calls = 0;
-  e.set(in, 1);
-  e.run([&](Engine& en) {
-    en.read(in, body([po = &out, pc = &calls](Engine& x, int v) {
-      x.write(*po, v);
-      x.memo(sac::fn<bump>(pc, 1));
-      x.alloc<int>(5, 5);
+  rt.set(in, 1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, body([po = &out, pc = &calls](Engine& rt3, int v) {
+      rt3.write(*po, v);
+      rt3.memo(sac::fn<bump>(pc, 1));
+      rt3.alloc<int>(5, 5);
     }));
   });
   std::ostringstream os;
-  e.dump_dot(os);
+  rt.dump_dot(os);
   const std::string dot = os.str();
   EXPECT_EQ(dot.rfind("digraph", 0), 0u) << dot;
   EXPECT_NE(dot.find("read"), std::string::npos) << dot;
   EXPECT_NE(dot.find("write"), std::string::npos) << dot;
   EXPECT_NE(dot.find('}'), std::string::npos);
-  e.set(in, 2);
-  e.propagate();
+  rt.set(in, 2);
+  rt.propagate();
   std::ostringstream os2;
-  e.dump_dot(os2);
-  // Regression: an alloc issued after the memo call once landed inside the memo entry and
-  // was duplicated by each update.
+  rt.dump_dot(os2);
+  // An alloc issued after the memo call lands outside the memo entry, so an update does not
+  // duplicate it.
   EXPECT_EQ(os2.str(), dot) << "same trace shape after an update";
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
 TEST(EngineDebug, CheckInvariantsAfterMultipleRuns) {
   // Several run() calls append their traces; propagation works across them.
-  Engine e;
+  Engine rt;
   Mod<int> a, b, x, y;
-  e.set(a, 1);
-  e.set(b, 2);
-  e.run([&](Engine& en) { en.read(a, body([px = &x](Engine& t, int v) { t.write(*px, v + 1); })); });
-  expect_healthy(e);
-  e.run([&](Engine& en) {
-    en.read(x, body([py = &y, pb = &b](Engine& t, int v) {
-      t.read(*pb, body([py, v](Engine& u, int w) { u.write(*py, v * w); }));
+  rt.set(a, 1);
+  rt.set(b, 2);
+  rt.run([&](Engine& rt2) { rt2.read(a, body([px = &x](Engine& rt3, int v) { rt3.write(*px, v + 1); })); });
+  expect_healthy(rt);
+  rt.run([&](Engine& rt2) {
+    rt2.read(x, body([py = &y, pb = &b](Engine& rt3, int v) {
+      rt3.read(*pb, body([py, v](Engine& rt4, int w) { rt4.write(*py, v * w); }));
     }));
   });
-  expect_healthy(e);
+  expect_healthy(rt);
   EXPECT_EQ(y.get(), 4);
-  e.set(a, 4);
-  e.propagate();
-  expect_healthy(e);
+  rt.set(a, 4);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(y.get(), 10);
-  e.set(b, 3);
-  e.propagate();
+  rt.set(b, 3);
+  rt.propagate();
   EXPECT_EQ(y.get(), 15);
-  expect_healthy(e);
+  expect_healthy(rt);
 }
 
 // ================================================================ the checker sees corruption
@@ -1734,8 +1733,8 @@ TEST(EngineDebug, CheckInvariantsAfterMultipleRuns) {
 // and repairs the trace before the engine is destroyed.
 
 using sac::EngineTestAccess;
-using sac::Stamp;
-using sac::StampKind;
+using sac::detail::Stamp;
+using sac::detail::StampKind;
 using sac::detail::AllocNode;
 using sac::detail::MemoNode;
 using sac::detail::ReadNode;
@@ -1746,18 +1745,18 @@ using sac::detail::VersionBase;
 struct SmallTrace {
   Mod<int> in, acc, out;
   int calls = 0;
-  Engine e;  // declared last, destroyed first: its records refer to the modifiables above
+  Engine rt;  // declared last, destroyed first: its records refer to the modifiables above
 
   SmallTrace() {
-    e.set(in, 1);
-    e.run([this](Engine& en) {
-      en.read(in, [this](Engine& x, int v) {
-        x.write(acc, v);
-        x.write(acc, v + 1);
-        x.write(acc, v + 2);
-        x.alloc<int>(7, v);
-        x.memo(sac::fn<bump>(&calls, 1));
-        x.read(acc, [this](Engine& y, int w) { y.write(out, w); });
+    rt.set(in, 1);
+    rt.run([this](Engine& rt2) {
+      rt2.read(in, [this](Engine& rt3, int v) {
+        rt3.write(acc, v);
+        rt3.write(acc, v + 1);
+        rt3.write(acc, v + 2);
+        rt3.alloc<int>(7, v);
+        rt3.memo(sac::fn<bump>(&calls, 1));
+        rt3.read(acc, [this](Engine& rt4, int w) { rt4.write(out, w); });
       });
     });
   }
@@ -1765,13 +1764,13 @@ struct SmallTrace {
   /// The stamps of kind k, in trace order.
   std::vector<Stamp*> stamps(StampKind k) {
     std::vector<Stamp*> out_stamps;
-    for (Stamp* s = EngineTestAccess::order(e).base()->next(); s; s = s->next())
+    for (Stamp* s = EngineTestAccess::order(rt).base()->next(); s; s = s->next())
       if (s->kind() == k) out_stamps.push_back(s);
     return out_stamps;
   }
   /// The stamp right before s.
   Stamp* before(const Stamp* s) {
-    Stamp* p = EngineTestAccess::order(e).base();
+    Stamp* p = EngineTestAccess::order(rt).base();
     while (p->next() != s) p = p->next();
     return p;
   }
@@ -1787,15 +1786,15 @@ struct SmallTrace {
   /// Moves s (linked) to right after pos.
   void move_stamp(Stamp* s, Stamp* pos) {
     const StampKind k = s->kind();
-    EngineTestAccess::order(e).erase(s);
-    EngineTestAccess::order(e).insert_after(pos, s, k);
+    EngineTestAccess::order(rt).erase(s);
+    EngineTestAccess::order(rt).insert_after(pos, s, k);
   }
 };
 
 /// The message of the sac::InvariantError that e.check_invariants() throws, or "" if none.
-std::string invariant_message(const Engine& e) {
+std::string invariant_message(const Engine& rt) {
   try {
-    e.check_invariants();
+    rt.check_invariants();
   } catch (const sac::InvariantError& err) {
     return err.what();
   }
@@ -1806,42 +1805,42 @@ using testing::HasSubstr;
 
 TEST(EngineChecker, ReadDetachedFromItsVersion) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   ReadNode* r = t.inner_read();
   VersionBase* v = t.acc_versions().at(2);
   ASSERT_EQ(v->readers, &r->link);
   EngineTestAccess::detach(r);
-  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("not attached"));
+  EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("not attached"));
   EngineTestAccess::attach(r, v);
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, ReaderListWithABrokenBackLink) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   ReadNode* r = t.inner_read();
   sac::detail::ReaderLink** saved = r->link.rpprev;
   r->link.rpprev = &r->link.rnext;
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("broken back link"));
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("broken back link"));
   r->link.rpprev = saved;
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 /// Two reads of a default that has no version: they hang on the modifiable.
 struct DefaultReads {
   Mod<int> d, out1, out2;
-  Engine e;
+  Engine rt;
   DefaultReads() {
-    e.init_default(d);
-    e.run([this](Engine& en) {
-      en.read(d, [this](Engine& x, int v) { x.write(out1, v); });
-      en.read(d, [this](Engine& x, int v) { x.write(out2, v); });
+    rt.init_default(d);
+    rt.run([this](Engine& rt2) {
+      rt2.read(d, [this](Engine& rt3, int v) { rt3.write(out1, v); });
+      rt2.read(d, [this](Engine& rt3, int v) { rt3.write(out2, v); });
     });
   }
   ReadNode* read(int i) {
     int k = 0;
-    for (Stamp* s = EngineTestAccess::order(e).base()->next(); s; s = s->next())
+    for (Stamp* s = EngineTestAccess::order(rt).base()->next(); s; s = s->next())
       if (s->kind() == StampKind::ReadStart && k++ == i) return sac::detail::read_of_start(s);
     return nullptr;
   }
@@ -1849,47 +1848,47 @@ struct DefaultReads {
 
 TEST(EngineChecker, DefaultReaderDetachedOrWithABrokenBackLink) {
   DefaultReads t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   ReadNode* first = t.read(1);  // the later read was attached last: it heads the list
   ReadNode* second = t.read(0);
   ASSERT_EQ(first->link.rnext, &second->link);
   sac::detail::ReaderLink** saved = second->link.rpprev;
   second->link.rpprev = &second->link.rnext;
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("default reader list has a broken back link"));
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("default reader list has a broken back link"));
   second->link.rpprev = saved;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   EngineTestAccess::detach(second);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("not attached"));
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("not attached"));
   EngineTestAccess::attach_default(second, t.d);
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, ReadAttachedToAnOlderVersion) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   ReadNode* r = t.inner_read();
   const std::vector<VersionBase*> v = t.acc_versions();
   EngineTestAccess::detach(r);
   EngineTestAccess::attach(r, v.at(1));  // the read comes after v[2], so it must see v[2]
-  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("reader after the next version"));
+  EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("reader after the next version"));
   EngineTestAccess::detach(r);
   EngineTestAccess::attach(r, v.at(2));
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, ReadersOutOfOrderOrOnTheWrongList) {
   // Two reads of one input: its ordered readers are the second, then the first.
   Mod<int> in, out1, out2;
-  Engine e;
-  e.set(in, 1);
-  e.run([&](Engine& en) {
-    en.read(in, [&out1](Engine& x, int v) { x.write(out1, v); });
-    en.read(in, [&out2](Engine& x, int v) { x.write(out2, v); });
+  Engine rt;
+  rt.set(in, 1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(in, [&out1](Engine& rt3, int v) { rt3.write(out1, v); });
+    rt2.read(in, [&out2](Engine& rt3, int v) { rt3.write(out2, v); });
   });
-  ASSERT_NO_THROW(e.check_invariants());
+  ASSERT_NO_THROW(rt.check_invariants());
   ReadNode* first = nullptr;
-  for (Stamp* s = EngineTestAccess::order(e).base()->next(); s && !first; s = s->next())
+  for (Stamp* s = EngineTestAccess::order(rt).base()->next(); s && !first; s = s->next())
     if (s->kind() == StampKind::ReadStart) first = sac::detail::read_of_start(s);
   ASSERT_NE(first, nullptr);
   // The list is the second read, then the first: the first's back link is the second's
@@ -1899,21 +1898,21 @@ TEST(EngineChecker, ReadersOutOfOrderOrOnTheWrongList) {
   auto* v = reinterpret_cast<VersionBase*>(reinterpret_cast<char*>(second->link.rpprev) - offsetof(VersionBase, readers));
   EngineTestAccess::detach(first);
   EngineTestAccess::attach(first, v);  // ahead of the newer read
-  EXPECT_THAT(invariant_message(e), HasSubstr("ordered readers are not newest first"));
+  EXPECT_THAT(invariant_message(rt), HasSubstr("ordered readers are not newest first"));
   EngineTestAccess::detach(first);
   EngineTestAccess::detach(second);
   EngineTestAccess::attach(first, v);
   EngineTestAccess::attach(second, v);
-  EXPECT_NO_THROW(e.check_invariants());
+  EXPECT_NO_THROW(rt.check_invariants());
   second->link.unordered = 1;
-  EXPECT_THAT(invariant_message(e), HasSubstr("on the other list than its flag says"));
+  EXPECT_THAT(invariant_message(rt), HasSubstr("on the other list than its flag says"));
   second->link.unordered = 0;
-  EXPECT_NO_THROW(e.check_invariants());
+  EXPECT_NO_THROW(rt.check_invariants());
 }
 
 TEST(EngineChecker, VersionsOutOfOrder) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   const std::vector<VersionBase*> v = t.acc_versions();
   ASSERT_EQ(v.size(), 3u);
   ASSERT_EQ(v[2]->older(), v[1]);
@@ -1922,17 +1921,17 @@ TEST(EngineChecker, VersionsOutOfOrder) {
   v[2]->set_older(v[0]);
   v[0]->set_older(v[1]);
   v[1]->link = end;
-  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("versions out of order"));
+  EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("versions out of order"));
   v[2]->set_older(v[1]);
   v[1]->set_older(v[0]);
   v[0]->link = end;
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, ReadIntervalsNotWellNested) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   // The nested read's end moves after its parent's end.
   const std::vector<Stamp*> ends = t.stamps(StampKind::ReadEnd);
   ASSERT_EQ(ends.size(), 2u);
@@ -1940,87 +1939,87 @@ TEST(EngineChecker, ReadIntervalsNotWellNested) {
   ASSERT_EQ(ends[0], inner_end);
   Stamp* pred = t.before(inner_end);
   t.move_stamp(inner_end, ends[1]);
-  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("not well nested"));
+  EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("not well nested"));
   t.move_stamp(inner_end, pred);
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, LiveEventCountMismatch) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
-  ++EngineTestAccess::stats(t.e).live_events;
-  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("live event count mismatch"));
-  --EngineTestAccess::stats(t.e).live_events;
-  EXPECT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
+  ++EngineTestAccess::stats(t.rt).live_events;
+  EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("live event count mismatch"));
+  --EngineTestAccess::stats(t.rt).live_events;
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, AllocationMissingFromItsTable) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   AllocNode* n = sac::detail::alloc_of(t.stamps(StampKind::Alloc).at(0));
   const std::size_t h = n->ops->hash(n);
-  EngineTestAccess::allocs(t.e).erase(n, h);
-  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("allocation table size mismatch"));
-  EngineTestAccess::allocs(t.e).insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EngineTestAccess::allocs(t.rt).erase(n, h);
+  EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("allocation table size mismatch"));
+  EngineTestAccess::allocs(t.rt).insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, MemoEntryMissingFromItsTable) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   MemoNode* n = sac::detail::memo_of_start(t.stamps(StampKind::MemoStart).at(0));
   const std::size_t h = n->ops->hash(n);
-  EngineTestAccess::memos(t.e).erase(n, h);
-  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("memo table size mismatch"));
-  EngineTestAccess::memos(t.e).insert(n, h, [](const MemoNode* x) { return x->ops->hash(x); });
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EngineTestAccess::memos(t.rt).erase(n, h);
+  EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("memo table size mismatch"));
+  EngineTestAccess::memos(t.rt).insert(n, h, [](const MemoNode* x) { return x->ops->hash(x); });
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, UndoneAllocationLeftInItsTable) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   // An undo that forgot the table: the record leaves the trace (and the live count) but
   // stays in the allocation table.
   Stamp* s = t.stamps(StampKind::Alloc).at(0);
   Stamp* pred = t.before(s);
-  EngineTestAccess::order(t.e).erase(s);
-  --EngineTestAccess::stats(t.e).live_events;
-  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("allocation table"));
-  EngineTestAccess::order(t.e).insert_after(pred, s, StampKind::Alloc);
-  ++EngineTestAccess::stats(t.e).live_events;
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EngineTestAccess::order(t.rt).erase(s);
+  --EngineTestAccess::stats(t.rt).live_events;
+  EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("allocation table"));
+  EngineTestAccess::order(t.rt).insert_after(pred, s, StampKind::Alloc);
+  ++EngineTestAccess::stats(t.rt).live_events;
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, ReadLeftInTheQueue) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
+  ASSERT_NO_THROW(t.rt.check_invariants());
   ReadNode* r = t.inner_read();
-  EngineTestAccess::queue(t.e).push(r);
-  EXPECT_THROW(t.e.check_invariants(), sac::InvariantError);
-  EXPECT_THAT(invariant_message(t.e), HasSubstr("queue not empty"));
-  EngineTestAccess::queue(t.e).remove(r);
-  EXPECT_NO_THROW(t.e.check_invariants());
+  EngineTestAccess::queue(t.rt).push(r);
+  EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
+  EXPECT_THAT(invariant_message(t.rt), HasSubstr("queue not empty"));
+  EngineTestAccess::queue(t.rt).remove(r);
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 TEST(EngineChecker, PropagateRunsTheCheckerUnderSacDebugChecks) {
   SmallTrace t;
-  ASSERT_NO_THROW(t.e.check_invariants());
-  ++EngineTestAccess::stats(t.e).live_events;  // survives the update: propagate adjusts it
-  t.e.set(t.in, 2);
+  ASSERT_NO_THROW(t.rt.check_invariants());
+  ++EngineTestAccess::stats(t.rt).live_events;  // survives the update: propagate adjusts it
+  t.rt.set(t.in, 2);
   if (test_support::kDebugChecks) {
-    EXPECT_THROW(t.e.propagate(), sac::InvariantError);
+    EXPECT_THROW(t.rt.propagate(), sac::InvariantError);
   } else {
-    EXPECT_NO_THROW(t.e.propagate());
+    EXPECT_NO_THROW(t.rt.propagate());
   }
-  EXPECT_FALSE(t.e.poisoned()) << "a failed check reports, it does not poison";
+  EXPECT_FALSE(t.rt.poisoned()) << "a failed check reports, it does not poison";
   EXPECT_EQ(t.out.get(), 4);
-  --EngineTestAccess::stats(t.e).live_events;
-  EXPECT_NO_THROW(t.e.check_invariants());
+  --EngineTestAccess::stats(t.rt).live_events;
+  EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
 // ================================================================ random differential
@@ -2032,24 +2031,24 @@ void differential(std::uint64_t seed, int n, int steps) {
   std::vector<long> values = random_values(rng, n);
   std::vector<bool> present(static_cast<std::size_t>(n));
   for (std::size_t i = 0; i < present.size(); ++i) present[i] = rng() % 5 != 0;
-  Engine e;
-  Input in(e, values, present);
+  Engine rt;
+  Input in(rt, values, present);
   Program p;
-  p.start(e, in);
-  expect_healthy(e);
+  p.start(rt, in);
+  expect_healthy(rt);
   std::vector<long> first;
   ASSERT_NO_THROW(first = p.result());
   ASSERT_EQ(first, Program::expected(in.sequence()));
-  ASSERT_EQ(figures(e), fresh_figures<Program>(values, in.presence()));
+  ASSERT_EQ(figures(rt), fresh_figures<Program>(values, in.presence()));
   for (int step = 0; step < steps; ++step) {
     SCOPED_TRACE("step " + std::to_string(step));
     const int r = static_cast<int>(rng() % 10);
     const int k = r < 6 ? 1 : r < 9 ? 2 + static_cast<int>(rng() % 4) : 0;  // 0: empty batch
     for (int j = 0; j < k; ++j) in.toggle(rng() % static_cast<std::size_t>(n));
-    e.propagate();
-    ASSERT_NO_THROW(e.check_invariants()) << e.stats();
-    ASSERT_FALSE(e.poisoned());
-    const Stats& s = e.stats();
+    rt.propagate();
+    ASSERT_NO_THROW(rt.check_invariants()) << rt.stats();
+    ASSERT_FALSE(rt.poisoned());
+    const Stats& s = rt.stats();
     ASSERT_EQ(s.live_events, s.events_created - s.events_undone);
     if (k == 0) {
       ASSERT_EQ(s.last_reexecuted, 0u);
@@ -2060,7 +2059,7 @@ void differential(std::uint64_t seed, int n, int steps) {
     ASSERT_NO_THROW(got = p.result()) << "an output modifiable lost its value";
     ASSERT_EQ(got, Program::expected(in.sequence()));
     ASSERT_EQ(got, scratch_result);
-    ASSERT_EQ(figures(e), scratch) << "live trace differs from a from-scratch run";
+    ASSERT_EQ(figures(rt), scratch) << "live trace differs from a from-scratch run";
   }
 }
 
@@ -2073,38 +2072,38 @@ TEST(EngineReaderOrder, AReexecutedWriteTestsTheReadersAfterItNotAllOfThem) {
   constexpr int kBefore = 2000, kAfter = 5;
   Mod<int> sel, m;
   auto outs = std::make_unique<Mod<int>[]>(kBefore + kAfter);
-  Engine e;
+  Engine rt;
   int vsel = 0, vm = 1;
-  e.set(sel, vsel);
-  e.set(m, vm);
-  e.run([&](Engine& en) {
-    for (int i = 0; i < kBefore; ++i) en.read(m, [o = &outs[i]](Engine& x, int v) { x.write(*o, v); });
-    en.read(sel, [&m](Engine& x, int s) {
-      if (s % 2 == 1) x.write(m, 100 + s);
+  rt.set(sel, vsel);
+  rt.set(m, vm);
+  rt.run([&](Engine& rt2) {
+    for (int i = 0; i < kBefore; ++i) rt2.read(m, [o = &outs[i]](Engine& rt3, int v) { rt3.write(*o, v); });
+    rt2.read(sel, [&m](Engine& rt3, int s) {
+      if (s % 2 == 1) rt3.write(m, 100 + s);
     });
-    for (int i = kBefore; i < kBefore + kAfter; ++i) en.read(m, [o = &outs[i]](Engine& x, int v) { x.write(*o, v); });
+    for (int i = kBefore; i < kBefore + kAfter; ++i) rt2.read(m, [o = &outs[i]](Engine& rt3, int v) { rt3.write(*o, v); });
   });
   std::mt19937 rng(20261129);
   std::printf("seed 20261129\n");
   int writes_added = 0;
   for (int t = 0; t < 60; ++t) {
-    const std::uint64_t tested0 = e.stats().readers_tested;
+    const std::uint64_t tested0 = rt.stats().readers_tested;
     const bool was_odd = vsel % 2 == 1;
     if (rng() % 3 == 0) {
-      e.set(m, vm = static_cast<int>(rng() % 50));
+      rt.set(m, vm = static_cast<int>(rng() % 50));
     } else {
-      e.set(sel, vsel = static_cast<int>(rng() % 9));
+      rt.set(sel, vsel = static_cast<int>(rng() % 9));
     }
-    e.propagate();
+    rt.propagate();
     const bool adds_write = !was_odd && vsel % 2 == 1;
     if (adds_write) {
       ++writes_added;
-      EXPECT_LE(e.stats().readers_tested - tested0, std::uint64_t{kAfter + 1}) << "change " << t;
+      EXPECT_LE(rt.stats().readers_tested - tested0, std::uint64_t{kAfter + 1}) << "change " << t;
     }
     for (int i = 0; i < kBefore; ++i) ASSERT_EQ(outs[i].get(), vm) << "change " << t;
     for (int i = kBefore; i < kBefore + kAfter; ++i)
       ASSERT_EQ(outs[i].get(), vsel % 2 == 1 ? 100 + vsel : vm) << "change " << t;
-    e.check_invariants();
+    rt.check_invariants();
   }
   EXPECT_GT(writes_added, 5);
 }
@@ -2117,17 +2116,17 @@ TEST(EngineReaderOrder, AnUndoneVersionsReadersMoveOntoTheWriteThatReplacesIt) {
   constexpr int kAfter = 50;
   Mod<int> sel, m, tag;
   auto outs = std::make_unique<Mod<int>[]>(kAfter);
-  Engine e;
+  Engine rt;
   int vsel = 0, reruns = 0;
-  e.set(sel, vsel);
-  e.set(m, -1);
-  e.run([&](Engine& en) {
-    en.read(m, [&tag](Engine& x, int v) { x.write(tag, v); });  // a reader of the older version
-    en.read(sel, [&m](Engine& x, int s) { x.write(m, s / 3); });
+  rt.set(sel, vsel);
+  rt.set(m, -1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(m, [&tag](Engine& rt3, int v) { rt3.write(tag, v); });  // a reader of the older version
+    rt2.read(sel, [&m](Engine& rt3, int s) { rt3.write(m, s / 3); });
     for (int i = 0; i < kAfter; ++i)
-      en.read(m, [o = &outs[i], &reruns](Engine& x, int v) {
+      rt2.read(m, [o = &outs[i], &reruns](Engine& rt3, int v) {
         ++reruns;
-        x.write(*o, v + 1);
+        rt3.write(*o, v + 1);
       });
   });
   std::mt19937 rng(20261130);
@@ -2135,9 +2134,9 @@ TEST(EngineReaderOrder, AnUndoneVersionsReadersMoveOntoTheWriteThatReplacesIt) {
   int same_value = 0, new_value = 0;
   for (int t = 0; t < 80; ++t) {
     const int before = vsel / 3;
-    e.set(sel, vsel = static_cast<int>(rng() % 12));
+    rt.set(sel, vsel = static_cast<int>(rng() % 12));
     reruns = 0;
-    e.propagate();
+    rt.propagate();
     if (vsel / 3 == before) {
       ++same_value;
       EXPECT_EQ(reruns, 0) << "change " << t;
@@ -2147,7 +2146,7 @@ TEST(EngineReaderOrder, AnUndoneVersionsReadersMoveOntoTheWriteThatReplacesIt) {
     }
     for (int i = 0; i < kAfter; ++i) ASSERT_EQ(outs[i].get(), vsel / 3 + 1) << "change " << t;
     ASSERT_EQ(tag.get(), -1) << "change " << t;
-    e.check_invariants();
+    rt.check_invariants();
   }
   EXPECT_GT(same_value, 5);
   EXPECT_GT(new_value, 5);
@@ -2158,25 +2157,25 @@ TEST(EngineReaderOrder, AnUndoneVersionsUnorderedReadersMoveWithoutARelinkOfTheO
   // change of pick[i] re-executes that inner read of m, which hangs on m's version among
   // its unordered readers. A change of sel then re-executes the write: the old version is
   // undone onto the new one, which has no readers yet, and both of its lists move over
-  // whole. Merging them into order relinked all 2,000 (a cell read by the steps of every
-  // class: bench/RESULTS.md, "Clusters far below the box's scale"). Outputs, re-runs and
+  // whole, rather than being merged into order, which would relink all 2,000 (a cell read by
+  // the steps of every class: docs/DESIGN.md, "Change propagation"). Outputs, re-runs and
   // the checker are tested after every change (seed printed).
   constexpr int kReaders = 2000;
   Mod<int> sel, m;
   auto pick = std::make_unique<Mod<int>[]>(kReaders);
   auto outs = std::make_unique<Mod<int>[]>(kReaders);
   std::vector<int> vpick(kReaders, 0);
-  Engine e;
+  Engine rt;
   int vsel = 0, reruns = 0;
-  e.set(sel, vsel);
-  for (int i = 0; i < kReaders; ++i) e.set(pick[i], 0);
-  e.run([&](Engine& en) {
-    en.read(sel, [&m](Engine& x, int s) { x.write(m, s / 3); });
+  rt.set(sel, vsel);
+  for (int i = 0; i < kReaders; ++i) rt.set(pick[i], 0);
+  rt.run([&](Engine& rt2) {
+    rt2.read(sel, [&m](Engine& rt3, int s) { rt3.write(m, s / 3); });
     for (int i = 0; i < kReaders; ++i)
-      en.read(pick[i], [&m, &reruns, o = &outs[i]](Engine& x, int p) {
-        x.read(m, [&reruns, o, p](Engine& y, int v) {
+      rt2.read(pick[i], [&m, &reruns, o = &outs[i]](Engine& rt3, int p) {
+        rt3.read(m, [&reruns, o, p](Engine& rt4, int v) {
           ++reruns;
-          y.write(*o, 10 * v + p);
+          rt4.write(*o, 10 * v + p);
         });
       });
   });
@@ -2187,15 +2186,15 @@ TEST(EngineReaderOrder, AnUndoneVersionsUnorderedReadersMoveWithoutARelinkOfTheO
     // Re-execute a few of the inner reads: they hang on m's version unordered.
     for (int k = 0; k < 5; ++k) {
       const int i = static_cast<int>(rng() % kReaders);
-      e.set(pick[i], ++vpick[i] % 7);
+      rt.set(pick[i], ++vpick[i] % 7);
     }
-    e.propagate();
-    e.check_invariants();
+    rt.propagate();
+    rt.check_invariants();
     const int before = vsel;
-    e.set(sel, vsel = static_cast<int>(rng() % 12));
-    const std::uint64_t relinked0 = e.stats().readers_relinked;
+    rt.set(sel, vsel = static_cast<int>(rng() % 12));
+    const std::uint64_t relinked0 = rt.stats().readers_relinked;
     reruns = 0;
-    e.propagate();
+    rt.propagate();
     const bool rewritten = vsel != before;  // the read of sel re-ran and wrote m again
     if (vsel / 3 == before / 3) {
       EXPECT_EQ(reruns, 0) << "change " << t;
@@ -2204,10 +2203,10 @@ TEST(EngineReaderOrder, AnUndoneVersionsUnorderedReadersMoveWithoutARelinkOfTheO
     }
     if (rewritten) {
       ++whole_moves;
-      EXPECT_LE(e.stats().readers_relinked - relinked0, std::uint64_t{5}) << "change " << t;
+      EXPECT_LE(rt.stats().readers_relinked - relinked0, std::uint64_t{5}) << "change " << t;
     }
     for (int i = 0; i < kReaders; ++i) ASSERT_EQ(outs[i].get(), 10 * (vsel / 3) + vpick[i] % 7) << "change " << t;
-    e.check_invariants();
+    rt.check_invariants();
   }
   EXPECT_GT(whole_moves, 10);
 }
@@ -2221,7 +2220,7 @@ TEST(EngineDifferential, PrefixSumsWithMemoRead) {
     differential<PsumProgram>(seed, 100 / kScale, 200 / kScale);
 }
 
-// Writes after reads in the same body (regression for the close-chaining bug above).
+// Writes after reads in the same body (the close chaining of WriteAfterANestedReadStaysOutsideIt).
 TEST(EngineDifferential, PrefixSumsWithWritesAfterReads) {
   for (std::uint64_t seed : {15u, 16u, 17u})
     differential<PsumLateProgram>(seed, 100 / kScale, 200 / kScale);
@@ -2246,14 +2245,14 @@ namespace {
 
 TEST(EngineChecker, MultiReadSlotDetachedOrOnAnotherModifiable) {
   Mod<int> a, b, out;
-  Engine e;
-  e.set(a, 1);
-  e.set(b, 2);
-  e.run([&](Engine& en) {
-    en.read_many({&a, &b}, [&out](Engine& x, std::span<const int* const> v) { x.write(out, *v[0] + *v[1]); });
+  Engine rt;
+  rt.set(a, 1);
+  rt.set(b, 2);
+  rt.run([&](Engine& rt2) {
+    rt2.read_many({&a, &b}, [&out](Engine& rt3, std::span<const int* const> v) { rt3.write(out, *v[0] + *v[1]); });
   });
-  ASSERT_NO_THROW(e.check_invariants());
-  Stamp* s = EngineTestAccess::order(e).base()->next();
+  ASSERT_NO_THROW(rt.check_invariants());
+  Stamp* s = EngineTestAccess::order(rt).base()->next();
   ASSERT_EQ(s->kind(), StampKind::ReadStart);
   sac::detail::ReadManyHeader* h = sac::detail::many_of(sac::detail::read_of_start(s));
   ASSERT_EQ(h->k, 2u);
@@ -2267,16 +2266,16 @@ TEST(EngineChecker, MultiReadSlotDetachedOrOnAnotherModifiable) {
   ASSERT_EQ(va->readers, &h->slots()[0].link);
   ASSERT_EQ(vbv->readers, slot);
   EngineTestAccess::detach(slot);
-  EXPECT_THAT(invariant_message(e), HasSubstr("not attached"));
+  EXPECT_THAT(invariant_message(rt), HasSubstr("not attached"));
   EngineTestAccess::attach(slot, va);
-  EXPECT_THAT(invariant_message(e), HasSubstr("another modifiable"));
+  EXPECT_THAT(invariant_message(rt), HasSubstr("another modifiable"));
   EngineTestAccess::detach(slot);
   EngineTestAccess::attach(slot, vbv);
-  EXPECT_NO_THROW(e.check_invariants());
+  EXPECT_NO_THROW(rt.check_invariants());
   h->read.link.qpos = 0;
-  EXPECT_THAT(invariant_message(e), HasSubstr("still queued"));
-  h->read.link.qpos = sac::kNotQueued;
-  EXPECT_NO_THROW(e.check_invariants());
+  EXPECT_THAT(invariant_message(rt), HasSubstr("still queued"));
+  h->read.link.qpos = sac::detail::kNotQueued;
+  EXPECT_NO_THROW(rt.check_invariants());
 }
 
 }  // namespace

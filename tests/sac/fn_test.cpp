@@ -53,30 +53,30 @@ TEST(Fn, ViewParametersStoreTheOwningArgument) {
 
 // A memoized call with an int argument is reused by a re-execution that passes a long.
 int calls = 0;
-void count_step(sac::Engine& e, long k, sac::Mod<long>* out) {
+void count_step(sac::Engine& rt, long k, sac::Mod<long>* out) {
   ++calls;
-  e.write(*out, k * 2);
+  rt.write(*out, k * 2);
 }
 
 TEST(Fn, MemoMatchesAcrossArgumentTypes) {
-  sac::Engine e;
+  sac::Engine rt;
   sac::Mod<int> in;
   sac::Mod<long> out, other;
-  e.set(in, 0);
+  rt.set(in, 0);
   calls = 0;
-  e.run([&](sac::Engine& en) {
-    en.read(in, [&out, &other](sac::Engine& x, const int& v) {
+  rt.run([&](sac::Engine& rt2) {
+    rt2.read(in, [&out, &other](sac::Engine& rt3, const int& v) {
       // Before the change an int 7; after it a long 7: the same memoized call.
-      if (v == 0) x.memo(sac::fn<count_step>(7, &out));
-      else x.memo(sac::fn<count_step>(7L, &out));
-      x.write(other, static_cast<long>(v));
+      if (v == 0) rt3.memo(sac::fn<count_step>(7, &out));
+      else rt3.memo(sac::fn<count_step>(7L, &out));
+      rt3.write(other, static_cast<long>(v));
     });
   });
   EXPECT_EQ(calls, 1);
-  e.set(in, 1);
-  e.propagate();
+  rt.set(in, 1);
+  rt.propagate();
   EXPECT_EQ(calls, 1) << "the memo entry was not reused: the closures did not compare equal";
-  e.check_invariants();
+  rt.check_invariants();
 }
 
 }  // namespace

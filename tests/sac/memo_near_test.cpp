@@ -43,34 +43,34 @@ int g_work = 0;
 
 void count_call(Engine&, int* calls, int /*key*/) { ++*calls; }
 
-void work(Engine& e, Item* it, Res* r) {
+void work(Engine& rt, Item* it, Res* r) {
   ++g_work;
-  e.write(r->v, it->value * 3 + 1);
+  rt.write(r->v, it->value * 3 + 1);
 }
 
 /// The list's outputs in order; each element's work is memoized on (element, output) only,
 /// so its key does not say where the element stands. reach 0: memo(), else memo_near(reach).
 /// The link reads' keys do say it: (element, its predecessor), as a list step in dynmesh's
 /// hpu program, so a moved element's old link read far ahead is not reused either.
-void walk(Engine& e, Item* it, Mod<Res*>* dest, std::uint32_t reach, Item* pred, Item* grand) {
+void walk(Engine& rt, Item* it, Mod<Res*>* dest, std::uint32_t reach, Item* pred, Item* grand) {
   (void)grand;
-  if (!it) return e.write(*dest, nullptr);
-  Res* r = e.alloc<Res>(it->id, it->id);
-  e.write(*dest, r);
-  if (reach) e.memo_near(reach, sac::fn<&work>(it, r));
-  else e.memo(sac::fn<&work>(it, r));
-  e.memo_read(it->next, sac::fn<&walk>(&r->next, reach, it, pred));
+  if (!it) return rt.write(*dest, nullptr);
+  Res* r = rt.alloc<Res>(it->id, it->id);
+  rt.write(*dest, r);
+  if (reach) rt.memo_near(reach, sac::fn<&work>(it, r));
+  else rt.memo(sac::fn<&work>(it, r));
+  rt.memo_read(it->next, sac::fn<&walk>(&r->next, reach, it, pred));
 }
 
 /// The mutator's list: items in `order`, linked through their next modifiables.
 struct List {
-  Engine& e;
+  Engine& rt;
   std::vector<std::unique_ptr<Item>> items;
   std::vector<Item*> order;
   Mod<Item*> head;
   Mod<Res*> out;
 
-  List(Engine& en, int n) : e(en) {
+  List(Engine& rt2, int n) : rt(rt2) {
     for (int i = 0; i < n; ++i) {
       items.push_back(std::make_unique<Item>(1000 + 7 * i, static_cast<std::uint64_t>(i)));
       order.push_back(items.back().get());
@@ -79,12 +79,12 @@ struct List {
   }
   /// Sets every next (and head) to the order; unchanged links cost nothing.
   void relink() {
-    e.set(head, order.empty() ? nullptr : order.front());
-    for (std::size_t i = 0; i < order.size(); ++i) e.set(order[i]->next, i + 1 < order.size() ? order[i + 1] : nullptr);
+    rt.set(head, order.empty() ? nullptr : order.front());
+    for (std::size_t i = 0; i < order.size(); ++i) rt.set(order[i]->next, i + 1 < order.size() ? order[i + 1] : nullptr);
   }
   void start(std::uint32_t reach) {
-    e.run([this, reach](Engine& en) {
-      en.memo_read(head, sac::fn<&walk>(&out, reach, static_cast<Item*>(nullptr), static_cast<Item*>(nullptr)));
+    rt.run([this, reach](Engine& rt2) {
+      rt2.memo_read(head, sac::fn<&walk>(&out, reach, static_cast<Item*>(nullptr), static_cast<Item*>(nullptr)));
     });
   }
   std::vector<long> result() const {
@@ -99,28 +99,28 @@ struct List {
   }
 };
 
-void expect_healthy(const Engine& e) {
-  EXPECT_FALSE(e.poisoned());
-  EXPECT_NO_THROW(e.check_invariants());
-  EXPECT_EQ(e.stats().live_events, e.stats().events_created - e.stats().events_undone);
+void expect_healthy(const Engine& rt) {
+  EXPECT_FALSE(rt.poisoned());
+  EXPECT_NO_THROW(rt.check_invariants());
+  EXPECT_EQ(rt.stats().live_events, rt.stats().events_created - rt.stats().events_undone);
 }
 
 /// Moves the last element to the front; returns the work calls the propagation ran.
 int move_last_to_front(std::uint32_t reach, int n, sac::Stats* delta) {
-  Engine e;
-  List l(e, n);
+  Engine rt;
+  List l(rt, n);
   l.start(reach);
   EXPECT_EQ(l.result(), l.expected());
-  const sac::Stats s0 = e.stats();
+  const sac::Stats s0 = rt.stats();
   const int w0 = g_work;
   std::rotate(l.order.begin(), l.order.end() - 1, l.order.end());
   l.relink();
-  e.propagate();
-  expect_healthy(e);
+  rt.propagate();
+  expect_healthy(rt);
   EXPECT_EQ(l.result(), l.expected());
-  delta->memo_hits = e.stats().memo_hits - s0.memo_hits;
-  delta->memo_far = e.stats().memo_far - s0.memo_far;
-  delta->last_trace_distance = e.stats().last_trace_distance;
+  delta->memo_hits = rt.stats().memo_hits - s0.memo_hits;
+  delta->memo_far = rt.stats().memo_far - s0.memo_far;
+  delta->last_trace_distance = rt.stats().last_trace_distance;
   return g_work - w0;
 }
 
@@ -145,29 +145,29 @@ TEST(MemoNear, ACallJustAheadIsReusedAndOneBeyondTheReachIsNot) {
   // the old body writes `pad` modifiables before the call, so its start lies pad stamps
   // ahead of the re-execution's first events.
   for (const std::uint32_t pad : {0u, 3u, 40u}) {
-    Engine e;
+    Engine rt;
     Mod<int> in;
     std::vector<Mod<int>> pads(pad);
     int calls = 0;
-    e.set(in, 0);
-    e.run([&](Engine& en) {
-      en.read(in, [&pads, pc = &calls](Engine& x, int v) {
+    rt.set(in, 0);
+    rt.run([&](Engine& rt2) {
+      rt2.read(in, [&pads, pc = &calls](Engine& rt3, int v) {
         if (v == 0)
-          for (auto& m : pads) x.write(m, 1);
-        x.memo_near(8, sac::fn<&count_call>(pc, 1));
+          for (auto& m : pads) rt3.write(m, 1);
+        rt3.memo_near(8, sac::fn<&count_call>(pc, 1));
       });
     });
     ASSERT_EQ(calls, 1);
-    const sac::Stats s0 = e.stats();
-    e.set(in, 1);  // the new body skips the pads: the old call lies pad stamps ahead
-    e.propagate();
-    expect_healthy(e);
+    const sac::Stats s0 = rt.stats();
+    rt.set(in, 1);  // the new body skips the pads: the old call lies pad stamps ahead
+    rt.propagate();
+    expect_healthy(rt);
     if (pad <= 8) {
       EXPECT_EQ(calls, 1) << "pad " << pad;
-      EXPECT_EQ(e.stats().memo_hits - s0.memo_hits, 1u);
+      EXPECT_EQ(rt.stats().memo_hits - s0.memo_hits, 1u);
     } else {
       EXPECT_EQ(calls, 2) << "pad " << pad;
-      EXPECT_EQ(e.stats().memo_far - s0.memo_far, 1u);
+      EXPECT_EQ(rt.stats().memo_far - s0.memo_far, 1u);
     }
   }
 }
@@ -177,8 +177,8 @@ TEST(MemoNear, RandomMovesMatchTheExpectedListAndAFromScratchTrace) {
   std::printf("MemoNear random differential: seed %u\n", seed);
   std::mt19937 rng(seed);
   const int n = test_support::kSanitized ? 60 : 300;
-  Engine e;
-  List l(e, n);
+  Engine rt;
+  List l(rt, n);
   l.start(16);
   std::vector<Item*> absent;
   int calls = 0, changes = 0;
@@ -203,8 +203,8 @@ TEST(MemoNear, RandomMovesMatchTheExpectedListAndAFromScratchTrace) {
     }
     const int w0 = g_work;
     l.relink();
-    e.propagate();
-    expect_healthy(e);
+    rt.propagate();
+    expect_healthy(rt);
     ASSERT_EQ(l.result(), l.expected()) << "seed " << seed << " step " << step;
     // The element that moved or came back runs its call anew; a reuse within the reach may
     // also undo the calls of the elements whose trace lies before it (an element moved two
@@ -213,15 +213,15 @@ TEST(MemoNear, RandomMovesMatchTheExpectedListAndAFromScratchTrace) {
     calls += g_work - w0;
     if (step % 50 == 49) {
       // The same ids in the same order, on items of its own.
-      Engine fresh;
-      List f(fresh, n);
+      Engine rt2;
+      List f(rt2, n);
       std::vector<Item*> order;
       for (const Item* it : l.order) order.push_back(f.items[it->id].get());
       f.order = order;
       f.relink();
       f.start(16);
       EXPECT_EQ(f.result(), l.result());
-      EXPECT_EQ(fresh.live_events(), e.live_events()) << "step " << step;
+      EXPECT_EQ(rt2.live_events(), rt.live_events()) << "step " << step;
     }
   }
   std::printf("MemoNear random differential: %d calls for %d changes\n", calls, changes);

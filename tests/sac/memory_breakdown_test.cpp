@@ -55,16 +55,16 @@ struct Tag {
 
 void note(Engine&, long* sink, std::uint64_t id) { *sink += static_cast<long>(id); }
 
-void step(Engine& e, Cell* c, Mod<Out*>* dst, long* sink) {
+void step(Engine& rt, Cell* c, Mod<Out*>* dst, long* sink) {
   if (!c) {
-    e.write(*dst, static_cast<Out*>(nullptr));
+    rt.write(*dst, static_cast<Out*>(nullptr));
     return;
   }
-  Out* o = e.alloc<Out>(c->id, 2 * c->value);
-  e.write(*dst, o);
-  if (c->value % 2 == 0) e.make<Tag>(c->value);
-  e.memo(sac::fn<note>(sink, c->id));
-  e.memo_read(c->next, sac::fn<step>(&o->next, sink));
+  Out* o = rt.alloc<Out>(c->id, 2 * c->value);
+  rt.write(*dst, o);
+  if (c->value % 2 == 0) rt.make<Tag>(c->value);
+  rt.memo(sac::fn<note>(sink, c->id));
+  rt.memo_read(c->next, sac::fn<step>(&o->next, sink));
 }
 
 using StepFn = decltype(sac::fn<step>(static_cast<Mod<Out*>*>(nullptr), static_cast<long*>(nullptr)));
@@ -79,21 +79,21 @@ class MapRun {
       cells_.push_back(std::make_unique<Cell>(values[i], i));
     Cell* nx = nullptr;
     for (std::size_t i = values.size(); i-- > 0;) {
-      engine.set(cells_[i]->next, present_[i] ? nx : static_cast<Cell*>(nullptr));
+      rt.set(cells_[i]->next, present_[i] ? nx : static_cast<Cell*>(nullptr));
       if (present_[i]) nx = cells_[i].get();
     }
-    engine.set(head_, nx);
-    engine.run([this](Engine& e) { e.read(head_, sac::fn<step>(&out_, &sink_)); });
+    rt.set(head_, nx);
+    rt.run([this](Engine& rt2) { rt2.read(head_, sac::fn<step>(&out_, &sink_)); });
   }
 
   void toggle(std::size_t i) {
     Mod<Cell*>& before = link_before(i);
     Cell* c = cells_[i].get();
     if (present_[i]) {
-      engine.set(before, c->next.get());
+      rt.set(before, c->next.get());
     } else {
-      engine.set(c->next, before.get());
-      engine.set(before, c);
+      rt.set(c->next, before.get());
+      rt.set(before, c);
     }
     present_[i] = !present_[i];
   }
@@ -129,7 +129,7 @@ class MapRun {
   long sink_ = 0;
 
  public:
-  Engine engine;
+  Engine rt;
 };
 
 std::vector<long> values_of(std::size_t n, std::uint64_t seed) {
@@ -141,17 +141,17 @@ std::vector<long> values_of(std::size_t n, std::uint64_t seed) {
 
 /// The parts sum to trace_bytes(), the records to record_bytes(), the base versions to
 /// input_bytes(), and the counts to live_events().
-void expect_sums(const Engine& e, const MemoryBreakdown& b) {
+void expect_sums(const Engine& rt, const MemoryBreakdown& b) {
   EXPECT_EQ(b.unaccounted, 0);
-  EXPECT_EQ(b.records(), e.record_bytes());
-  EXPECT_EQ(b.trace(), e.trace_bytes());
-  EXPECT_EQ(b.inputs.bytes(), e.input_bytes());
+  EXPECT_EQ(b.records(), rt.record_bytes());
+  EXPECT_EQ(b.trace(), rt.trace_bytes());
+  EXPECT_EQ(b.inputs.bytes(), rt.input_bytes());
   std::size_t parts = 0;
   b.for_each_part([&](const char*, std::uint64_t, std::size_t bytes) { parts += bytes; });
-  EXPECT_EQ(parts, e.trace_bytes());
+  EXPECT_EQ(parts, rt.trace_bytes());
   EXPECT_EQ(b.reads.count + b.versions.count + b.memos.count + b.keyed_allocs.count +
                 b.plain_allocs.count,
-            e.live_events());
+            rt.live_events());
   std::uint64_t sized = 0;
   std::size_t sized_bytes = 0;
   for (const auto& [bytes, count] : b.read_sizes) {
@@ -178,7 +178,7 @@ TEST(MemoryBreakdown, CountsAndBytesFollowTheProgramsEvents) {
   MapRun run(values, present);
   const std::size_t n = run.present_count();
   const std::size_t even = run.present_even(values);
-  const MemoryBreakdown b = run.engine.memory_breakdown();
+  const MemoryBreakdown b = run.rt.memory_breakdown();
 
   using sac::detail::AllocNode;
   using sac::detail::MemoNode;
@@ -196,7 +196,7 @@ TEST(MemoryBreakdown, CountsAndBytesFollowTheProgramsEvents) {
   EXPECT_EQ(b.inputs, kind(values.size() + 1, sizeof(VersionBase), 0, sizeof(void*)));
   ASSERT_EQ(b.read_sizes.size(), 1u);  // every read is a step
   EXPECT_EQ(b.read_sizes[0].first, sizeof(sac::detail::ReadNodeT<StepFn>));
-  expect_sums(run.engine, b);
+  expect_sums(run.rt, b);
   EXPECT_GT(b.order_groups, 0u);
   EXPECT_GT(b.order_bytes, 0u);
   EXPECT_GT(b.alloc_table_bytes, 0u);
@@ -230,13 +230,13 @@ TEST(MemoryBreakdown, AfterUpdatesEqualsAFromScratchRun) {
   for (int round = 0; round < 30; ++round) {
     const int k = 1 + static_cast<int>(rng() % 3);  // batches of one to three edits
     for (int j = 0; j < k; ++j) run.toggle(rng() % values.size());
-    run.engine.propagate();
-    const MemoryBreakdown b = run.engine.memory_breakdown();
-    expect_sums(run.engine, b);
+    run.rt.propagate();
+    const MemoryBreakdown b = run.rt.memory_breakdown();
+    expect_sums(run.rt, b);
 
     MapRun fresh(values, run.presence());
     ASSERT_EQ(run.output(), fresh.output());
-    const MemoryBreakdown f = fresh.engine.memory_breakdown();
+    const MemoryBreakdown f = fresh.rt.memory_breakdown();
     EXPECT_EQ(b.reads, f.reads) << "round " << round;
     EXPECT_EQ(b.versions, f.versions) << "round " << round;
     EXPECT_EQ(b.memos, f.memos) << "round " << round;
@@ -249,23 +249,23 @@ TEST(MemoryBreakdown, AfterUpdatesEqualsAFromScratchRun) {
 }
 
 TEST(MemoryBreakdown, LargeBlocksAndMisuse) {
-  Engine e;
+  Engine rt;
   Mod<int> m;
-  e.set(m, 1);
-  e.run([&](Engine& x) {
-    x.read(m, [](Engine& y, int v) { y.make<std::array<char, 600>>(std::array<char, 600>{static_cast<char>(v)}); });
+  rt.set(m, 1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(m, [](Engine& rt3, int v) { rt3.make<std::array<char, 600>>(std::array<char, 600>{static_cast<char>(v)}); });
   });
-  const MemoryBreakdown b = e.memory_breakdown();
+  const MemoryBreakdown b = rt.memory_breakdown();
   EXPECT_EQ(b.plain_allocs.count, 1u);
   EXPECT_EQ(b.reads.count, 1u);
   EXPECT_EQ(b.read_sizes.size(), 1u);
   EXPECT_EQ(b.pool_large, (sizeof(sac::detail::AllocNode) + 600 + 7) / 8 * 8);
   EXPECT_EQ(b.unaccounted, 0);
-  EXPECT_EQ(b.trace(), e.trace_bytes());
+  EXPECT_EQ(b.trace(), rt.trace_bytes());
   EXPECT_EQ(b.pool_unused(), b.pool_reserved - (b.records() + b.inputs.bytes() - b.pool_large));
 
-  Engine inside;
-  EXPECT_THROW(inside.run([](Engine& x) { (void)x.memory_breakdown(); }), sac::UsageError);
+  Engine rt2;
+  EXPECT_THROW(rt2.run([](Engine& rt3) { (void)rt3.memory_breakdown(); }), sac::UsageError);
 }
 
 }  // namespace

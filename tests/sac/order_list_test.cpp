@@ -23,7 +23,7 @@
 #include "sac/detail/order_list.hpp"
 #include "sac/errors.hpp"
 
-namespace sac {
+namespace sac::detail {
 
 /// The test-only hook declared in OrderList: the private groups, so that the checker tests
 /// below can corrupt one of them and see check_invariants() fail.
@@ -33,7 +33,7 @@ struct OrderListTestAccess {
   static std::size_t& group_count(OrderList& ol) { return ol.group_count_; }
 };
 
-}  // namespace sac
+}  // namespace sac::detail
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SAC_OL_TEST_SANITIZED 1
@@ -48,9 +48,9 @@ struct OrderListTestAccess {
 
 namespace {
 
-using sac::OrderList;
-using sac::Stamp;
-using sac::StampKind;
+using sac::detail::OrderList;
+using sac::detail::Stamp;
+using sac::detail::StampKind;
 
 constexpr int kScale = SAC_OL_TEST_SANITIZED ? 4 : 1;  // divide loop sizes under ASan
 
@@ -529,7 +529,7 @@ std::string invariant_message(const OrderList& ol) {
   return {};
 }
 
-using sac::OrderListTestAccess;
+using sac::detail::OrderListTestAccess;
 using testing::HasSubstr;
 
 TEST(OrderList, CheckInvariantsDetectsAWrongGroupCount) {

@@ -36,76 +36,76 @@ int sum(Vals v) {
 
 TEST(ReadMany, OneEventAndOneRerunPerChange) {
   Mod<int> a, b, c, d, out;
-  Engine e;
-  e.set(a, 1);
-  e.set(b, 2);
-  e.set(c, 3);
-  e.set(d, 4);
+  Engine rt;
+  rt.set(a, 1);
+  rt.set(b, 2);
+  rt.set(c, 3);
+  rt.set(d, 4);
   int runs = 0;
-  e.run([&](Engine& en) {
-    en.read_many({&a, &b, &c, &d}, [&out, &runs](Engine& x, Vals v) {
+  rt.run([&](Engine& rt2) {
+    rt2.read_many({&a, &b, &c, &d}, [&out, &runs](Engine& rt3, Vals v) {
       ++runs;
-      x.write(out, sum(v));
+      rt3.write(out, sum(v));
     });
   });
   EXPECT_EQ(out.get(), 1234);
-  EXPECT_EQ(e.live_events(), 2u);  // the multi-read and the write
-  EXPECT_EQ(e.stats().events_created, 2u);
-  e.check_invariants();
+  EXPECT_EQ(rt.live_events(), 2u);  // the multi-read and the write
+  EXPECT_EQ(rt.stats().events_created, 2u);
+  rt.check_invariants();
 
-  e.set(c, 7);
-  e.propagate();
+  rt.set(c, 7);
+  rt.propagate();
   EXPECT_EQ(out.get(), 1274);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
   EXPECT_EQ(runs, 2);
 
-  e.set(a, 5);  // two of the four change: still one re-run
-  e.set(d, 9);
-  e.propagate();
+  rt.set(a, 5);  // two of the four change: still one re-run
+  rt.set(d, 9);
+  rt.propagate();
   EXPECT_EQ(out.get(), 5279);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
   EXPECT_EQ(runs, 3);
 
-  e.set(b, 2);  // equal: cut off
-  e.propagate();
-  EXPECT_EQ(e.stats().last_reexecuted, 0u);
+  rt.set(b, 2);  // equal: cut off
+  rt.propagate();
+  EXPECT_EQ(rt.stats().last_reexecuted, 0u);
   EXPECT_EQ(runs, 3);
-  EXPECT_EQ(e.live_events(), 2u);
-  e.check_invariants();
+  EXPECT_EQ(rt.live_events(), 2u);
+  rt.check_invariants();
 }
 
 TEST(ReadMany, BodyWithoutEngineAndRepeatedModifiables) {
   Mod<int> a, b;
-  Engine e;
-  e.set(a, 1);
-  e.set(b, 2);
+  Engine rt;
+  rt.set(a, 1);
+  rt.set(b, 2);
   int seen = 0;
-  e.run([&](Engine& en) {
+  rt.run([&](Engine& rt2) {
     const std::array<const Mod<int>*, 3> ms{&a, &b, &a};
-    en.read_many(std::span<const Mod<int>* const>(ms), [&seen](Vals v) { seen = sum(v); });
+    rt2.read_many(std::span<const Mod<int>* const>(ms), [&seen](Vals v) { seen = sum(v); });
   });
   EXPECT_EQ(seen, 121);
-  e.set(a, 3);
-  e.propagate();
+  rt.set(a, 3);
+  rt.propagate();
   EXPECT_EQ(seen, 323);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);
-  e.check_invariants();
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);
+  rt.check_invariants();
 }
 
 TEST(ReadMany, SizeOutOfRangeIsAUsageError) {
   Mod<int> a;
-  Engine e;
-  e.set(a, 1);
-  EXPECT_THROW(e.run([&](Engine& en) {
-    en.read_many(std::span<const Mod<int>* const>(), [](Vals) {});
+  Engine rt;
+  rt.set(a, 1);
+  EXPECT_THROW(rt.run([&](Engine& rt2) {
+    rt2.read_many(std::span<const Mod<int>* const>(), [](Vals) {});
   }),
                sac::UsageError);
-  Engine e2;
+  Engine rt2;
   Mod<int> a2;
-  e2.set(a2, 1);
+  rt2.set(a2, 1);
   std::vector<const Mod<int>*> many2(17, &a2);
-  EXPECT_THROW(e2.run([&](Engine& en) {
-    en.read_many(std::span<const Mod<int>* const>(many2), [](Vals) {});
+  EXPECT_THROW(rt2.run([&](Engine& rt3) {
+    rt3.read_many(std::span<const Mod<int>* const>(many2), [](Vals) {});
   }),
                sac::UsageError);
 }
@@ -114,134 +114,134 @@ TEST(ReadMany, SeesTheLatestVersionBeforeItAndIgnoresWritesInsideItsInterval) {
   // sel -> m written before the multi-read; the multi-read writes m itself (inside its
   // interval) and a later plain read sees that write.
   Mod<int> sel, m, y, out, out2;
-  Engine e;
-  e.set(sel, 1);
-  e.set(m, 0);
-  e.set(y, 5);
+  Engine rt;
+  rt.set(sel, 1);
+  rt.set(m, 0);
+  rt.set(y, 5);
   int runs = 0;
-  e.run([&](Engine& en) {
-    en.read(sel, [&m](Engine& x, int s) { x.write(m, s * 10); });
-    en.write(m, 7);  // a second version before the multi-read: the one it sees
-    en.read_many({&m, &y}, [&out, &m, &runs](Engine& x, Vals v) {
+  rt.run([&](Engine& rt2) {
+    rt2.read(sel, [&m](Engine& rt3, int s) { rt3.write(m, s * 10); });
+    rt2.write(m, 7);  // a second version before the multi-read: the one it sees
+    rt2.read_many({&m, &y}, [&out, &m, &runs](Engine& rt3, Vals v) {
       ++runs;
-      x.write(out, *v[0] + *v[1]);
-      x.write(m, 100 + *v[1]);  // inside its own interval: does not affect it
+      rt3.write(out, *v[0] + *v[1]);
+      rt3.write(m, 100 + *v[1]);  // inside its own interval: does not affect it
     });
-    en.read(m, [&out2](Engine& x, int v) { x.write(out2, v); });
+    rt2.read(m, [&out2](Engine& rt3, int v) { rt3.write(out2, v); });
   });
   EXPECT_EQ(out.get(), 12);
   EXPECT_EQ(out2.get(), 105);
   EXPECT_EQ(runs, 1);
 
-  e.set(sel, 2);  // the version before 7: hidden from the multi-read
-  e.propagate();
+  rt.set(sel, 2);  // the version before 7: hidden from the multi-read
+  rt.propagate();
   EXPECT_EQ(runs, 1);
-  EXPECT_EQ(e.stats().last_reexecuted, 1u);  // only the read of sel
+  EXPECT_EQ(rt.stats().last_reexecuted, 1u);  // only the read of sel
 
-  e.set(y, 6);  // the multi-read re-runs, its own write changes, the later read follows
-  e.propagate();
+  rt.set(y, 6);  // the multi-read re-runs, its own write changes, the later read follows
+  rt.propagate();
   EXPECT_EQ(runs, 2);
   EXPECT_EQ(out.get(), 13);
   EXPECT_EQ(out2.get(), 106);
-  EXPECT_EQ(e.stats().last_reexecuted, 2u);
-  e.check_invariants();
+  EXPECT_EQ(rt.stats().last_reexecuted, 2u);
+  rt.check_invariants();
 }
 
 TEST(ReadMany, AWriteInsertedBeforeItOrUndoneRerunsItOnce) {
   Mod<int> sel, m, a, out;
-  Engine e;
-  e.set(sel, 0);
-  e.set(m, 1);
-  e.set(a, 2);
+  Engine rt;
+  rt.set(sel, 0);
+  rt.set(m, 1);
+  rt.set(a, 2);
   int runs = 0;
-  e.run([&](Engine& en) {
-    en.read(sel, [&m](Engine& x, int s) {
-      if (s) x.write(m, s);
+  rt.run([&](Engine& rt2) {
+    rt2.read(sel, [&m](Engine& rt3, int s) {
+      if (s) rt3.write(m, s);
     });
-    en.read_many({&a, &m}, [&out, &runs](Engine& x, Vals v) {
+    rt2.read_many({&a, &m}, [&out, &runs](Engine& rt3, Vals v) {
       ++runs;
-      x.write(out, sum(v));
+      rt3.write(out, sum(v));
     });
   });
   EXPECT_EQ(out.get(), 21);
-  e.set(sel, 5);  // a new version of m before it: the split moves its slot, once
-  e.propagate();
+  rt.set(sel, 5);  // a new version of m before it: the split moves its slot, once
+  rt.propagate();
   EXPECT_EQ(out.get(), 25);
   EXPECT_EQ(runs, 2);
-  e.check_invariants();
-  e.set(sel, 1);  // the version it sees is replaced by an equal-to-base value: changed (5 -> 1)
-  e.propagate();
+  rt.check_invariants();
+  rt.set(sel, 1);  // the version it sees is replaced by an equal-to-base value: changed (5 -> 1)
+  rt.propagate();
   EXPECT_EQ(out.get(), 21);
   EXPECT_EQ(runs, 3);
-  e.set(sel, 0);  // the write is undone: m's base value 1 again, equal: cut off
-  e.propagate();
+  rt.set(sel, 0);  // the write is undone: m's base value 1 again, equal: cut off
+  rt.propagate();
   EXPECT_EQ(runs, 3);
   EXPECT_EQ(out.get(), 21);
-  e.set(m, 4);
-  e.propagate();
+  rt.set(m, 4);
+  rt.propagate();
   EXPECT_EQ(out.get(), 24);
   EXPECT_EQ(runs, 4);
-  e.check_invariants();
+  rt.check_invariants();
 }
 
 TEST(ReadMany, DefaultsAndTheirVersions) {
   Mod<int> sel, d, a, out;
-  Engine e;
-  e.set(sel, 0);
-  e.init_default(d);
-  e.set(a, 3);
+  Engine rt;
+  rt.set(sel, 0);
+  rt.init_default(d);
+  rt.set(a, 3);
   int runs = 0;
-  e.run([&](Engine& en) {
-    en.read_many({&d, &a}, [&out, &runs](Engine& x, Vals v) {
+  rt.run([&](Engine& rt2) {
+    rt2.read_many({&d, &a}, [&out, &runs](Engine& rt3, Vals v) {
       ++runs;
-      x.write(out, sum(v));
+      rt3.write(out, sum(v));
     });
-    en.read(sel, [&d](Engine& x, int s) {
-      if (s) x.write(d, s);  // after the multi-read: a version it does not see
+    rt2.read(sel, [&d](Engine& rt3, int s) {
+      if (s) rt3.write(d, s);  // after the multi-read: a version it does not see
     });
   });
   EXPECT_EQ(out.get(), 3);
-  e.set(sel, 4);
-  e.propagate();
+  rt.set(sel, 4);
+  rt.propagate();
   EXPECT_EQ(runs, 1);
   EXPECT_EQ(out.get(), 3);
-  e.check_invariants();
-  e.set(a, 5);
-  e.propagate();
+  rt.check_invariants();
+  rt.set(a, 5);
+  rt.propagate();
   EXPECT_EQ(runs, 2);
   EXPECT_EQ(out.get(), 5);
-  e.set(sel, 0);
-  e.propagate();
+  rt.set(sel, 0);
+  rt.propagate();
   EXPECT_EQ(runs, 2);
-  e.check_invariants();
+  rt.check_invariants();
 }
 
 TEST(ReadMany, DefaultWrittenBeforeItThenUndone) {
   Mod<int> sel, d, out;
-  Engine e;
-  e.set(sel, 0);
-  e.init_default(d);
+  Engine rt;
+  rt.set(sel, 0);
+  rt.init_default(d);
   int runs = 0;
-  e.run([&](Engine& en) {
-    en.read(sel, [&d](Engine& x, int s) {
-      if (s) x.write(d, s);
+  rt.run([&](Engine& rt2) {
+    rt2.read(sel, [&d](Engine& rt3, int s) {
+      if (s) rt3.write(d, s);
     });
-    en.read_many({&d, &d}, [&out, &runs](Engine& x, Vals v) {
+    rt2.read_many({&d, &d}, [&out, &runs](Engine& rt3, Vals v) {
       ++runs;
-      x.write(out, sum(v));
+      rt3.write(out, sum(v));
     });
   });
   EXPECT_EQ(out.get(), 0);
-  e.set(sel, 3);
-  e.propagate();
+  rt.set(sel, 3);
+  rt.propagate();
   EXPECT_EQ(out.get(), 33);
   EXPECT_EQ(runs, 2);
-  e.check_invariants();
-  e.set(sel, 0);  // undone: back to the default
-  e.propagate();
+  rt.check_invariants();
+  rt.set(sel, 0);  // undone: back to the default
+  rt.propagate();
   EXPECT_EQ(out.get(), 0);
   EXPECT_EQ(runs, 3);
-  e.check_invariants();
+  rt.check_invariants();
 }
 
 // ------------------------------------------------------------------ differential
@@ -263,70 +263,70 @@ struct Program {
   std::array<Mod<int>, kCells> cell;
   std::array<Mod<int>, kGroups> ctrl;
   std::array<Mod<int>, kGroups> gout;
-  Engine e;
+  Engine rt;
 
   const Mod<int>* mod(int i) const { return i < kInputs ? &in[i] : &cell[i - kInputs]; }
 
-  static void finish(Engine& e, Program* p, int s, const std::array<int, 16>& vals) {
+  static void finish(Engine& rt2, Program* p, int s, const std::array<int, 16>& vals) {
     const Step& st = p->steps[s];
     std::uint64_t h = 1469598103934665603ull + s;
     for (int i = 0; i < st.k; ++i) h = (h ^ static_cast<std::uint64_t>(vals[i] + 7)) * 1099511628211ull;
-    e.write(p->cell[st.dst], static_cast<int>(h % 5));
-    if (h % 3 == 0) e.write(p->cell[st.dst2], static_cast<int>((h >> 8) % 4));
+    rt2.write(p->cell[st.dst], static_cast<int>(h % 5));
+    if (h % 3 == 0) rt2.write(p->cell[st.dst2], static_cast<int>((h >> 8) % 4));
   }
   struct Nest {
     Program* p;
     int s, i;
     std::array<int, 16> vals;
-    void operator()(Engine& e, int v) const {
+    void operator()(Engine& rt2, int v) const {
       Nest n = *this;
       n.vals[i] = v;
-      if (++n.i == p->steps[s].k) finish(e, p, s, n.vals);
-      else e.read(*p->mod(p->steps[s].src[n.i]), n);
+      if (++n.i == p->steps[s].k) finish(rt2, p, s, n.vals);
+      else rt2.read(*p->mod(p->steps[s].src[n.i]), n);
     }
   };
-  static void step(Engine& e, Program* p, int s) {
+  static void step(Engine& rt2, Program* p, int s) {
     const Step& st = p->steps[s];
     if (p->many) {
       std::array<const Mod<int>*, 16> ms{};
       for (int i = 0; i < st.k; ++i) ms[i] = p->mod(st.src[i]);
-      e.read_many(std::span<const Mod<int>* const>(ms.data(), st.k), [p, s](Engine& x, Vals v) {
+      rt2.read_many(std::span<const Mod<int>* const>(ms.data(), st.k), [p, s](Engine& rt3, Vals v) {
         std::array<int, 16> vals{};
         for (std::size_t i = 0; i < v.size(); ++i) vals[i] = *v[i];
-        finish(x, p, s, vals);
+        finish(rt3, p, s, vals);
       });
     } else {
-      e.read(*p->mod(st.src[0]), Nest{p, s, 0, {}});
+      rt2.read(*p->mod(st.src[0]), Nest{p, s, 0, {}});
     }
   }
-  static void group(Engine& e, Program* p, int g, int parity) {
+  static void group(Engine& rt2, Program* p, int g, int parity) {
     const int per = static_cast<int>(p->steps.size()) / kGroups;
-    for (int s = g * per; s < (g + 1) * per; ++s) step(e, p, s);
-    e.write(p->gout[g], parity);
+    for (int s = g * per; s < (g + 1) * per; ++s) step(rt2, p, s);
+    rt2.write(p->gout[g], parity);
   }
-  void body(Engine& en) {
+  void body(Engine& rt2) {
     for (int g = 0; g < kGroups; ++g)
-      en.read(ctrl[g], [this, g](Engine& x, int c) {
-        x.memo(sac::fn<&Program::group>(this, g, c % 2));  // odd changes miss, even hit
-        x.write(gout[g], c);
+      rt2.read(ctrl[g], [this, g](Engine& rt3, int c) {
+        rt3.memo(sac::fn<&Program::group>(this, g, c % 2));  // odd changes miss, even hit
+        rt3.write(gout[g], c);
       });
   }
   void setup(const std::vector<int>& inputs) {
-    for (int i = 0; i < kInputs; ++i) e.set(in[i], inputs[i]);
+    for (int i = 0; i < kInputs; ++i) rt.set(in[i], inputs[i]);
     for (int i = 0; i < kCells; ++i) {
-      if (i % 2) e.init_default(cell[i]);
-      else e.set(cell[i], 1);
+      if (i % 2) rt.init_default(cell[i]);
+      else rt.set(cell[i], 1);
     }
-    for (int g = 0; g < kGroups; ++g) e.set(ctrl[g], inputs[kInputs + g]);
-    e.run([this](Engine& en) { body(en); });
+    for (int g = 0; g < kGroups; ++g) rt.set(ctrl[g], inputs[kInputs + g]);
+    rt.run([this](Engine& rt2) { body(rt2); });
   }
   void propagate_and_check() {
-    e.propagate();
-    e.check_invariants();
+    rt.propagate();
+    rt.check_invariants();
   }
   void set(int i, int v) {
-    if (i < kInputs) e.set(in[i], v);
-    else e.set(ctrl[i - kInputs], v);
+    if (i < kInputs) rt.set(in[i], v);
+    else rt.set(ctrl[i - kInputs], v);
   }
   std::vector<int> outputs() const {
     std::vector<int> o;
@@ -368,7 +368,7 @@ TEST(ReadManyDifferential, MatchesNestedReadsAndFromScratch) {
         nested->set(i, inputs[i]);
       }
       many->propagate_and_check();
-      nested->e.propagate();
+      nested->rt.propagate();
       ASSERT_EQ(many->outputs(), nested->outputs()) << "update " << u;
       // From scratch on the same inputs: same outputs, same live trace.
       auto scratch = std::make_unique<Program>();
@@ -376,9 +376,9 @@ TEST(ReadManyDifferential, MatchesNestedReadsAndFromScratch) {
       scratch->many = true;
       scratch->setup(inputs);
       ASSERT_EQ(many->outputs(), scratch->outputs()) << "update " << u;
-      ASSERT_EQ(many->e.live_events(), scratch->e.live_events()) << "update " << u;
-      ASSERT_EQ(many->e.record_bytes(), scratch->e.record_bytes()) << "update " << u;
-      ASSERT_LE(many->e.live_events(), nested->e.live_events());
+      ASSERT_EQ(many->rt.live_events(), scratch->rt.live_events()) << "update " << u;
+      ASSERT_EQ(many->rt.record_bytes(), scratch->rt.record_bytes()) << "update " << u;
+      ASSERT_LE(many->rt.live_events(), nested->rt.live_events());
     }
   }
 }
@@ -394,9 +394,9 @@ struct Extend {
   std::array<const Mod<int>*, 2> outer;
   Mod<int>* out;
   int* inner_runs;
-  void operator()(Engine& e, Vals v) const {
+  void operator()(Engine& rt, Vals v) const {
     ++*inner_runs;
-    e.write(*out, e.current(*outer[0]) * 100 + e.current(*outer[1]) * 10 + *v[0]);
+    rt.write(*out, rt.current(*outer[0]) * 100 + rt.current(*outer[1]) * 10 + *v[0]);
   }
 };
 
@@ -404,106 +404,106 @@ struct Extend {
 
 TEST(ReadMany, CurrentLooksUpTheValuesOfAnEnclosingRead) {
   Mod<int> a, b, c, d, out;
-  Engine e;
-  e.set(a, 1);
-  e.set(b, 2);
-  e.set(c, 3);
-  e.set(d, 4);
+  Engine rt;
+  rt.set(a, 1);
+  rt.set(b, 2);
+  rt.set(c, 3);
+  rt.set(d, 4);
   int outer_runs = 0, inner_runs = 0;
-  e.run([&](Engine& en) {
-    en.read_many({&a, &b}, [&](Engine& x, Vals v) {
+  rt.run([&](Engine& rt2) {
+    rt2.read_many({&a, &b}, [&](Engine& rt3, Vals v) {
       ++outer_runs;
       // Which inner modifiable depends on the outer values, as a search's next cell does.
       const Mod<int>* next = *v[0] + *v[1] > 5 ? &d : &c;
-      x.read_many({next}, Extend{{&a, &b}, &out, &inner_runs});
+      rt3.read_many({next}, Extend{{&a, &b}, &out, &inner_runs});
     });
   });
   EXPECT_EQ(out.get(), 123);
-  e.check_invariants();
+  rt.check_invariants();
 
-  e.set(c, 8);  // inner only
-  e.propagate();
+  rt.set(c, 8);  // inner only
+  rt.propagate();
   EXPECT_EQ(out.get(), 128);
   EXPECT_EQ(outer_runs, 1);
   EXPECT_EQ(inner_runs, 2);
 
-  e.set(b, 7);  // outer: the nest re-runs and now reads d
-  e.propagate();
+  rt.set(b, 7);  // outer: the nest re-runs and now reads d
+  rt.propagate();
   EXPECT_EQ(out.get(), 174);
   EXPECT_EQ(outer_runs, 2);
   EXPECT_EQ(inner_runs, 3);
-  e.check_invariants();
+  rt.check_invariants();
 
-  e.set(c, 9);  // no longer read
-  e.propagate();
+  rt.set(c, 9);  // no longer read
+  rt.propagate();
   EXPECT_EQ(inner_runs, 3);
-  e.set(a, 2);  // an outer value the inner body looks up
-  e.propagate();
+  rt.set(a, 2);  // an outer value the inner body looks up
+  rt.propagate();
   EXPECT_EQ(out.get(), 274);
-  e.check_invariants();
+  rt.check_invariants();
 }
 
 TEST(ReadMany, CurrentOutsideTheComputationIsAUsageError) {
   Mod<int> a;
-  Engine e;
-  e.set(a, 1);
-  EXPECT_THROW((void)e.current(a), sac::UsageError);
+  Engine rt;
+  rt.set(a, 1);
+  EXPECT_THROW((void)rt.current(a), sac::UsageError);
 }
 
 TEST(ReadMany, PeekSeesTheValueVisibleNowAndRecordsNothing) {
   Mod<int> a, b, guess, later, out;
-  Engine e;
-  e.set(a, 1);
-  e.set(b, 0);
-  e.set(guess, 5);
+  Engine rt;
+  rt.set(a, 1);
+  rt.set(b, 0);
+  rt.set(guess, 5);
   int runs = 0, before = 0, after = 0;
-  e.run([&](Engine& en) {
-    en.read(a, [&](Engine& x, int v) {
+  rt.run([&](Engine& rt2) {
+    rt2.read(a, [&](Engine& rt3, int v) {
       ++runs;
-      const int* p = x.peek(later);  // written later in this body: no version visible yet
+      const int* p = rt3.peek(later);  // written later in this body: no version visible yet
       before = p ? *p : -1;
-      x.write(later, v * 10);
-      x.write(out, v + *x.peek(guess));
-      x.read(b, [&](Engine& y, int) { after = *y.peek(later); });  // later in time: seen
+      rt3.write(later, v * 10);
+      rt3.write(out, v + *rt3.peek(guess));
+      rt3.read(b, [&](Engine& rt4, int) { after = *rt4.peek(later); });  // later in time: seen
     });
   });
   EXPECT_EQ(before, -1);
   EXPECT_EQ(after, 10);
   EXPECT_EQ(out.get(), 6);
 
-  e.set(guess, 7);  // peeked, not read: nothing re-runs, so out keeps the old guess
-  e.propagate();
+  rt.set(guess, 7);  // peeked, not read: nothing re-runs, so out keeps the old guess
+  rt.propagate();
   EXPECT_EQ(runs, 1);
   EXPECT_EQ(out.get(), 6);
 
-  e.set(a, 2);  // the re-run undoes its old write first: the peek sees none again
-  e.propagate();
+  rt.set(a, 2);  // the re-run undoes its old write first: the peek sees none again
+  rt.propagate();
   EXPECT_EQ(runs, 2);
   EXPECT_EQ(before, -1);
   EXPECT_EQ(after, 20);
   EXPECT_EQ(out.get(), 9);
-  e.check_invariants();
+  rt.check_invariants();
 }
 
 TEST(ReadMany, PeekSeesAWriteJustMadeByTheSameBody) {
   // The write's time is now itself: a peek right after it must see it, on the first run
   // (at the trace's end) and on a re-run inside the trace alike.
   Mod<int> a, m, seen;
-  Engine e;
-  e.set(a, 1);
-  e.run([&](Engine& en) {
-    en.read(a, [&](Engine& x, int v) {
-      x.write(m, v * 10);
-      const int* p = x.peek(m);
-      x.write(seen, p ? *p : -1);
+  Engine rt;
+  rt.set(a, 1);
+  rt.run([&](Engine& rt2) {
+    rt2.read(a, [&](Engine& rt3, int v) {
+      rt3.write(m, v * 10);
+      const int* p = rt3.peek(m);
+      rt3.write(seen, p ? *p : -1);
     });
   });
   EXPECT_EQ(seen.get(), 10);
   for (int v : {2, 3, 5}) {
-    e.set(a, v);
-    e.propagate();
+    rt.set(a, v);
+    rt.propagate();
     EXPECT_EQ(seen.get(), v * 10);
-    e.check_invariants();
+    rt.check_invariants();
   }
 }
 
@@ -530,22 +530,22 @@ struct ChainWalk {
     }
     return {sum, need};
   }
-  void round(Engine& e) const {
+  void round(Engine& rt) const {
     ++*rounds;
     // Values: read ones through current (the enclosing reads depend on them), others peeked.
     const auto [sum, need] = walk([&](int i) {
-      if (read_mask >> i & 1) return e.current((*cells)[i]);
-      const int* p = e.peek((*cells)[i]);
+      if (read_mask >> i & 1) return rt.current((*cells)[i]);
+      const int* p = rt.peek((*cells)[i]);
       return p ? *p : -1;
     });
     const std::uint32_t missing = need & ~read_mask;
-    if (missing == 0) return e.write(*out, sum);
+    if (missing == 0) return rt.write(*out, sum);
     std::vector<const Mod<int>*> mods;
     for (int i = 0; i < kChainCells; ++i)
       if (missing >> i & 1) mods.push_back(&(*cells)[i]);
     ChainWalk next = *this;
     next.read_mask |= missing;
-    e.read_many(std::span<const Mod<int>* const>(mods), [next](Engine& x, Vals) { next.round(x); });
+    rt.read_many(std::span<const Mod<int>* const>(mods), [next](Engine& rt2, Vals) { next.round(rt2); });
   }
 };
 
@@ -554,16 +554,16 @@ struct ChainWalk {
 TEST(ReadMany, APeekedPrefetchMatchesFromScratchAfterEveryChange) {
   std::array<Mod<int>, kChainCells> cells;
   Mod<int> out;
-  Engine e;
+  Engine rt;
   std::mt19937 rng(20261125);
   std::printf("seed 20261125\n");
   std::array<int, kChainCells> v{};
   for (int i = 0; i < kChainCells; ++i) {
     v[i] = i + 1 < kChainCells ? i + 1 : -1;
-    e.set(cells[i], v[i]);
+    rt.set(cells[i], v[i]);
   }
   int rounds = 0;
-  e.run([&](Engine& en) { ChainWalk{&cells, &out, &rounds}.round(en); });
+  rt.run([&](Engine& rt2) { ChainWalk{&cells, &out, &rounds}.round(rt2); });
   const auto expected = [&] {
     int sum = 0;
     for (int i = 0, steps = 0; i >= 0 && steps < kChainCells; ++steps) {
@@ -577,10 +577,10 @@ TEST(ReadMany, APeekedPrefetchMatchesFromScratchAfterEveryChange) {
   for (int t = 0; t < 200; ++t) {
     const int i = static_cast<int>(rng() % kChainCells);
     v[i] = static_cast<int>(rng() % (kChainCells + 1)) - 1;
-    e.set(cells[i], v[i]);
-    e.propagate();
+    rt.set(cells[i], v[i]);
+    rt.propagate();
     ASSERT_EQ(out.get(), expected()) << "change " << t;
-    e.check_invariants();
+    rt.check_invariants();
   }
 }
 
@@ -590,46 +590,46 @@ TEST(ReadMany, APeekedPrefetchMatchesFromScratchAfterEveryChange) {
 struct LastDigits {
   Mod<int>* out;
   int* runs;
-  void operator()(Engine& x, Vals v) const {
+  void operator()(Engine& rt, Vals v) const {
     ++*runs;
     int s = 0;
     for (const int* p : v) s = s * 10 + *p % 10;
-    x.write(*out, s);
+    rt.write(*out, s);
   }
   bool affected(std::size_t, const int& before, const int& after) const { return before % 10 != after % 10; }
 };
 
 TEST(ReadManyProjection, ReRunsOnlyWhenTheProjectionChanges) {
   Mod<int> sel, a, b, out;
-  Engine e;
-  e.set(sel, 0);
-  e.set(a, 11);
-  e.set(b, 22);
+  Engine rt;
+  rt.set(sel, 0);
+  rt.set(a, 11);
+  rt.set(b, 22);
   int runs = 0;
-  e.run([&](Engine& en) {
-    en.read(sel, [&b](Engine& x, int s) {
-      if (s) x.write(b, s);  // a version of b before the multi-read
+  rt.run([&](Engine& rt2) {
+    rt2.read(sel, [&b](Engine& rt3, int s) {
+      if (s) rt3.write(b, s);  // a version of b before the multi-read
     });
-    en.read_many({&a, &b}, LastDigits{&out, &runs});
+    rt2.read_many({&a, &b}, LastDigits{&out, &runs});
   });
   EXPECT_EQ(out.get(), 12);
   EXPECT_EQ(runs, 1);
   // Sets m to v and propagates: the body has then run `want_runs` times in all and written
   // `want_out`.
   const auto change = [&](Mod<int>& m, int v, int want_runs, int want_out) {
-    e.set(m, v);
-    e.propagate();
+    rt.set(m, v);
+    rt.propagate();
     EXPECT_EQ(runs, want_runs) << "after setting " << v;
     EXPECT_EQ(out.get(), want_out) << "after setting " << v;
   };
   // set(): a new base value with the same last digit does not re-run it ...
   change(a, 41, 1, 12);
-  EXPECT_EQ(e.stats().last_reexecuted, 0u);
+  EXPECT_EQ(rt.stats().last_reexecuted, 0u);
   // ... one with another does, and it sees the newest value.
   change(a, 43, 2, 32);
   // A write inserted before it (link_write): 72 ends in 2, as b's 22 does.
   change(sel, 72, 2, 32);
-  e.check_invariants();
+  rt.check_invariants();
   // The write replaced by one ending in 5: a change.
   change(sel, 75, 3, 35);
   // The write undone: b's base 22 ends in 2, not 5: a change.
@@ -639,7 +639,7 @@ TEST(ReadManyProjection, ReRunsOnlyWhenTheProjectionChanges) {
   change(sel, 0, 4, 32);
   // The base value b sees changes its digit while the read is attached to it.
   change(b, 28, 5, 38);
-  e.check_invariants();
+  rt.check_invariants();
 }
 
 // Counts the values of slots 1.. that are below slot 0's value: it depends on all of slot 0,
@@ -649,13 +649,13 @@ struct BelowThreshold {
   Mod<int>* out;
   int* runs;
   mutable int threshold = 0;
-  void operator()(Engine& x, Vals v) const {
+  void operator()(Engine& rt, Vals v) const {
     ++*runs;
     if (v.empty()) return;  // never (k >= 1); tells g++ that v[0] was filled
     threshold = *v[0];
     int below = 0;
     for (std::size_t i = 1; i < v.size(); ++i) below += *v[i] < threshold;
-    x.write(*out, below);
+    rt.write(*out, below);
   }
   bool affected(std::size_t i, const int& before, const int& after) const {
     return i == 0 || (before < threshold) != (after < threshold);
@@ -674,31 +674,31 @@ TEST(ReadManyProjection, MatchesFromScratchAfterEveryChange) {
   std::array<int, kN> vin{}, vsel{}, vmid{};
   std::mt19937 rng(20261127);
   std::printf("seed 20261127\n");
-  Engine e;
+  Engine rt;
   for (int i = 0; i < kN; ++i) {
     vin[i] = static_cast<int>(rng() % 20);
     vsel[i] = static_cast<int>(rng() % 2);
     vmid[i] = static_cast<int>(rng() % 20);
-    e.set(in[i], vin[i]);
-    e.set(sel[i], vsel[i]);
-    e.set(mid[i], vmid[i]);
+    rt.set(in[i], vin[i]);
+    rt.set(sel[i], vsel[i]);
+    rt.set(mid[i], vmid[i]);
   }
   // Slots of read r: mid[r] (the threshold), then mid[r+1], mid[r+3], mid[r+4].
   const auto slots = [](int r) { return std::array<int, 4>{r, (r + 1) % kN, (r + 3) % kN, (r + 4) % kN}; };
   int runs = 0;
-  e.run([&](Engine& en) {
+  rt.run([&](Engine& rt2) {
     for (int i = 0; i < kN; ++i)
-      en.read(sel[i], [&, i](Engine& x, int s) {
-        if (s) x.read(in[i], [&, i](Engine& y, int v) { y.write(mid[i], v); });
+      rt2.read(sel[i], [&, i](Engine& rt3, int s) {
+        if (s) rt3.read(in[i], [&, i](Engine& rt4, int v) { rt4.write(mid[i], v); });
       });
     for (int r = 0; r < kReads; ++r) {
       const auto s = slots(r);
-      en.read_many({&mid[s[0]], &mid[s[1]], &mid[s[2]], &mid[s[3]]}, BelowThreshold{&outs[r], &runs});
+      rt2.read_many({&mid[s[0]], &mid[s[1]], &mid[s[2]], &mid[s[3]]}, BelowThreshold{&outs[r], &runs});
     }
-    en.read_many({&outs[0], &outs[1], &outs[2], &outs[3]}, [&total](Engine& x, Vals v) {
+    rt2.read_many({&outs[0], &outs[1], &outs[2], &outs[3]}, [&total](Engine& rt3, Vals v) {
       int t = 0;
       for (const int* p : v) t = t * 10 + *p;
-      x.write(total, t);
+      rt3.write(total, t);
     });
   });
   const auto expected = [&] {
@@ -725,13 +725,13 @@ TEST(ReadManyProjection, MatchesFromScratchAfterEveryChange) {
     const int runs_before = runs;
     const auto m_before = effective();
     switch (rng() % 3) {
-      case 0: e.set(in[i], vin[i] = static_cast<int>(rng() % 20)); break;
-      case 1: e.set(sel[i], vsel[i] = 1 - vsel[i]); break;
-      default: e.set(mid[i], vmid[i] = static_cast<int>(rng() % 20)); break;
+      case 0: rt.set(in[i], vin[i] = static_cast<int>(rng() % 20)); break;
+      case 1: rt.set(sel[i], vsel[i] = 1 - vsel[i]); break;
+      default: rt.set(mid[i], vmid[i] = static_cast<int>(rng() % 20)); break;
     }
-    e.propagate();
+    rt.propagate();
     ASSERT_EQ(total.get(), expected()) << "change " << t;
-    e.check_invariants();
+    rt.check_invariants();
     cut += effective() != m_before && runs == runs_before;  // every mid[] is some read's slot
   }
   // The projections cut re-runs off: changes on the same side of every threshold.
@@ -756,29 +756,29 @@ TEST(ReadMany, AReexecutedWriteMovesTheReadsBeforeItsOldVersion) {
   int vsel = 3, vm = 1, va = 2;
   std::mt19937 rng(20261128);
   std::printf("seed 20261128\n");
-  Engine e;
-  e.set(sel, vsel);
-  e.set(m, vm);
-  e.set(a, va);
-  e.run([&](Engine& en) {
-    for (auto& o : early) en.read_many({&m, &a}, [&o](Engine& x, Vals v) { x.write(o, sum(v)); });
-    en.read(sel, [&](Engine& x, int s) {
-      x.read_many({&a, &m}, [&o1](Engine& y, Vals v) { y.write(o1, sum(v)); });
-      if (s % 4 == 1) x.read(m, [&o3](Engine& y, int z) { y.write(o3, z); });
+  Engine rt;
+  rt.set(sel, vsel);
+  rt.set(m, vm);
+  rt.set(a, va);
+  rt.run([&](Engine& rt2) {
+    for (auto& o : early) rt2.read_many({&m, &a}, [&o](Engine& rt3, Vals v) { rt3.write(o, sum(v)); });
+    rt2.read(sel, [&](Engine& rt3, int s) {
+      rt3.read_many({&a, &m}, [&o1](Engine& rt4, Vals v) { rt4.write(o1, sum(v)); });
+      if (s % 4 == 1) rt3.read(m, [&o3](Engine& rt4, int z) { rt4.write(o3, z); });
       if (s % 4 == 2)
-        for (auto& p : pad) x.write(p, s);
-      x.write(m, s);
-      x.read_many({&m, &a}, [&o2](Engine& y, Vals v) { y.write(o2, sum(v)); });
+        for (auto& p : pad) rt3.write(p, s);
+      rt3.write(m, s);
+      rt3.read_many({&m, &a}, [&o2](Engine& rt4, Vals v) { rt4.write(o2, sum(v)); });
     });
-    for (auto& o : late) en.read_many({&a, &m}, [&o](Engine& x, Vals v) { x.write(o, sum(v)); });
+    for (auto& o : late) rt2.read_many({&a, &m}, [&o](Engine& rt3, Vals v) { rt3.write(o, sum(v)); });
   });
   for (int t = 0; t < 300; ++t) {
     switch (rng() % 3) {
-      case 0: e.set(sel, vsel = static_cast<int>(rng() % 9)); break;
-      case 1: e.set(m, vm = static_cast<int>(rng() % 9)); break;
-      default: e.set(a, va = static_cast<int>(rng() % 9)); break;
+      case 0: rt.set(sel, vsel = static_cast<int>(rng() % 9)); break;
+      case 1: rt.set(m, vm = static_cast<int>(rng() % 9)); break;
+      default: rt.set(a, va = static_cast<int>(rng() % 9)); break;
     }
-    e.propagate();
+    rt.propagate();
     for (auto& o : early) ASSERT_EQ(o.get(), vm * 10 + va) << "change " << t;
     ASSERT_EQ(o1.get(), va * 10 + vm) << "change " << t;
     if (vsel % 4 == 1) {
@@ -786,7 +786,7 @@ TEST(ReadMany, AReexecutedWriteMovesTheReadsBeforeItsOldVersion) {
     }
     ASSERT_EQ(o2.get(), vsel * 10 + va) << "change " << t;
     for (auto& o : late) ASSERT_EQ(o.get(), va * 10 + vsel) << "change " << t;
-    e.check_invariants();
+    rt.check_invariants();
   }
 }
 
@@ -796,9 +796,9 @@ TEST(ReadMany, AReexecutedWriteMovesTheReadsBeforeItsOldVersion) {
 struct WholeValue {
   Mod<int>* out;
   int* runs;
-  void operator()(Engine& x, Vals v) const {
+  void operator()(Engine& rt, Vals v) const {
     ++*runs;
-    x.write(*out, *v[0]);
+    rt.write(*out, *v[0]);
   }
   bool affected(std::size_t, const int& before, const int& after) const { return before != after; }
 };
@@ -811,46 +811,46 @@ TEST(ReadManyLazy, AChangeUndoneBeforePropagationReachesAReadDoesNotRerunIt) {
   // again: a record per change would cost plain reads more than it saves).
   for (const bool projection : {true, false}) {
     Mod<int> sel, m, out;
-    Engine e;
-    e.set(sel, 0);
-    e.set(m, 0);
+    Engine rt;
+    rt.set(sel, 0);
+    rt.set(m, 0);
     int runs = 0;
-    e.run([&](Engine& en) {
-      en.read(sel, [&m](Engine& x, int s) {
-        if (s == 0) x.write(m, 7);
+    rt.run([&](Engine& rt2) {
+      rt2.read(sel, [&m](Engine& rt3, int s) {
+        if (s == 0) rt3.write(m, 7);
       });
-      en.read(sel, [&m](Engine& x, int s) {
-        if (s == 1) x.write(m, 7);
+      rt2.read(sel, [&m](Engine& rt3, int s) {
+        if (s == 1) rt3.write(m, 7);
       });
       if (projection)
-        en.read_many({&m}, WholeValue{&out, &runs});
+        rt2.read_many({&m}, WholeValue{&out, &runs});
       else
-        en.read(m, [&](Engine& x, int v) {
+        rt2.read(m, [&](Engine& rt3, int v) {
           ++runs;
-          x.write(out, v);
+          rt3.write(out, v);
         });
     });
     ASSERT_EQ(out.get(), 7);
     ASSERT_EQ(runs, 1);
-    e.set(sel, 1);
-    e.propagate();
+    rt.set(sel, 1);
+    rt.propagate();
     EXPECT_EQ(out.get(), 7);
     EXPECT_EQ(runs, projection ? 1 : 2);
-    EXPECT_EQ(e.stats().reads_unaffected, projection ? 1u : 0u);
-    e.check_invariants();
+    EXPECT_EQ(rt.stats().reads_unaffected, projection ? 1u : 0u);
+    rt.check_invariants();
     // Neither writes: R sees the base value and re-runs.
-    e.set(sel, 2);
-    e.propagate();
+    rt.set(sel, 2);
+    rt.propagate();
     EXPECT_EQ(out.get(), 0);
     EXPECT_EQ(runs, projection ? 2 : 3);
-    e.check_invariants();
+    rt.check_invariants();
     // A set() of the base value and back, before propagating: R saw 0, sees 0.
-    e.set(m, 5);
-    e.set(m, 0);
-    e.propagate();
+    rt.set(m, 5);
+    rt.set(m, 0);
+    rt.propagate();
     EXPECT_EQ(out.get(), 0);
     EXPECT_EQ(runs, projection ? 2 : 4);
-    e.check_invariants();
+    rt.check_invariants();
   }
 }
 
@@ -861,9 +861,9 @@ struct FollowingSum {
   int* runs;
   std::span<Mod<int>> pool;
   std::array<int, 4>* names;  // which pool member slot i reads: follow() keeps it (test-owned)
-  void operator()(Engine& x, Vals v) const {
+  void operator()(Engine& rt, Vals v) const {
     ++*runs;
-    x.write(*out, sum(v));
+    rt.write(*out, sum(v));
   }
   bool affected(std::size_t, const int& before, const int& after) const { return before != after; }
   const Mod<int>* follow(std::size_t i, const int& seen, const int&, const Engine::At& at) const {
@@ -879,33 +879,33 @@ struct FollowingSum {
 TEST(ReadManyFollow, AReadMovesToAModifiableThatHoldsWhatItSaw) {
   Mod<int> out;
   std::array<Mod<int>, 3> pool;
-  Engine e;
-  e.set(pool[0], 1);
-  e.set(pool[1], 2);
-  e.set(pool[2], 1);
+  Engine rt;
+  rt.set(pool[0], 1);
+  rt.set(pool[1], 2);
+  rt.set(pool[2], 1);
   int runs = 0;
   std::array<int, 4> names{0, 1, 0, 0};
-  e.run([&](Engine& en) { en.read_many({&pool[0], &pool[1]}, FollowingSum{&out, &runs, pool, &names}); });
+  rt.run([&](Engine& rt2) { rt2.read_many({&pool[0], &pool[1]}, FollowingSum{&out, &runs, pool, &names}); });
   ASSERT_EQ(out.get(), 12);
   // pool[0] becomes 5: slot 0 saw 1, which pool[2] holds: it reads pool[2], no re-run.
-  e.set(pool[0], 5);
-  e.propagate();
+  rt.set(pool[0], 5);
+  rt.propagate();
   EXPECT_EQ(runs, 1);
   EXPECT_EQ(out.get(), 12);
-  EXPECT_EQ(e.stats().reads_followed, 1u);
+  EXPECT_EQ(rt.stats().reads_followed, 1u);
   EXPECT_EQ(names[0], 2);
-  e.check_invariants();
+  rt.check_invariants();
   // pool[0] is no longer read ...
-  e.set(pool[0], 6);
-  e.propagate();
+  rt.set(pool[0], 6);
+  rt.propagate();
   EXPECT_EQ(runs, 1);
   EXPECT_EQ(out.get(), 12);
   // ... pool[2] is: 3 is held by no pool member (follow() says null), so it re-runs.
-  e.set(pool[2], 3);
-  e.propagate();
+  rt.set(pool[2], 3);
+  rt.propagate();
   EXPECT_EQ(runs, 2);
   EXPECT_EQ(out.get(), 32);
-  e.check_invariants();
+  rt.check_invariants();
 }
 
 TEST(ReadManyFollow, MatchesTheValuesOfTheModifiablesItNamesAfterEveryChange) {
@@ -919,26 +919,26 @@ TEST(ReadManyFollow, MatchesTheValuesOfTheModifiablesItNamesAfterEveryChange) {
   std::array<int, kN> vin{}, vsel{}, vmid{};
   std::mt19937 rng(20261129);
   std::printf("seed 20261129\n");
-  Engine e;
+  Engine rt;
   for (int i = 0; i < kN; ++i) {
     vin[i] = static_cast<int>(rng() % 6);
     vsel[i] = static_cast<int>(rng() % 2);
     vmid[i] = static_cast<int>(rng() % 6);
-    e.set(in[i], vin[i]);
-    e.set(sel[i], vsel[i]);
-    e.set(mid[i], vmid[i]);
+    rt.set(in[i], vin[i]);
+    rt.set(sel[i], vsel[i]);
+    rt.set(mid[i], vmid[i]);
   }
   int runs = 0;
   std::array<std::array<int, 4>, kReads> names{};
-  e.run([&](Engine& en) {
+  rt.run([&](Engine& rt2) {
     for (int i = 0; i < kN; ++i)
-      en.read(sel[i], [&, i](Engine& x, int s) {
-        if (s) x.read(in[i], [&, i](Engine& y, int v) { y.write(mid[i], v); });
+      rt2.read(sel[i], [&, i](Engine& rt3, int s) {
+        if (s) rt3.read(in[i], [&, i](Engine& rt4, int v) { rt4.write(mid[i], v); });
       });
     for (int r = 0; r < kReads; ++r) {
       names[r] = {r, (r + 1) % kN, (r + 3) % kN, (r + 5) % kN};
       const auto& s = names[r];
-      en.read_many({&mid[s[0]], &mid[s[1]], &mid[s[2]], &mid[s[3]]},
+      rt2.read_many({&mid[s[0]], &mid[s[1]], &mid[s[2]], &mid[s[3]]},
                    FollowingSum{&outs[r], &runs, std::span<Mod<int>>(mid), &names[r]});
     }
   });
@@ -955,14 +955,14 @@ TEST(ReadManyFollow, MatchesTheValuesOfTheModifiablesItNamesAfterEveryChange) {
   for (int t = 0; t < 400; ++t) {
     const int i = static_cast<int>(rng() % kN);
     switch (rng() % 3) {
-      case 0: e.set(in[i], vin[i] = static_cast<int>(rng() % 6)); break;
-      case 1: e.set(sel[i], vsel[i] = 1 - vsel[i]); break;
-      default: e.set(mid[i], vmid[i] = static_cast<int>(rng() % 6)); break;
+      case 0: rt.set(in[i], vin[i] = static_cast<int>(rng() % 6)); break;
+      case 1: rt.set(sel[i], vsel[i] = 1 - vsel[i]); break;
+      default: rt.set(mid[i], vmid[i] = static_cast<int>(rng() % 6)); break;
     }
-    e.propagate();
+    rt.propagate();
     check(t);
-    e.check_invariants();
+    rt.check_invariants();
   }
-  std::printf("%llu slots followed, %d runs\n", static_cast<unsigned long long>(e.stats().reads_followed), runs);
-  EXPECT_GT(e.stats().reads_followed, 0u);
+  std::printf("%llu slots followed, %d runs\n", static_cast<unsigned long long>(rt.stats().reads_followed), runs);
+  EXPECT_GT(rt.stats().reads_followed, 0u);
 }

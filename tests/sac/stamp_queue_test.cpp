@@ -34,15 +34,15 @@
 
 namespace {
 
-using sac::OrderList;
-using sac::Stamp;
-using sac::StampKind;
+using sac::detail::OrderList;
+using sac::detail::Stamp;
+using sac::detail::StampKind;
 
 constexpr int kScale = SAC_SQ_TEST_SANITIZED ? 4 : 1;
 
 struct Elem {
   Stamp stamp;
-  std::uint32_t qpos = sac::kNotQueued;
+  std::uint32_t qpos = sac::detail::kNotQueued;
   int id = 0;
 };
 
@@ -52,7 +52,7 @@ struct ElemTraits {
   static std::uint32_t pos(const Elem* e) { return e->qpos; }
 };
 
-using Queue = sac::StampQueue<Elem, ElemTraits>;
+using Queue = sac::detail::StampQueue<Elem, ElemTraits>;
 
 /// Elements, their order list and the reference order.
 class World {
@@ -128,7 +128,7 @@ void run_random(std::uint64_t seed, int n_elems, int ops, bool relabel_heavy) {
         Elem* got = q.pop();
         ASSERT_EQ(got, expect);
         ASSERT_FALSE(q.contains(got));
-        ASSERT_EQ(got->qpos, sac::kNotQueued);
+        ASSERT_EQ(got->qpos, sac::detail::kNotQueued);
         model.erase(model.begin());
       }
     } else if (r < 90) {
@@ -229,7 +229,7 @@ TEST(StampQueue, AuxValuesStayWithTheirElements) {
   std::vector<int> ids;
   for (int i = 0; i < 300; ++i) ids.push_back(w.add_after(ids.empty() ? -1 : ids[rng() % ids.size()]));
   const std::vector<int> rank = w.ranks();
-  sac::StampQueue<Elem, ElemTraits, long> q(w.ol);
+  sac::detail::StampQueue<Elem, ElemTraits, long> q(w.ol);
   std::shuffle(ids.begin(), ids.end(), rng);
   for (int id : ids) q.push(w.elem(id), 1000L + id);
   for (std::size_t i = 0; i < ids.size(); i += 3) q.remove(w.elem(ids[i]));

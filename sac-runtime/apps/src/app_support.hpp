@@ -74,14 +74,14 @@ class ListApp : public App {
     plain_dirty_ = true;
   }
 
-  sac::Engine& engine() override { return state().engine; }
+  sac::Engine& engine() override { return state().rt; }
 
  protected:
   struct State {
-    sac::Engine engine;
+    sac::Engine rt;
     InputList<Value> input;
     Out out;  // written by the computation
-    explicit State(const std::vector<Value>& values) : input(engine, values) {}
+    explicit State(const std::vector<Value>& values) : input(rt, values) {}
   };
 
   /// A new, empty app of the same kind (for clone_current).
@@ -100,7 +100,7 @@ class ListApp : public App {
   template <class F>
   void run_from_scratch(F body) {
     State& s = state();
-    s.engine.run([&](sac::Engine& rt) { body(rt, s); });
+    s.rt.run([&](sac::Engine& rt) { body(rt, s); });
   }
 
   /// The current input as a plain linked list (rebuilt after changes, outside timing when

@@ -79,7 +79,7 @@ void DiameterApp::run_conventional() { conventional_ = diameter_conventional(pla
 void DiameterApp::run_self_adjusting() {
   begin_run();
   out_ = std::make_unique<sac::Mod<double>>();
-  engine_->run([this](sac::Engine& rt) { diameter(rt, input_->head(), out_.get()); });
+  rt_->run([this](sac::Engine& rt) { diameter(rt, input_->head(), out_.get()); });
 }
 
 bool DiameterApp::verify() {

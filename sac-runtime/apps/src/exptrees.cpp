@@ -69,8 +69,8 @@ Value evaluate_conventional(const Shape& shape, const std::vector<bool>& present
   return v;
 }
 
-ExpTree::ExpTree(sac::Engine& e, Shape shape, std::vector<bool> present)
-    : engine_(&e), shape_(std::move(shape)), present_(std::move(present)) {
+ExpTree::ExpTree(sac::Engine& rt, Shape shape, std::vector<bool> present)
+    : rt_(&rt), shape_(std::move(shape)), present_(std::move(present)) {
   const std::size_t n = shape_.op.size();
   if (present_.size() != shape_.leaves) throw std::invalid_argument("ExpTree: presence size");
   nodes_.reserve(n);
@@ -80,18 +80,18 @@ ExpTree::ExpTree(sac::Engine& e, Shape shape, std::vector<bool> present)
     nodes_.push_back(std::make_unique<Node>(shape_.op[k]));
     Node* x = nodes_.back().get();
     if (k < shape_.leaves) {
-      engine_->set(x->value, shape_.value[k]);
+      rt_->set(x->value, shape_.value[k]);
       rep_[k] = present_[k] ? x : nullptr;
       continue;
     }
     for (int side = 0; side < 2; ++side) {  // operands come first (post order)
       const std::size_t c = shape_.operands[k][side];
       parent_[c] = k;
-      engine_->set(x->child[side], rep_[c]);
+      rt_->set(x->child[side], rep_[c]);
     }
     rep_[k] = representative(k);
   }
-  engine_->set(root_, n ? rep_[n - 1] : nullptr);
+  rt_->set(root_, n ? rep_[n - 1] : nullptr);
 }
 
 Node* ExpTree::representative(std::size_t k) const {
@@ -107,11 +107,11 @@ void ExpTree::relink(std::size_t k) {
   for (;;) {
     const std::size_t p = parent_[k];
     if (p == kNone) {
-      engine_->set(root_, rep_[k]);
+      rt_->set(root_, rep_[k]);
       return;
     }
     const int side = shape_.operands[p][0] == k ? 0 : 1;
-    engine_->set(nodes_[p]->child[side], rep_[k]);
+    rt_->set(nodes_[p]->child[side], rep_[k]);
     Node* r = representative(p);
     if (r == rep_[p]) return;
     rep_[p] = r;
@@ -135,7 +135,7 @@ void ExpTree::reinsert(std::size_t leaf) {
 
 void ExpTree::set_value(std::size_t leaf, Value v) {
   shape_.value.at(leaf) = v;
-  engine_->set(nodes_[leaf]->value, v);
+  rt_->set(nodes_[leaf]->value, v);
 }
 
 }  // namespace sacapps::exptrees
@@ -165,7 +165,7 @@ class ExpTreesApp final : public App {
 
   void run_self_adjusting() override {
     State& s = state();
-    s.engine.run([&](sac::Engine& rt) { eval_tree(rt, s.tree.root(), &s.out); });
+    s.rt.run([&](sac::Engine& rt) { eval_tree(rt, s.tree.root(), &s.out); });
   }
 
   std::size_t positions() const override { return state().tree.leaves(); }
@@ -182,15 +182,15 @@ class ExpTreesApp final : public App {
            s.out.get() == evaluate_conventional(s.tree.shape(), s.tree.presence());
   }
 
-  sac::Engine& engine() override { return state().engine; }
+  sac::Engine& engine() override { return state().rt; }
 
  private:
   struct State {
-    sac::Engine engine;
+    sac::Engine rt;
     ExpTree tree;
     sac::Mod<Value> out;  // written by the computation
     State(Shape shape, std::vector<bool> present)
-        : tree(engine, std::move(shape), std::move(present)) {}
+        : tree(rt, std::move(shape), std::move(present)) {}
   };
 
   State& state() {

@@ -4,6 +4,8 @@
 
 #include <utility>
 
+#include "sac/splitmix64.hpp"
+
 #include "sacapps/contraction.hpp"
 #include "sacapps/partition.hpp"
 
@@ -155,8 +157,9 @@ std::vector<Site> quickhull_conventional(const std::vector<Site>& points) {
 
 Point PointApp::draw(std::uint64_t seed) const {
   auto unit = [](std::uint64_t x) { return static_cast<double>(x >> 11) * 0x1.0p-53; };  // [0, 1)
-  for (std::uint64_t k = 0;; ++k) {
-    const std::uint64_t r = sac::mix64(seed + (k + 1) * 0x9e3779b97f4a7c15ULL);
+  std::uint64_t state = seed;  // the k-th try draws the k-th output of splitmix64(seed)
+  for (;;) {
+    const std::uint64_t r = sac::splitmix64(state);
     const Point p{unit(r), unit(sac::mix64(r))};
     if (distribution_ == Distribution::Square) return p;
     const double x = 2 * p.x - 1, y = 2 * p.y - 1;  // rejection sampling in the unit disk
@@ -185,7 +188,7 @@ void QuickhullApp::run_conventional() { conventional_ = quickhull_conventional(p
 void QuickhullApp::run_self_adjusting() {
   begin_run();
   out_ = std::make_unique<PointList>();
-  engine_->run([this](sac::Engine& rt) { quickhull(rt, input_->head(), out_.get()); });
+  rt_->run([this](sac::Engine& rt) { quickhull(rt, input_->head(), out_.get()); });
 }
 
 bool QuickhullApp::verify() {

@@ -8,6 +8,7 @@
 // a loop may opt in to more.
 // Invariants: chunk_cache_bytes() ≤ chunk_cache_limit() at every return of these functions.
 // Complexity: O(cached chunks) per call; thread-safe.
+// Paper: docs/DESIGN.md, "The runtime".
 #pragma once
 
 #include <cstddef>

@@ -1,11 +1,13 @@
-// sac/engine.hpp — the self-adjusting computation engine.
+// sac/engine.hpp — the self-adjusting computation engine: the facade.
 //
 // Purpose: run an ordinary-looking program once from scratch while recording its trace, then
 // after input changes bring every output to exactly what a from-scratch run would produce,
 // re-executing only the affected reads (change propagation). The model is Acar's imperative
-// self-adjusting computation (Acar, Ahmed, Blume POPL'08; Hammer, Acar, Chen "CEAL",
-// PLDI'09), as a C++ library without a compiler:
+// self-adjusting computation, as a C++ library without a compiler:
 //
+//   rt.run(f)               run f(rt) from scratch, recording its trace.
+//   rt.set(m, v)            change an input (outside the computation).
+//   rt.propagate()          bring the trace and every output up to date with the inputs.
 //   rt.read(m, body)        record a read of m over the interval of body(value); on change,
 //                           body is re-run in its own interval.
 //   rt.write(m, v)          add a version of m at the current time (cut off if equal).
@@ -21,6 +23,12 @@
 //                           with body.affected(i, before, after), a read of a projection.
 //   rt.current(m)           the value of m an enclosing read already depends on, unrecorded.
 //   rt.peek(m)              the value of m visible now, unrecorded: a guess for a prefetch.
+//   rt.stats()              event counts and trace distance (sac/stats.hpp).
+//
+// The class below lists that API first; the calls only some programs need (init,
+// init_default, unused, retire, set_context, At, order) follow under "Advanced". Template
+// bodies are in sac/detail/engine_impl.hpp, the machinery (records, ops tables, order list,
+// queue, pool, trampoline) in sac/detail/, the non-template code in src/.
 //
 // Execution is trampolined, so deep recursion (a read chain a million long) never grows the
 // C++ stack: read/memo_read/memo calls are recorded when issued and run after the issuing
@@ -33,14 +41,32 @@
 // (Engine&, const T&) or (const T&); memoized closures must be equality comparable and
 // hashable (use sac::fn<f>(args...)).
 //
-// Invariants (check_invariants()): the order list, queue and tables are valid; the trace is
-// well nested (every read's interval contains exactly the events its body created); every
-// live read (each slot of a multi-read) is attached to the version visible at its start
-// time, and a multi-read's own link to none; a version's ordered readers are newest first;
-// versions of a modifiable are ordered by time; every memo entry and keyed allocation is in
-// its table; outside propagate() the queue is empty. Built with the CMake option
-// SAC_DEBUG_CHECKS, propagate() runs the check at its end and throws InvariantError on a
-// violation.
+// Invariants (check_invariants() checks each and names its number; built with the CMake
+// option SAC_DEBUG_CHECKS, propagate() runs the check at its end and throws InvariantError on
+// a violation):
+//   I1. The order list, the queue and the memo and allocation tables each satisfy their own
+//       invariants — because every "happens before" test and every match rests on them.
+//   I2. The trace is well nested: every read's and memo entry's interval is closed, its end
+//       after its start, and contains exactly the events its body created — because undoing
+//       an interval must remove exactly what re-running its body recreates, and a memo hit
+//       reuses exactly one call's events.
+//   I3. A modifiable's versions are ordered newest first, strictly decreasing in time, and a
+//       base version, if any, is the oldest — because visible() walks them from the newest and
+//       stops at the first one not after the reader.
+//   I4. Every live read (each slot of a multi-read) hangs on the version of its modifiable
+//       visible at its start time, exactly once, or on the modifiable itself when it sees a
+//       default and the modifiable has no version; a multi-read's own link hangs on nothing —
+//       because a write finds the reads it affects among its older version's readers only,
+//       never by a search of the trace.
+//   I5. A version's ordered readers are newest first, its unordered ones in no order, and each
+//       reader's flag names its list — because link_write takes the readers after a time as
+//       all the unordered ones and a prefix of the ordered ones.
+//   I6. Every live keyed allocation and memo entry is in its table, the tables hold nothing
+//       undone, and stats().live_events counts the live events — because matching looks only
+//       in the tables, and the statistics are part of the contract.
+//   I7. Outside propagate() the queue is empty and nothing waits to be freed (undone
+//       allocations, undone versions, seen lists) — because a read left queued would be an
+//       output left stale, and a deferred record a leak between updates.
 // Complexity: read/write/alloc O(1) amortized plus the version walk of the touched
 // modifiable; a write inside propagate() also finds the older version's readers timed after
 // it: by walking the trace up to the next version when that is at most 64 events away (a
@@ -53,18 +79,15 @@
 // the way: the queue keeps, per changed slot, the version it had seen (undone versions, and
 // the old values set() replaced, are then freed when propagate() ends), so a change undone
 // or redone before its time costs no re-execution.
-// The machinery (records, ops tables, order list, queue, pool, trampoline) is in sac/detail/.
+// Paper: Acar, Ahmed, Blume, "Imperative self-adjusting computation" (POPL'08); Hammer, Acar,
+// Chen, "CEAL" (PLDI'09); docs/DESIGN.md, "The runtime".
 #pragma once
 
-#include <concepts>
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
 #include <iosfwd>
-#include <new>
 #include <span>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 #include "sac/detail/intrusive_hash.hpp"
@@ -91,41 +114,20 @@ class Engine {
   Engine(const Engine&) = delete;
   Engine& operator=(const Engine&) = delete;
 
+  // ======================================================================================
+  //   The API
+  // ======================================================================================
+
   // ---------------------------------------------------------------- mutator
-  /// Sets the base (input) value of m. Outside the computation only. Readers of the old
-  /// base value are affected unless the value is equal.
-  template <class T, class U>
-  void set(Mod<T>& m, U&& value);
-
-  /// Releases m's base version so that m's storage may be reused. m must have no readers
-  /// and no versions written by the computation.
-  void retire(ModBase& m);
-
-  /// Gives a never-written m a base value, as set() before the first run would. Unlike
-  /// set() it may also be called inside the computation: it serves modifiables that are
-  /// named lazily outside the trace (a directory keyed by name), which every run, fresh or
-  /// re-executing, would find with the same default. UsageError if m is already written.
-  template <class T, class U>
-  void init(Mod<T>& m, U&& value);
-
-  /// Gives a never-written m the default T{}: what a read sees when no version of m
-  /// precedes it. Costs no memory of its own: while m has no version, the reads that see
-  /// the default hang on m itself; once m has a version too, the default becomes a base
-  /// version (as init(m, T{}) would have made). So modifiables named by the thousands
-  /// outside the trace (a directory's cells, the ends of lists) hold nothing for their
-  /// defaults. May be called inside the computation, like init(). UsageError if m is
-  /// already written. As for any modifiable, m must outlive the reads of it (unused()
-  /// says when nothing refers to it).
-  template <class T>
-  void init_default(Mod<T>& m);
-
-  /// True when nothing in the trace refers to m: it has no version written by the
-  /// computation and no reader (it may then be retired).
-  bool unused(const ModBase& m) const noexcept;
+  // Outside the computation only (UsageError otherwise).
 
   /// Runs f(Engine&) (or f()) from scratch, appending its trace after earlier runs.
   template <class F>
   void run(F&& f);
+
+  /// Sets the base (input) value of m; readers of the old value are affected unless equal.
+  template <class T, class U>
+  void set(Mod<T>& m, U&& value);
 
   /// Brings the trace and all outputs up to date with the changed inputs.
   void propagate();
@@ -179,26 +181,9 @@ class Engine {
   /// at.value() apart.
   template <class T, class F>
   void read_many(std::span<const Mod<T>* const> mods, F&& body);
-
-  /// The time of a read whose closure follow() is asked (read_many): the values there.
-  class At {
-   public:
-    At(const Engine& e, const detail::ReadNode* r) : e_(&e), r_(r) {}
-    /// The value of m visible at the read's time; null when m has no version there.
-    template <class T>
-    const T* value(const Mod<T>& m) const {
-      const detail::VersionBase* v = e_->visible(m, &r_->start);
-      return v ? &static_cast<const detail::Version<T>*>(v)->value : nullptr;
-    }
-
-   private:
-    const Engine* e_;
-    const detail::ReadNode* r_;
-  };
+  /// read_many over a braced list of modifiables.
   template <class T, class F>
-  void read_many(std::initializer_list<const Mod<T>*> mods, F&& body) {
-    read_many(std::span<const Mod<T>* const>(mods.begin(), mods.size()), std::forward<F>(body));
-  }
+  void read_many(std::initializer_list<const Mod<T>*> mods, F&& body);
 
   /// The value of m visible now, recording nothing. Only for a value the running body
   /// already depends on: m was read by an enclosing read (plain or multi) of this body, and
@@ -252,51 +237,98 @@ class Engine {
   template <class F>
   void memo_near(std::uint32_t max_skip, F&& f);
 
-  // ---------------------------------------------------------------- context
-  /// Gives the computation a context: a pointer its bodies reach through the Engine
-  /// (context<T>()) instead of carrying it in every closure, for what is the same for the
-  /// whole computation (a program object and its tables). One per engine; the mutator sets
-  /// it, before run(), and it must not change while the trace depends on it.
-  template <class T>
-  void set_context(T* c) noexcept {
-    context_ = c;
-    context_type_ = &detail::kTypeTag<T>;
-  }
   /// The pointer set_context<T>() gave. UsageError if none was given, or one of another type.
   template <class T>
-  T* context() const {
-    if (context_type_ != &detail::kTypeTag<T>) throw_bad_context();
-    return static_cast<T*>(context_);
-  }
+  T* context() const;
 
-  // ---------------------------------------------------------------- introspection
+  // ---------------------------------------------------------------- statistics
+  /// Event counts, trace distance and queue work since the engine was made (sac/stats.hpp).
   const Stats& stats() const { return stats_; }
+  /// The number of events in the trace now.
+  std::uint64_t live_events() const { return stats_.live_events; }
   /// Bytes held by the trace: records, closures, versions, tables, order-list groups, queue.
   std::size_t trace_bytes() const;
   /// Bytes of the base (input) versions set by the mutator; not part of the trace.
   std::size_t input_bytes() const { return input_bytes_; }
   /// Bytes of live trace records only (exactly equal for equal traces; no table slack).
   std::size_t record_bytes() const { return pool_.live_bytes() - input_bytes_; }
-  std::uint64_t live_events() const { return stats_.live_events; }
   /// trace_bytes() by record kind and side structure, and what it leaves out (base
   /// versions, pool slack); see sac/memory_breakdown.hpp. Outside the computation only.
   /// O(live events + base versions).
   MemoryBreakdown memory_breakdown() const;
+  /// True inside run() or propagate().
   bool in_computation() const { return in_computation_; }
+  /// True once a body threw: the engine then refuses every call but destruction.
   bool poisoned() const { return poisoned_; }
-  const OrderList& order() const { return order_; }
 
-  /// Checks every structure (order list, queue, trace, memo and allocation tables); throws
-  /// InvariantError on the first violation. Outside the computation only. O(trace size).
+  /// Checks invariants I1-I7 (see the header); throws InvariantError naming the first
+  /// violation. Outside the computation only. O(trace size).
   void check_invariants() const;
 
   /// Writes the trace as a Graphviz digraph (intended for small traces).
   void dump_dot(std::ostream& os) const;
 
+  // ======================================================================================
+  //   Advanced: for programs that name modifiables outside the trace, share a context, or
+  //   follow a read's values (read_many), and for tests of the machinery.
+  // ======================================================================================
+
+  /// Gives a never-written m a base value, as set() before the first run would. Unlike
+  /// set() it may also be called inside the computation: it serves modifiables that are
+  /// named lazily outside the trace (a directory keyed by name), which every run, fresh or
+  /// re-executing, would find with the same default. UsageError if m is already written.
+  template <class T, class U>
+  void init(Mod<T>& m, U&& value);
+
+  /// Gives a never-written m the default T{}: what a read sees when no version of m
+  /// precedes it. Costs no memory of its own: while m has no version, the reads that see
+  /// the default hang on m itself; once m has a version too, the default becomes a base
+  /// version (as init(m, T{}) would have made). So modifiables named by the thousands
+  /// outside the trace (a directory's cells, the ends of lists) hold nothing for their
+  /// defaults. May be called inside the computation, like init(). UsageError if m is
+  /// already written. As for any modifiable, m must outlive the reads of it (unused()
+  /// says when nothing refers to it).
+  template <class T>
+  void init_default(Mod<T>& m);
+
+  /// True when nothing in the trace refers to m: it has no version written by the
+  /// computation and no reader (it may then be retired).
+  bool unused(const ModBase& m) const noexcept;
+
+  /// Releases m's base version so that m's storage may be reused. m must have no readers
+  /// and no versions written by the computation.
+  void retire(ModBase& m);
+
+  /// Gives the computation a context: a pointer its bodies reach through the Engine
+  /// (context<T>()) instead of carrying it in every closure, for what is the same for the
+  /// whole computation (a program object and its tables). One per engine; the mutator sets
+  /// it, before run(), and it must not change while the trace depends on it.
+  template <class T>
+  void set_context(T* ctx) noexcept;
+
+  /// The time of a read whose closure follow() is asked (read_many): the values there.
+  class At {
+   public:
+    At(const Engine& rt, const detail::ReadNode* r) : rt_(&rt), r_(r) {}
+    /// The value of m visible at the read's time; null when m has no version there.
+    template <class T>
+    const T* value(const Mod<T>& m) const;
+
+   private:
+    const Engine* rt_;
+    const detail::ReadNode* r_;
+  };
+
+  /// The order list of the trace's stamps (for tests and tools).
+  const detail::OrderList& order() const { return order_; }
+
  private:
   // Test-only hook: tests/sac/engine_test.cpp defines it to corrupt one part of the trace
   // and see check_invariants() fail. Nothing else may define it.
   friend struct EngineTestAccess;
+
+  using Stamp = detail::Stamp;
+  using StampKind = detail::StampKind;
 
   static constexpr std::uint32_t kSeenNone = 0xffffffffu;
   /// What a queued read waits with, in 8 bytes (a heap entry stays 16): a plain read, the
@@ -324,7 +356,7 @@ class Engine {
     std::uintptr_t bits_ = 0;
   };
   static_assert(sizeof(std::uintptr_t) == 8);
-  using ReadQueue = StampQueue<detail::ReadNode, detail::ReadQueueTraits, QueueAux>;
+  using ReadQueue = detail::StampQueue<detail::ReadNode, detail::ReadQueueTraits, QueueAux>;
   /// A slot of a queued read whose value changed after its last execution, and the version
   /// it had seen then (or one equal to it in what the read depends on).
   struct Seen {
@@ -353,29 +385,10 @@ class Engine {
   void deallocate(void* p, std::size_t n) noexcept { pool_.deallocate(p, n); }
   /// A record of type N from the pool; the memory goes back if the constructor throws.
   template <class N, class... A>
-  N* construct(A&&... args) {
-    static_assert(alignof(N) <= detail::Pool::kGrain, "record over-aligned");
-    void* mem = allocate(sizeof(N));
-    try {
-      return new (mem) N(std::forward<A>(args)...);
-    } catch (...) {
-      deallocate(mem, sizeof(N));
-      throw;
-    }
-  }
+  N* construct(A&&... args);
   /// Destroys a record through its ops table and returns its memory.
   template <class Rec>
-  void destroy(Rec* r) noexcept {
-    if constexpr (std::is_base_of_v<detail::ReadNode, Rec>) {
-      const std::size_t n = read_size(r);
-      r->ops()->destroy(r);
-      deallocate(r, n);
-    } else {
-      const auto* ops = r->ops;
-      ops->destroy(r);
-      deallocate(r, ops->size);
-    }
-  }
+  void destroy(Rec* r) noexcept;
   /// The bytes of a read record: a multi-read's grow with its slots.
   static std::size_t read_size(const detail::ReadNode* r) {
     const detail::ReadOps* ops = r->ops();
@@ -425,15 +438,6 @@ class Engine {
   /// `tail` (a chain, or null); empties order_scratch_. O(order_scratch_ + the run up to the
   /// last of those), plus the run's length when tail is not null.
   void link_merged(detail::ReaderLink** at, detail::ReaderLink* run, detail::ReaderLink* tail);
-  /// Hangs r, a read at its start's time, on v: at the head of v's ordered readers when it
-  /// is at the trace's end (every from-scratch read) or v has none, else on v's unordered
-  /// readers. Testing r against the head's time instead costs a cache miss per read that
-  /// re-execution adds, and most of them land among older readers anyway; link_write folds
-  /// the unordered readers it tests into order.
-  static void attach_timed(detail::ReaderLink* r, detail::VersionBase* v) {
-    if (!v->readers || detail::owner_of(r)->start.next() == nullptr) attach(r, v);
-    else attach_unordered(r, v);
-  }
   void unlink_version(ModBase* m, detail::VersionBase* v);  // v a version of m
   void link_alloc(detail::AllocNode* n, std::size_t h);
   void link_memo(detail::MemoNode* n, std::size_t h);
@@ -491,7 +495,7 @@ class Engine {
   /// Hangs r on what it sees, v (from visible_or_default).
   static void attach_seen(detail::ReaderLink* r, const ModBase& m, const detail::VersionBase* v) {
     if (m.default_only()) attach_default(r, m);
-    else attach_timed(r, const_cast<detail::VersionBase*>(v));
+    else detail::attach_timed(r, const_cast<detail::VersionBase*>(v));
   }
   /// m's default made into its base version, if m has a default (init_default) and no base
   /// version yet (m's default readers move onto it); else null. `defaulted`: whether m has
@@ -505,50 +509,14 @@ class Engine {
   bool in_window(const Stamp* start, const Stamp* end) const {
     return order_.less(now_, start) && order_.less(end, window_end_);
   }
-  /// Hangs r at the head of v's ordered readers (the caller knows it is the newest).
-  static void attach(detail::ReaderLink* r, detail::VersionBase* v) { push_reader(r, &v->readers, 0); }
-  static void attach_unordered(detail::ReaderLink* r, detail::VersionBase* v) {
-    push_reader(r, &v->unordered_readers, 1);
-  }
-  static void push_reader(detail::ReaderLink* r, detail::ReaderLink** head, std::uint16_t unordered) {
-    r->rnext = *head;
-    if (*head) (*head)->rpprev = &r->rnext;
-    *head = r;
-    r->rpprev = head;
-    r->unordered = unordered;
-  }
-  /// The first of a modifiable's default readers has this bit in its rpprev, which then
-  /// points at the modifiable's head_ (whose kDefaultOnly mark a plain store would lose).
-  static constexpr std::uintptr_t kHeadLink = 1;
   /// Hangs r on m's default (m has a default and no version).
   static void attach_default(detail::ReaderLink* r, const ModBase& m) {
     ModBase& w = const_cast<ModBase&>(m);
-    detail::ReaderLink* first = w.default_readers();
-    r->rnext = first;
-    if (first) first->rpprev = &r->rnext;
-    w.head_ = reinterpret_cast<std::uintptr_t>(r) | ModBase::kDefaultOnly;
-    r->rpprev = reinterpret_cast<detail::ReaderLink**>(reinterpret_cast<std::uintptr_t>(&w.head_) | kHeadLink);
-  }
-  /// The modifiable whose default r hangs on, if r is the first of its default readers.
-  static const ModBase* default_head(const detail::ReaderLink* r) {
-    const auto pp = reinterpret_cast<std::uintptr_t>(r->rpprev);
-    return (pp & kHeadLink) ? reinterpret_cast<const ModBase*>(pp & ~kHeadLink) : nullptr;
-  }
-  static void detach(detail::ReaderLink* r) {
-    if (!r->rpprev) return;
-    const auto pp = reinterpret_cast<std::uintptr_t>(r->rpprev);
-    if (pp & kHeadLink)
-      *reinterpret_cast<std::uintptr_t*>(pp & ~kHeadLink) =
-          reinterpret_cast<std::uintptr_t>(r->rnext) | ModBase::kDefaultOnly;
-    else
-      *r->rpprev = r->rnext;
-    if (r->rnext) r->rnext->rpprev = r->rpprev;
-    r->rpprev = nullptr;
-    r->rnext = nullptr;
+    detail::push_default_reader(r, &w.head_, w.default_readers());
   }
 
   detail::Pool pool_;
-  OrderList order_;
+  detail::OrderList order_;
   ReadQueue queue_{order_};
   detail::IntrusiveHash<detail::AllocNode> allocs_;
   detail::IntrusiveHash<detail::MemoNode> memos_;
@@ -585,204 +553,7 @@ class Engine {
   std::size_t input_bytes_ = 0;
 };
 
-// ------------------------------------------------------------------ templates
-
-template <class T, class U>
-void Engine::set(Mod<T>& m, U&& value) {
-  require_mutator("set");
-  using V = detail::Version<T>;
-  V* v = construct<V>(std::forward<U>(value));
-  v->ops = &detail::VersionOpsFor<T>::ops;
-  // set_base compares the values first (VersionOps::equal): this only moves.
-  set_base(m, v, [](detail::VersionBase* old_base, detail::VersionBase* fresh) {
-    auto* o = static_cast<V*>(old_base);
-    auto* f = static_cast<V*>(fresh);
-    if constexpr (std::is_swappable_v<T>) {
-      using std::swap;
-      swap(o->value, f->value);
-      return true;
-    } else {
-      o->value.~T();
-      new (&o->value) T(std::move(f->value));
-      return false;
-    }
-  });
-}
-
-template <class T, class U>
-void Engine::init(Mod<T>& m, U&& value) {
-  if (m.written()) throw UsageError("sac::Engine::init: the modifiable is already written");
-  using V = detail::Version<T>;
-  V* v = construct<V>(std::forward<U>(value));
-  v->ops = &detail::VersionOpsFor<T>::ops;
-  set_base(m, v, nullptr);  // no base yet, so nothing to compare with
-}
-
-template <class T>
-void Engine::init_default(Mod<T>& m) {
-  static_assert(std::is_default_constructible_v<T>, "init_default needs a default-constructible T");
-  if (m.written()) throw UsageError("sac::Engine::init_default: the modifiable is already written");
-  m.head_ = ModBase::kDefaultOnly;
-}
-
-template <class F>
-void Engine::run(F&& f) {
-  require_mutator("run");
-  in_computation_ = true;
-  now_ = tail_;
-  window_end_ = nullptr;
-  try {
-    exec_body([&] { detail::call_thunk(f, *this); });
-    drain(0);
-  } catch (...) {
-    poison();
-    throw;
-  }
-  index_pending_allocs();
-  order_.trim();
-  tail_ = now_;
-  now_ = nullptr;
-  in_computation_ = false;
-}
-
-template <class T, class F>
-void Engine::read(const Mod<T>& m, F&& body) {
-  using Fn = std::decay_t<F>;
-  using N = detail::ReadNodeT<Fn>;
-  require_computation("read");
-  N* r = construct<N>(std::forward<F>(body));
-  r->link.issued_mod = &m;
-  r->link.ops_id = static_cast<std::uint16_t>(detail::ReadOpsFor<T, Fn>::id());
-  r->link.qpos = kNotQueued;
-  issue(TaskKind::ExecRead, r);
-}
-
-template <class T, class F>
-void Engine::read_many(std::span<const Mod<T>* const> mods, F&& body) {
-  using Fn = std::decay_t<F>;
-  using H = detail::ReadManyHeader;
-  static_assert(alignof(Fn) <= detail::Pool::kGrain, "closure over-aligned");
-  require_computation("read_many");
-  const std::size_t k = mods.size();
-  if (k == 0 || k > detail::kMaxReadMany) [[unlikely]]
-    throw_read_many_size();
-  const std::size_t bytes = H::closure_offset(k) + sizeof(Fn);
-  char* mem = static_cast<char*>(allocate(bytes));
-  try {
-    new (mem + H::closure_offset(k)) Fn(std::forward<F>(body));
-  } catch (...) {
-    deallocate(mem, bytes);
-    throw;
-  }
-  H* h = new (mem) H{};
-  h->k = static_cast<std::uint32_t>(k);
-  h->read.link.ops_id = static_cast<std::uint16_t>(detail::ReadManyOpsFor<T, Fn>::id());
-  h->read.link.qpos = kNotQueued;
-  detail::ReadSlot* slots = h->slots();
-  for (std::size_t i = 0; i < k; ++i) {
-    detail::ReadSlot* sl = new (&slots[i]) detail::ReadSlot{};
-    sl->link.ops_id = detail::kSlotOps;
-    sl->link.qpos = static_cast<std::uint32_t>(i);
-    sl->mod = mods[i];
-  }
-  issue(TaskKind::ExecReadMany, &h->read);
-}
-
-template <class T>
-const T& Engine::current(const Mod<T>& m) {
-  require_computation("current");
-  flush_if_pending();  // calls issued earlier in this body come first in program order
-  const detail::VersionBase* v = visible_or_default(m, now_, &detail::VersionOpsFor<T>::ops);
-  if (!v) throw UsageError("sac::Engine::current: the modifiable has no value now");
-  return static_cast<const detail::Version<T>*>(v)->value;
-}
-
-template <class T>
-const T* Engine::peek(const Mod<T>& m) {
-  require_computation("peek");
-  flush_if_pending();  // as current(): calls issued earlier in this body come first
-  const detail::VersionBase* v = visible(m, now_);
-  return v ? &static_cast<const detail::Version<T>*>(v)->value : nullptr;
-}
-
-template <class T, class F>
-void Engine::memo_read(const Mod<T>& m, F&& body) {
-  using Fn = std::decay_t<F>;
-  static_assert(std::equality_comparable<Fn>,
-                "memo_read needs an equality-comparable closure: use sac::fn<f>(args...)");
-  read(m, std::forward<F>(body));
-  issued_.back().kind = TaskKind::ExecMemoRead;  // matched against the old trace when run
-}
-
-template <class T, class U>
-void Engine::write(Mod<T>& m, U&& value) {
-  using V = detail::Version<T>;
-  require_computation("write");
-  flush_if_pending();
-  V* v = construct<V>(std::forward<U>(value));
-  v->ops = &detail::VersionOpsFor<T>::ops;
-  link_write(m, v);
-}
-
-template <class T, class K, class... A>
-T* Engine::alloc(const K& key, A&&... args) {
-  static_assert(Hashable<K> && std::equality_comparable<K>,
-                "alloc keys must be hashable (sac::Hash) and equality comparable");
-  using N = detail::AllocNodeT<T, K>;
-  require_computation("alloc");
-  flush_if_pending();
-  const detail::AllocOps* ops = &detail::AllocOpsFor<T, K>::ops;
-  const std::size_t h = Hash<K>{}(key);
-  if (window_end_) {
-    if (detail::AllocNode* hit = find_alloc_match(ops, h, &key)) {
-      reuse_alloc(hit);
-      return &static_cast<N*>(hit)->object;
-    }
-  }
-  N* n = construct<N>(key, std::forward<A>(args)...);
-  n->ops = ops;
-  link_alloc(n, h);
-  return &n->object;
-}
-
-template <class T, class... A>
-T* Engine::make(A&&... args) {
-  using N = detail::PlainAllocNodeT<T>;
-  require_computation("make");
-  flush_if_pending();
-  N* n = construct<N>(std::forward<A>(args)...);
-  n->ops = &detail::PlainAllocOpsFor<T>::ops;
-  link_alloc(n, 0);
-  return &n->object;
-}
-
-template <class F>
-void Engine::memo(F&& f) {
-  memo_near(detail::kAnyDistance, std::forward<F>(f));
-}
-
-template <class F>
-void Engine::memo_near(std::uint32_t max_skip, F&& f) {
-  using Fn = std::decay_t<F>;
-  using N = detail::MemoNodeT<Fn>;
-  static_assert(std::equality_comparable<Fn> && Hashable<Fn>,
-                "memo needs an equality-comparable, hashable closure: use sac::fn<f>(args...)");
-  require_computation("memo");
-  N* n = construct<N>(std::forward<F>(f));
-  n->ops = &detail::MemoOpsFor<Fn>::ops;
-  issue(TaskKind::ExecMemo, n, max_skip);
-}
-
-template <class Body>
-void Engine::exec_body(Body&& body) {
-  // Calls issued by this body are queued above body_mark_ and handed to the trampoline in
-  // issue order once it returns.
-  const std::size_t saved = body_mark_;
-  body_mark_ = issued_.size();
-  body();
-  for (std::size_t i = issued_.size(); i-- > body_mark_;) tasks_.push_back(issued_[i]);
-  issued_.resize(body_mark_);
-  body_mark_ = saved;
-}
-
 }  // namespace sac
+
+// The template bodies (CDT-style: the declarations above, the definitions there).
+#include "sac/detail/engine_impl.hpp"

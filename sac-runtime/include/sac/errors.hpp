@@ -9,6 +9,7 @@
 //   InvariantError – a check_invariants() found a broken invariant (a runtime bug or a
 //                    documented misuse such as mutating a non-modifiable field).
 // Invariants: none (value types). Complexity: n/a.
+// Paper: docs/DESIGN.md, "The correctness contract".
 #pragma once
 
 #include <stdexcept>

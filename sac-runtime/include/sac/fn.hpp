@@ -15,6 +15,7 @@
 // Invariants: equality and hash depend on the stored arguments only; fn<f>(a...) and
 // fn<f>(b...) with equal values after that conversion are equal.
 // Complexity: call, compare and hash are O(number of arguments).
+// Paper: docs/DESIGN.md, "Memoization and keyed allocation".
 #pragma once
 
 #include <functional>

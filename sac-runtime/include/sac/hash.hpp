@@ -6,6 +6,7 @@
 // Hash values only choose buckets; matches are decided by operator==, and among equal keys
 // by trace time, so results never depend on pointer values (docs/DESIGN.md, "Determinism").
 // Invariants: a == b implies Hash(a) == Hash(b). Complexity: O(size of the key).
+// Paper: docs/DESIGN.md, "Memoization and keyed allocation".
 #pragma once
 
 #include <bit>

@@ -18,6 +18,7 @@
 // Engine::input_bytes(). Two engines whose traces are equal have equal record kinds (the
 // side structures are capacities and may differ with their history).
 // Complexity: Engine::memory_breakdown() is O(live events + base versions).
+// Paper: docs/DESIGN.md, "The runtime".
 #pragma once
 
 #include <cstddef>

@@ -13,7 +13,8 @@
 // a default; a modifiable has default readers only while it has no version. Only the
 // engine that wrote a Mod may touch it.
 // Complexity: get() O(1); reads and writes at time t are O(number of versions after t).
-// Follows Acar, Ahmed, Blume, "Imperative self-adjusting computation" (POPL'08).
+// Paper: Acar, Ahmed, Blume, "Imperative self-adjusting computation" (POPL'08);
+// docs/DESIGN.md, "Modifiables, reads and versions".
 #pragma once
 
 #include <cstdint>
@@ -37,7 +38,7 @@ class ModBase {
   friend class Engine;
   /// Marks head_ when init_default() gave m a default and no version exists yet; the rest
   /// of head_ is then the first of the reads that see the default (or null).
-  static constexpr std::uintptr_t kDefaultOnly = 2;
+  static constexpr std::uintptr_t kDefaultOnly = detail::kDefaultOnlyMark;
   /// True when m has a default and no version (the default is a version's flag once one
   /// exists).
   bool default_only() const { return (head_ & kDefaultOnly) != 0; }

@@ -1,4 +1,8 @@
-// sac/sac.hpp — umbrella header of sac-runtime. See sac/engine.hpp for the model.
+// sac/sac.hpp — umbrella header of sac-runtime.
+//
+// Purpose: one include for a program of the runtime; sac/engine.hpp states the model.
+// Invariants: includes only public headers. Complexity: n/a.
+// Paper: docs/DESIGN.md, "How it fits together".
 #pragma once
 
 #include "sac/chunk_cache.hpp"

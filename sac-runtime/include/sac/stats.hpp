@@ -6,6 +6,7 @@
 // An event is one trace record: a read, a write, an allocation or a memo entry.
 // Invariants: live_events == events created - events undone (over the engine's life).
 // Complexity: all O(1) to read.
+// Paper: docs/DESIGN.md, "Trace distance".
 #pragma once
 
 #include <cstdint>

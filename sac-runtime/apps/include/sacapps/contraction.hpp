@@ -75,7 +75,7 @@ void with_value(sac::Engine& rt, Cell<T>* c, const R& r, K k) {
 }
 template <class R, class V, class K>
 void with_value(sac::Engine& rt, RCell<V>* c, const R&, K k) {
-  rt.read(c->value, [k](sac::Engine& e, const V& v) { k(e, v); });
+  rt.read(c->value, [k](sac::Engine& rt2, const V& v) { k(rt2, v); });
 }
 
 template <class C, class R>
@@ -99,8 +99,8 @@ void round_first(sac::Engine& rt, C* first, const sac::Mod<C*>* list, unsigned r
     rt.write(*dst, r.identity());
     return;
   }
-  with_value(rt, first, r, [=](sac::Engine& e, const V& x) {
-    e.memo_read(first->next, sac::fn<round_second<C, R>>(first, x, list, round, r, dst));
+  with_value(rt, first, r, [=](sac::Engine& rt2, const V& x) {
+    rt2.memo_read(first->next, sac::fn<round_second<C, R>>(first, x, list, round, r, dst));
   });
 }
 
@@ -138,9 +138,9 @@ void contract_step(sac::Engine& rt, C* next, C* c, typename R::value_type acc, u
     }
     dst = &o->next;
   }
-  with_value(rt, next, r, [=](sac::Engine& e, const V& y) {
+  with_value(rt, next, r, [=](sac::Engine& rt2, const V& y) {
     const V v = block_ends ? y : r.combine(acc, y);
-    e.memo_read(next->next, sac::fn<contract_step<C, R>>(next, v, round, r, dst));
+    rt2.memo_read(next->next, sac::fn<contract_step<C, R>>(next, v, round, r, dst));
   });
 }
 

@@ -135,7 +135,7 @@ Value evaluate_conventional(const Shape& shape, const std::vector<bool>& present
 class ExpTree {
  public:
   /// Builds the nodes of `shape` in engine e, with leaf i present iff present[i].
-  ExpTree(sac::Engine& e, Shape shape, std::vector<bool> present);
+  ExpTree(sac::Engine& rt, Shape shape, std::vector<bool> present);
   ExpTree(const ExpTree&) = delete;
   ExpTree& operator=(const ExpTree&) = delete;
 
@@ -157,7 +157,7 @@ class ExpTree {
   Node* representative(std::size_t k) const;
   void relink(std::size_t k);
 
-  sac::Engine* engine_;
+  sac::Engine* rt_;
   Shape shape_;
   std::vector<bool> present_;
   std::vector<std::unique_ptr<Node>> nodes_;

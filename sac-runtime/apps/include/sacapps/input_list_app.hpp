@@ -83,8 +83,8 @@ class InputListApp : public App {
   }
 
   sac::Engine& engine() override {
-    if (!engine_) throw std::logic_error(std::string(name()) + ": generate() first");
-    return *engine_;
+    if (!rt_) throw std::logic_error(std::string(name()) + ": generate() first");
+    return *rt_;
   }
 
   /// The current input sequence with ids (mutator side).
@@ -118,15 +118,15 @@ class InputListApp : public App {
   }
   bool ran() const { return ran_; }
 
-  std::unique_ptr<sac::Engine> engine_;  // first: destroyed last
+  std::unique_ptr<sac::Engine> rt_;  // first: destroyed last
   std::unique_ptr<InputList<T>> input_;
 
  private:
   void reset_input() {
     reset_outputs();
     input_.reset();
-    engine_ = std::make_unique<sac::Engine>();
-    input_ = std::make_unique<InputList<T>>(*engine_, values_);
+    rt_ = std::make_unique<sac::Engine>();
+    input_ = std::make_unique<InputList<T>>(*rt_, values_);
     ran_ = false;
     input_changed();
   }

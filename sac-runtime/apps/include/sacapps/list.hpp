@@ -40,14 +40,14 @@ std::vector<T> to_vector(const List<T>& head) {
 template <class T>
 class InputList {
  public:
-  InputList(sac::Engine& e, const std::vector<T>& values) : engine_(&e) {
+  InputList(sac::Engine& rt, const std::vector<T>& values) : rt_(&rt) {
     cells_.reserve(values.size());
     for (std::size_t i = 0; i < values.size(); ++i)
       cells_.push_back(std::make_unique<Cell<T>>(values[i], i));
     present_.assign(values.size(), true);
-    engine_->set(head_, cells_.empty() ? nullptr : cells_[0].get());
+    rt_->set(head_, cells_.empty() ? nullptr : cells_[0].get());
     for (std::size_t i = 0; i < cells_.size(); ++i)
-      engine_->set(cells_[i]->next, i + 1 < cells_.size() ? cells_[i + 1].get() : nullptr);
+      rt_->set(cells_[i]->next, i + 1 < cells_.size() ? cells_[i + 1].get() : nullptr);
   }
 
   List<T>& head() { return head_; }
@@ -59,7 +59,7 @@ class InputList {
   /// Unlinks element i (must be present). A mutator change: call propagate() afterwards.
   void remove(std::size_t i) {
     Cell<T>* c = cells_.at(i).get();
-    engine_->set(link_before(i), c->next.get());
+    rt_->set(link_before(i), c->next.get());
     present_[i] = false;
   }
 
@@ -67,8 +67,8 @@ class InputList {
   void reinsert(std::size_t i) {
     Cell<T>* c = cells_.at(i).get();
     sac::Mod<Cell<T>*>& before = link_before(i);
-    engine_->set(c->next, before.get());
-    engine_->set(before, c);
+    rt_->set(c->next, before.get());
+    rt_->set(before, c);
     present_[i] = true;
   }
 
@@ -76,8 +76,8 @@ class InputList {
   void replace(std::size_t i, T v) {
     Cell<T>* old = cells_.at(i).get();
     auto fresh = std::make_unique<Cell<T>>(v, next_id_++);
-    engine_->set(fresh->next, old->next.get());
-    engine_->set(link_before(i), fresh.get());
+    rt_->set(fresh->next, old->next.get());
+    rt_->set(link_before(i), fresh.get());
     retired_.push_back(std::move(cells_[i]));
     cells_[i] = std::move(fresh);
   }
@@ -92,7 +92,7 @@ class InputList {
     return head_;
   }
 
-  sac::Engine* engine_;
+  sac::Engine* rt_;
   List<T> head_;
   std::vector<std::unique_ptr<Cell<T>>> cells_;
   std::vector<std::unique_ptr<Cell<T>>> retired_;  // still referenced by the old trace

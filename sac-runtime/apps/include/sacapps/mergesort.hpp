@@ -21,8 +21,7 @@
 // Complexity: from scratch O(n log n) expected. An insertion or deletion changes O(1)
 // expected split steps and O(1) expected merge steps per level (the merge re-runs until
 // the next element from the changed side, a geometric run): O(log n) expected trace
-// distance. Measured: about 20 log2 n events per update, 8-9 KB of trace per element at
-// n = 10^4..10^5.
+// distance.
 //
 // Follows Acar's thesis (CMU 2005), "mergesort"; Acar, Blelloch, Blume, Harper,
 // Tangwongsan, "An experimental analysis of self-adjusting computation" (TOPLAS 2009); and

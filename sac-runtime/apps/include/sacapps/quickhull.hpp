@@ -26,13 +26,12 @@
 // re-execution finds the old trace of every edge whose end points and candidates did not
 // change.
 // Complexity: from scratch, each level of the recursion filters and reduces the points that
-// are still outside the current polygon: O(n) for the first levels, O(n h) in the worst case,
-// about 30 trace events per point for random points (h = hull size). A point
+// are still outside the current polygon: O(n) for the first levels, O(n h) in the worst case
+// (h = hull size). A point
 // inserted or deleted inside the hull costs O(1) filter steps and one O(log n) reduction
 // update per level of the recursion it survives (O(1) levels expected for random points),
 // plus the two extreme-point reductions: O(log n) expected. A change of the hull itself also
-// rebuilds the recursion below the changed edge. Measured for random points: about 7 log2 n
-// events per update and 3 KB of trace per point at n = 10^4..10^5.
+// rebuilds the recursion below the changed edge.
 //
 // Follows Acar, Blelloch, Blume, Harper, Tangwongsan, "An experimental analysis of
 // self-adjusting computation" (TOPLAS 2009), "quickhull", and the CEAL benchmark of Hammer,

@@ -77,7 +77,7 @@ class SortApp : public InputListApp<std::int64_t> {
   void run_self_adjusting() override {
     begin_run();
     out_ = std::make_unique<List<Value>>();
-    engine_->run([this](sac::Engine& rt) { sort_self_adjusting(rt, input_->head(), out_.get()); });
+    rt_->run([this](sac::Engine& rt) { sort_self_adjusting(rt, input_->head(), out_.get()); });
   }
 
   bool verify() override {
@@ -99,7 +99,8 @@ class SortApp : public InputListApp<std::int64_t> {
                                                    SortArena<Value>& arena) = 0;
 
   Value draw(std::uint64_t seed) const override {
-    const std::uint64_t r = sac::mix64(seed + 0x9e3779b97f4a7c15ULL);
+    std::uint64_t state = seed;
+    const std::uint64_t r = sac::splitmix64(state);  // the first output of splitmix64(seed)
     return static_cast<Value>(r % static_cast<std::uint64_t>(range_));
   }
   void reset_outputs() override { out_.reset(); }

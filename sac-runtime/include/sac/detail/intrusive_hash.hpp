@@ -1,13 +1,15 @@
 // sac/detail/intrusive_hash.hpp — chained hash table over trace records (memo and allocation
 // tables).
 //
-// The records carry their own chain link (hnext) and know their hash through their ops, so
+// Purpose: find the memo entries and keyed allocations a re-execution may reuse. The records
+// carry their own chain link (hnext) and know their hash through their ops, so
 // the table is one bucket array. Lookups return every record of a bucket; the engine filters
 // by ops, key and trace window.
 // Invariants: every record is in bucket hash(record) & mask; size() counts them;
 //             buckets.size() is a power of two >= size() / 2 (grows at load factor 2:
 //             lookups happen only during re-execution, inserts on every keyed allocation).
 // Complexity: insert O(1) amortized, erase O(chain), lookup O(chain).
+// Paper: docs/DESIGN.md, "Memoization and keyed allocation".
 #pragma once
 
 #include <cstddef>

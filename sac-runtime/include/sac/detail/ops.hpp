@@ -8,6 +8,7 @@
 // called on records that carry that same table, so the casts are exact; an ops table with
 // key_equal set is the `ops` member of a KeyedAllocOps.
 // Complexity: every entry O(1) plus the user's operator==, Hash and body.
+// Paper: docs/DESIGN.md, "The runtime".
 #pragma once
 
 #include <concepts>
@@ -37,14 +38,14 @@ struct ReadQueueTraits {
 };
 
 template <class F, class T>
-void call_body(F& f, Engine& e, const T& v) {
-  if constexpr (std::is_invocable_v<F&, Engine&, const T&>) f(e, v);
+void call_body(F& f, Engine& rt, const T& v) {
+  if constexpr (std::is_invocable_v<F&, Engine&, const T&>) f(rt, v);
   else f(v);
 }
 
 template <class F>
-void call_thunk(F& f, Engine& e) {
-  if constexpr (std::is_invocable_v<F&, Engine&>) f(e);
+void call_thunk(F& f, Engine& rt) {
+  if constexpr (std::is_invocable_v<F&, Engine&>) f(rt);
   else f();
 }
 
@@ -92,8 +93,8 @@ const VersionBase* VersionOpsFor<T>::shared_default() {
 
 template <class T, class F>
 struct ReadOpsFor {
-  static void invoke(Engine& e, ReadNode* r, const VersionBase* v) {
-    call_body(static_cast<ReadNodeT<F>*>(r)->fn, e, static_cast<const Version<T>*>(v)->value);
+  static void invoke(Engine& rt, ReadNode* r, const VersionBase* v) {
+    call_body(static_cast<ReadNodeT<F>*>(r)->fn, rt, static_cast<const Version<T>*>(v)->value);
   }
   static void destroy(ReadNode* r) noexcept { static_cast<ReadNodeT<F>*>(r)->~ReadNodeT<F>(); }
   static bool equal(const ReadNode* r, const void* c) {
@@ -134,13 +135,13 @@ struct ReadManyOpsFor {
     return std::launder(reinterpret_cast<F*>(reinterpret_cast<char*>(r) +
                                              ReadManyHeader::closure_offset(many_of(r)->k)));
   }
-  static void invoke_many(Engine& e, ReadNode* r, const VersionBase* const* vs) {
+  static void invoke_many(Engine& rt, ReadNode* r, const VersionBase* const* vs) {
     const std::uint32_t k = many_of(r)->k;
     const T* vals[kMaxReadMany];
     for (std::uint32_t i = 0; i < k; ++i) vals[i] = &static_cast<const Version<T>*>(vs[i])->value;
     const std::span<const T* const> span(vals, k);
     F& f = *closure(r);
-    if constexpr (std::is_invocable_v<F&, Engine&, std::span<const T* const>>) f(e, span);
+    if constexpr (std::is_invocable_v<F&, Engine&, std::span<const T* const>>) f(rt, span);
     else f(span);
   }
   static void destroy(ReadNode* r) noexcept {
@@ -217,7 +218,7 @@ struct MemoOpsFor {
   static bool equal(const MemoNode* n, const void* c) {
     return static_cast<const N*>(n)->fn == *static_cast<const F*>(c);
   }
-  static void invoke(Engine& e, MemoNode* n) { call_thunk(static_cast<N*>(n)->fn, e); }
+  static void invoke(Engine& rt, MemoNode* n) { call_thunk(static_cast<N*>(n)->fn, rt); }
   static std::size_t hash(const MemoNode* n) { return Hash<F>{}(static_cast<const N*>(n)->fn); }
   static constexpr MemoOps ops{&invoke, &destroy, &equal, &hash, sizeof(N)};
 };

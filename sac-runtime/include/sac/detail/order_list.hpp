@@ -21,13 +21,14 @@
 // Complexity: less O(1); insert_after O(1) amortized (group relabel/split O(kGroupCap),
 //             top-level relabel O(log n) amortized, spread over Theta(kGroupCap) inserts);
 //             erase O(kGroupCap); erase_between O(number erased).
+// Paper: Dietz, Sleator (STOC'87); Bender et al. (ESA'02); docs/DESIGN.md, "The runtime".
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
-namespace sac {
+namespace sac::detail {
 
 /// What a stamp marks in the trace; stored in the low bits of the stamp's link.
 enum class StampKind : std::uint8_t {
@@ -182,4 +183,4 @@ class OrderList {
   std::uint64_t top_relabels_ = 0;
 };
 
-}  // namespace sac
+}  // namespace sac::detail

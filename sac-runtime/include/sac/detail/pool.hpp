@@ -3,12 +3,13 @@
 // Purpose: the hot paths (reads, writes, allocations) must not call the general-purpose heap
 // once per event. Blocks are carved from chunks that grow geometrically from 64 KiB to
 // 32 MiB; chunks of 2 MiB and more are mapped 2 MiB-aligned and advised as transparent huge
-// pages (first touch of a large trace is then ~5x cheaper), one free list per 8-byte size
-// class.
+// pages (first touch of a large trace then faults once per huge page, not per small one),
+// one free list per 8-byte size class.
 // Invariants: live_bytes() == sum of sizes of blocks handed out and not yet returned;
 //             a block is returned with the same size it was requested with.
 // Complexity: allocate/deallocate O(1); chunks are released only when the pool dies.
 // Blocks larger than kMaxSmall bytes go to ::operator new.
+// Paper: docs/DESIGN.md, "The runtime".
 #pragma once
 
 #include <cstddef>

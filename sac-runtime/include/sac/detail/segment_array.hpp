@@ -8,6 +8,7 @@
 // destructible: the segments are raw memory and no destructor runs on their elements.
 // Complexity: push_back O(1) (one chunk acquisition per kPerSegment elements), operator[]
 // O(1), clear O(segments).
+// Paper: docs/DESIGN.md, "Memoization and keyed allocation".
 #pragma once
 
 #include <cstddef>

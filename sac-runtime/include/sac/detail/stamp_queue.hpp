@@ -10,7 +10,8 @@
 // Invariants (check_invariants()): heap order under OrderList::less; Traits::pos(heap_[i]) == i
 // for every i; elements not in the queue have pos == kNotQueued.
 // Complexity: push, pop, remove O(log n) comparisons; top O(1).
-// Follows the priority-queue propagation of Acar, "Self-Adjusting Computation" (2005), ch. 6.
+// Paper: the priority-queue propagation of Acar, "Self-Adjusting Computation" (thesis, 2005),
+// ch. 6; docs/DESIGN.md, "Change propagation".
 #pragma once
 
 #include <cstddef>
@@ -21,7 +22,7 @@
 #include "sac/detail/order_list.hpp"
 #include "sac/errors.hpp"
 
-namespace sac {
+namespace sac::detail {
 
 inline constexpr std::uint32_t kNotQueued = 0xffffffffu;
 
@@ -119,4 +120,4 @@ class StampQueue {
   std::vector<Entry> heap_;
 };
 
-}  // namespace sac
+}  // namespace sac::detail

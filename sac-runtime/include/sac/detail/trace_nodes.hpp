@@ -1,6 +1,7 @@
 // sac/detail/trace_nodes.hpp — the records the trace is made of.
 //
-// Every record embeds its Stamp(s) at a fixed offset so that a stamp met while walking the
+// Purpose: the layout of reads, versions, allocations and memo entries. Every record embeds
+// its Stamp(s) at a fixed offset so that a stamp met while walking the
 // order list leads back to its record (container_of by kind). Records come from the engine's
 // Pool; their type-specific behaviour (destroy, compare, hash, invoke) sits in a static ops
 // table per instantiated type, so a record costs one pointer for it and no vtable — a read,
@@ -8,9 +9,12 @@
 //
 // Layout (bytes, 64-bit): VersionBase 40 + value; ReadNode 56 + closure; a multi-read
 // (ReadManyHeader) 64 + 32 per modifiable + closure; AllocNode 32 + key + object; MemoNode 48
-// + closure. A read or memo entry keeps no flags: it is dead once
-// its start stamp is unlinked, and closed once its end stamp is linked.
-// Invariants: see Engine::check_invariants().
+// + closure. A read or memo entry keeps no flags: it is dead once its start stamp is
+// unlinked, and closed once its end stamp is linked. The reader-list operations (attach,
+// detach, ...) are free functions at the end.
+// Invariants: sac/engine.hpp, I1-I7 (Engine::check_invariants() checks them).
+// Complexity: every function here O(1).
+// Paper: docs/DESIGN.md, "Modifiables, reads and versions".
 #pragma once
 
 #include <cstddef>
@@ -252,6 +256,66 @@ inline AllocNode* alloc_of(Stamp* s) { return reinterpret_cast<AllocNode*>(s); }
 inline MemoNode* memo_of_start(Stamp* s) { return reinterpret_cast<MemoNode*>(s); }
 inline MemoNode* memo_of_end(Stamp* s) {
   return reinterpret_cast<MemoNode*>(reinterpret_cast<char*>(s) - offsetof(MemoNode, end));
+}
+
+// ------------------------------------------------------------------ reader lists
+// A version's readers are two doubly linked lists (VersionBase::readers, newest first, and
+// VersionBase::unordered_readers); a modifiable with a default and no version keeps the
+// reads of its default in a third, headed by the modifiable's own head word. Each entry's
+// rpprev points at what points at it, so detaching is O(1) without knowing the list.
+
+/// The first of a modifiable's default readers has this bit in its rpprev, which then
+/// points at the modifiable's head word (whose default mark a plain store would lose).
+inline constexpr std::uintptr_t kHeadLink = 1;
+/// The mark of a modifiable's head word that holds its first default reader
+/// (ModBase::kDefaultOnly).
+inline constexpr std::uintptr_t kDefaultOnlyMark = 2;
+
+/// Pushes r at *head, on the list `unordered` names (0: ordered, 1: unordered).
+inline void push_reader(ReaderLink* r, ReaderLink** head, std::uint16_t unordered) {
+  r->rnext = *head;
+  if (*head) (*head)->rpprev = &r->rnext;
+  *head = r;
+  r->rpprev = head;
+  r->unordered = unordered;
+}
+/// Hangs r at the head of v's ordered readers (the caller knows it is the newest).
+inline void attach(ReaderLink* r, VersionBase* v) { push_reader(r, &v->readers, 0); }
+/// Hangs r on v's unordered readers.
+inline void attach_unordered(ReaderLink* r, VersionBase* v) { push_reader(r, &v->unordered_readers, 1); }
+/// Hangs r, a read at its start's time, on v: at the head of v's ordered readers when it is
+/// at the trace's end (every from-scratch read) or v has none, else on v's unordered
+/// readers. Testing r against the head's time instead would cost a cache miss per read that
+/// re-execution adds, and most of them land among older readers anyway; Engine::link_write
+/// folds the unordered readers it tests into order.
+inline void attach_timed(ReaderLink* r, VersionBase* v) {
+  if (!v->readers || owner_of(r)->start.next() == nullptr) attach(r, v);
+  else attach_unordered(r, v);
+}
+/// Pushes r first on the default readers whose head word is *head and whose first is
+/// `first` (the modifiable has a default and no version).
+inline void push_default_reader(ReaderLink* r, std::uintptr_t* head, ReaderLink* first) {
+  r->rnext = first;
+  if (first) first->rpprev = &r->rnext;
+  *head = reinterpret_cast<std::uintptr_t>(r) | kDefaultOnlyMark;
+  r->rpprev = reinterpret_cast<ReaderLink**>(reinterpret_cast<std::uintptr_t>(head) | kHeadLink);
+}
+/// The modifiable whose default r hangs on, if r is the first of its default readers.
+inline const ModBase* default_head(const ReaderLink* r) {
+  const auto pp = reinterpret_cast<std::uintptr_t>(r->rpprev);
+  return (pp & kHeadLink) ? reinterpret_cast<const ModBase*>(pp & ~kHeadLink) : nullptr;
+}
+/// Unhangs r from whatever list it is on (nothing if none).
+inline void detach(ReaderLink* r) {
+  if (!r->rpprev) return;
+  const auto pp = reinterpret_cast<std::uintptr_t>(r->rpprev);
+  if (pp & kHeadLink)
+    *reinterpret_cast<std::uintptr_t*>(pp & ~kHeadLink) = reinterpret_cast<std::uintptr_t>(r->rnext) | kDefaultOnlyMark;
+  else
+    *r->rpprev = r->rnext;
+  if (r->rnext) r->rnext->rpprev = r->rpprev;
+  r->rpprev = nullptr;
+  r->rnext = nullptr;
 }
 
 }  // namespace sac::detail

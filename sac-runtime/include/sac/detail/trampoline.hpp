@@ -9,6 +9,7 @@
 // close right after it (low bit set: a memo entry; 0 ends the chain); Engine::reruns_ holds
 // one RerunContext per FinishRerun on the stack.
 // Complexity: a task is 16 bytes; push and pop O(1).
+// Paper: docs/DESIGN.md, "The runtime".
 #pragma once
 
 #include <cstdint>
