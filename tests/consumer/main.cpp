@@ -8,12 +8,12 @@
 #include <sac/sac.hpp>
 
 int main() {
-  sac::Engine e;
+  sac::Engine rt;
   sac::Mod<int> in, out;
-  e.set(in, 1);
-  e.run([&](sac::Engine& rt) { rt.read(in, [po = &out](sac::Engine& r, int v) { r.write(*po, v + 1); }); });
-  e.set(in, 41);
-  e.propagate();
+  rt.set(in, 1);
+  rt.run([&](sac::Engine& rt2) { rt2.read(in, [po = &out](sac::Engine& rt3, int v) { rt3.write(*po, v + 1); }); });
+  rt.set(in, 41);
+  rt.propagate();
   if (out.get() != 42) return 1;
 
   const std::vector<dynmesh::Point<2>> pts{{{0.0, 0.0}}, {{1.0, 1.0}}};
