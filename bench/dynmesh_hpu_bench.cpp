@@ -1,9 +1,9 @@
 // dynmesh_hpu_bench — the hpu mesh (HpuMesh, DynHPU's static twin) against its peers on the
-// issue's inputs, for bench/RESULTS.md and docs/EXPERIMENTS.md.
+// peers' benchmark inputs, for bench/RESULTS.md and docs/EXPERIMENTS.md.
 //
 // Method: unif1e4 and unif1e5 are python_uniform(n, 1) (CPython's random.Random(1)), in
 // FORMATS.md's default box, the inputs on which Triangle 1.6 (-pq) and CGAL 5.5 Mesh_2 were
-// measured (their figures below are the issue's, measured on this kind of machine). With
+// measured (their figures below were measured on this kind of machine). With
 // --dist D the inputs are generate(D, n, 1) instead (spiral, curves, ...: data along curves,
 // where a mesher's point location and cavities meet long thin triangles), in the box
 // derive_box gives them, at 20.7 and 30 degrees; no earlier peer figures exist for them, so
@@ -17,7 +17,7 @@
 // When the build has Triangle (DYNMESH_TRIANGLE_SOURCE, triangle_peer.hpp), each rep also
 // builds Triangle's mesh of the same points and box right after the twin's, so that both
 // medians come from the same run: tri_s is its median time, twin/Tri the ratio of the
-// medians, and vs_Tri uses the vertices Triangle made here instead of the figure.
+// medians, and vs_Tri uses the vertices Triangle made here instead of the quoted figure.
 // Without it those columns are empty ("-"; CSV: empty). Output: a table, or CSV with --csv:
 //   input,angle,seconds,vertices,triangles,vs_triangle,vs_cgal,min_angle,rounds,entries_per_vertex,checked,
 //   triangle_seconds,twin_over_triangle,triangle_vertices
@@ -55,7 +55,7 @@ struct Peer {
   double triangle_vertices, cgal_vertices;
 };
 
-// The table (vertices): Triangle 1.6 -pq and CGAL 5.5 Mesh_2 at 20.7 and 30 degrees.
+// The quoted peer table (vertices): Triangle 1.6 -pq and CGAL 5.5 Mesh_2 at 20.7 and 30 degrees.
 constexpr Peer kPeers[] = {
     {10000, 20.7, 16462, 19773},
     {10000, 30.0, 28427, 46426},

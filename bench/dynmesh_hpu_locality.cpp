@@ -1,6 +1,6 @@
 // dynmesh_hpu_locality — how much of the hpu refinement one point update changes when every
-// question is answered from the cells (src/hpu/cell_refiner.hpp), measured before the
-// self-adjusting version of that refiner exists.
+// question is answered from the cells (src/hpu/cell_refiner.hpp): the reach of the rules
+// alone, without the runtime, beside which the self-adjusting program's updates are judged.
 //
 // Method: refine P with the step log on; then, for U points x of P drawn with a fixed seed,
 // refine P \ {x} in the same box and count the steps (CellStep: a step's key, what the cells

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# soak.sh — the soak run of bench/RESULTS.md (issue 10 §2): dynmesh_soak, 10^6 single-point
+# soak.sh — the soak run of bench/RESULTS.md ("Soak run"): dynmesh_soak, 10^6 single-point
 # updates in 2D, then in 3D (one after the other, never in parallel: the RSS samples and the
 # times assume the process has a core to itself), each under `/usr/bin/time -v` for the
 # peak RSS. Logs land in $OUT (default build/soak/): soak_2d.log, soak_3d.log with the

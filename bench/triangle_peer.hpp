@@ -1,11 +1,10 @@
 // triangle_peer.hpp — Shewchuk's Triangle as a peer of the hpu mesh, timed on the same points
 // in the same process, for the benches' "against Triangle" figures.
 //
-// Purpose: issue 20 asks for the static twin's time and size against Triangle's, measured in
-// the same run. Triangle's licence forbids bundling it, so the project never ships it: a user
+// Purpose: the static twin's time and size against Triangle's, measured in the same run. Triangle's licence forbids bundling it, so the project never ships it: a user
 // who has its source points the build at it (-DDYNMESH_TRIANGLE_SOURCE=/path/triangle.c, with
 // triangle.h beside it; bench/CMakeLists.txt) and the benches then call it. Without it,
-// kHaveTriangle is false and the benches print the peer figures quoted in the issue instead.
+// kHaveTriangle is false and the benches print quoted peer figures instead.
 // The mesh asked of Triangle is the twin's problem: the points and the box's corners, the
 // box's four sides as segments (a .poly), minimum angle `min_angle_deg` (switches -pzq<angle>,
 // quiet, no output segments or markers).

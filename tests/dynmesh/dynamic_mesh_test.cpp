@@ -350,7 +350,7 @@ double mean_hpu_distance(std::size_t n, std::size_t updates, std::uint64_t seed)
 }
 
 /// What re-ran, not only the result: an update's trace distance does not grow with n (the
-/// issue's bound: at most 1.5 times between sizes, here 8x apart).
+/// target: at most 1.5 times between sizes, here 8x apart).
 TEST(DynamicMeshHpu, TraceDistanceDoesNotGrowWithN) {
   const std::size_t small = kSlowBuild ? 150 : 500, large = kSlowBuild ? 1200 : 4000;
   const std::size_t updates = kSlowBuild ? 20 : 80;

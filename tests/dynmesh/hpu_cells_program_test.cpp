@@ -272,22 +272,20 @@ TEST(HpuCellsProgram, EveryUpdateMatchesAFromScratchTwin) {
               n, updates, static_cast<unsigned long long>(scratch), mean, pct(mean),
               static_cast<unsigned long long>(sorted[sorted.size() / 2]), pct(double(sorted[sorted.size() / 2])),
               static_cast<unsigned long long>(sorted.back()), pct(double(sorted.back())));
-  // A figure, not a tight bound: a program that re-ran the refinement would be near 100%.
-  // One update's reach is a fixed number of vertices, so its share falls with n: 6.5% at
-  // n = 200, 28% at the sanitizer build's 60.
+  // Not a tight bound: a program that re-ran the refinement would be near the whole trace.
+  // One update's reach is a fixed number of vertices, so its share falls with n, and the
+  // sanitizer build's smaller n gets a looser share.
   EXPECT_LT(mean, (kSanitized ? 0.5 : 0.15) * double(scratch));
 }
 
-/// On the inputs that broke the triangulation-based program (its spiral updates grew as
-/// n^0.45), deleting a point and inserting it back stays under one fixed budget of trace
-/// distance, the same at n = 1,000 and 10,000, on a spiral and on curves. The budget is
-/// about twice the means measured at 16,000 and 32,000 (bench/RESULTS.md); the old program
-/// was at 39,790 (spiral) and 17,628 (curves) at 16,000. The spiral's mean still grows
-/// (2,381 to 5,165 here), as the rules' own changed steps do: its points stay active through
-/// more size classes as its spread grows. Every single propagation stays under a second
-/// budget: an update that re-ran a long list pass (the class filter before its lists went
-/// by block) cost 4.7·10^4 to 6.2·10^4 events on 32,000 curve points, against a largest
-/// 8,167 here.
+/// On points along curves, where a program that answered its questions from a global
+/// triangulation would not be local (its long thin triangles span the arms), deleting a
+/// point and inserting it back stays under one fixed budget of trace distance, the same at
+/// n = 1,000 and 10,000, on a spiral and on curves. The budget is about twice the means of
+/// bench/RESULTS.md at larger n. The spiral's mean still grows, as the rules' own changed
+/// steps do: its points stay active through more size classes as its spread grows. Every
+/// single propagation stays under a second budget, which an update that re-ran a long list
+/// pass would exceed.
 TEST(HpuCellsProgram, AnUpdateOnCurvesStaysWithinAFixedBudget) {
   constexpr double kBudget = 15000;     // mean events per propagation
   constexpr std::uint64_t kMost = 30000;  // events in any one propagation
@@ -367,10 +365,10 @@ TEST(HpuCellsProgram, AChangeOfPlaceInAListReRunsNoCollectOrTry) {
 }
 
 /// The least initial class is the blocks' (HpuCellsProgram::block_bounds), not a running
-/// minimum in the first-class steps' keys: an update that makes a new least class, a point
-/// put next to another, used to re-run the first class of every initial vertex after it in
-/// the list (7,488 in one update at uniform 10^5, `dynmesh_hpu_steps --tail`). Per
-/// propagation the first classes re-run stay a handful, wherever the pair falls in the list.
+/// minimum in the first-class steps' keys, which would make an update that creates a new
+/// least class (a point put next to another) re-run the first class of every initial vertex
+/// after it in the list. Per propagation the first classes re-run stay a handful, wherever
+/// the pair falls in the list.
 TEST(HpuCellsProgram, ANewLeastClassReRunsAFewFirstClasses) {
   const std::uint64_t seed = 11;
   SCOPED_TRACE(seed_note(seed));

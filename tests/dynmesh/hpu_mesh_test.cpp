@@ -1,7 +1,7 @@
 // hpu_mesh_test.cpp — hpu_mesh.hpp and its triangulation (src/geometry/delaunay.hpp): the mesh
 // contract at 20.7°, 25° and 30° (Delaunay by exact predicates, every angle, tiling, inputs
 // present) on every distribution, independence of the input order, bad input, and the
-// size against Triangle's on the unif1e4 input.
+// size against Triangle's on the peers' unif1e4 input.
 #include "dynmesh/hpu_mesh.hpp"
 
 #include <gtest/gtest.h>
@@ -380,7 +380,7 @@ TEST(HpuMesh, RejectsBadInput) {
 }
 
 TEST(HpuMesh, SizeAgainstTriangleOnUnif1e4) {
-  // The unif1e4 (Python's random.Random(1)), FORMATS.md's default box. Triangle 1.6
+  // The peers' unif1e4 (Python's random.Random(1)), FORMATS.md's default box. Triangle 1.6
   // (-pq) makes 16,462 vertices at 20.7° and 28,427 at 30°; the target is at most 1.10x.
   if (kSanitized) GTEST_SKIP() << "10^4 points at -O0 under the sanitizers";
   const auto pts = python_uniform(10000);  // unif1e4

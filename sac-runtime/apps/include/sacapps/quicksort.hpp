@@ -22,8 +22,8 @@
 // Complexity: from scratch O(n log n) expected (O(n^2) on sorted input: the pivot is the
 // first cell, as in the classic benchmark). An insertion or deletion at a random position
 // changes O(1) expected partition steps per level of the recursion it passes and its own
-// subtree's partitions: O(log n) expected trace distance (Acar's thesis). Measured: about
-// 20 log2 n events per update, 4-5 KB of trace per element at n = 10^4..10^5.
+// subtree's partitions: O(log n) expected trace distance (Acar's thesis; the figures are in
+// bench/RESULTS.md, "The classic suite (`sac_suite`)").
 //
 // Follows Acar's thesis (CMU 2005), "quicksort"; Acar, Blelloch, Blume, Harper,
 // Tangwongsan, "An experimental analysis of self-adjusting computation" (TOPLAS 2009); and
