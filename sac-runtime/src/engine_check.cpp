@@ -81,65 +81,98 @@ class AddressSet {
 
 }  // namespace
 
-void Engine::check_invariants() const {
-  if (in_computation_) throw UsageError("sac::Engine::check_invariants: not inside the computation");
-  // Every message starts with the number of the invariant it breaks (sac/engine.hpp).
-  auto fail = [](const std::string& what) { throw InvariantError("Engine trace: " + what); };
-  // I1: the order list and the queue (the tables are checked at the end).
-  order_.check_invariants();
-  queue_.check_invariants();
-  // I7: nothing left over from the last propagate().
-  if (!queue_.empty()) fail("I7: queue not empty outside propagate()");
-  if (!deferred_.empty()) fail("I7: deferred frees left after propagate()");
-  if (!dead_versions_.empty() || !seen_.empty()) fail("I7: undone versions or seen lists left after propagate()");
+namespace detail {
 
-  // Walk the trace: nesting (I2), per-record checks, counts (I6).
+/// check_invariants() as named phases over one engine: the trace walk collects the
+/// modifiables, the live reads and the default readers that the later phases check.
+class TraceChecker {
+ public:
+  explicit TraceChecker(const Engine& rt)
+      : rt_(rt), mods_(rt.stats_.live_events / 2), reads_(rt.stats_.live_events / 2) {}
+
+  [[noreturn]] static void fail(const std::string& what) { throw InvariantError("Engine trace: " + what); }
+
+  /// I1: the order list and the queue (the tables are checked last, by check_tables).
+  void check_order_and_queue() const {
+    rt_.order_.check_invariants();
+    rt_.queue_.check_invariants();
+  }
+  /// I7: nothing left over from the last propagate().
+  void check_nothing_left() const {
+    if (!rt_.queue_.empty()) fail("I7: queue not empty outside propagate()");
+    if (!rt_.deferred_.empty()) fail("I7: deferred frees left after propagate()");
+    if (!rt_.dead_versions_.empty() || !rt_.seen_.empty())
+      fail("I7: undone versions or seen lists left after propagate()");
+  }
+  /// I2 and I6: walks the trace in time order, checking that intervals nest and counting the
+  /// live events, keyed allocations and memo entries; collects what the next phases check.
+  void walk_trace();
+  /// I3, I4, I5: each written or read modifiable's versions, and the readers on each.
+  void check_versions();
+  /// I4: reads of a default with no version hang on the modifiable, which has no version;
+  /// and every live read hangs somewhere, exactly once.
+  void check_default_readers();
+  /// I1 and I6: the tables' own structure, and that they hold only live records.
+  void check_tables() const;
+
+ private:
+  void walk_read(const ReadNode* r);
+
   struct Open {
-    const Stamp* close;   // stamp that closes this interval
+    const Stamp* close;  // the stamp that closes this interval
     bool is_memo;
   };
-  std::vector<Open> stack;
+
+  const Engine& rt_;
+  std::vector<Open> stack_;
+  AddressSet mods_;                         // the modifiables written (then: or read)
+  AddressSet reads_;                        // the reader list entries: links and slots
+  std::vector<const ModBase*> default_mods_;  // one per modifiable whose default reads hang on it
+  std::size_t attached_ = 0;                // readers found on versions and defaults
+};
+
+void TraceChecker::walk_read(const ReadNode* r) {
+  if (!r->end.linked()) fail("I2: read without end stamp");
+  if (!rt_.order_.less(&r->start, &r->end)) fail("I2: read end not after start");
+  // Attachment to the version visible at its start is checked from the version side
+  // (check_versions): a read record does not name its modifiable, and scanning the visible
+  // version's readers here would be quadratic in a modifiable's fan-out.
+  if (r->link.qpos != kNotQueued) fail("I7: read still queued");
+  if (r->many()) {
+    // A multi-read hangs on versions through its slots only; each slot is checked with its
+    // modifiable, like a read.
+    const ReadManyHeader* h = many_of(r);
+    if (r->link.rpprev) fail("I4: a multi-read's own link is attached");
+    if (h->k == 0 || h->k > kMaxReadMany) fail("I4: a multi-read with a bad slot count");
+    for (std::uint32_t i = 0; i < h->k; ++i) {
+      const ReaderLink* l = &h->slots()[i].link;
+      if (!is_slot(l) || l->qpos != i || owner_of(l) != r) fail("I4: a multi-read's slot is malformed");
+      reads_.insert(l);
+      if (const ModBase* m = default_head(l)) default_mods_.push_back(m);
+    }
+  } else {
+    reads_.insert(&r->link);
+    if (const ModBase* m = default_head(&r->link)) default_mods_.push_back(m);
+  }
+  stack_.push_back({&r->end, false});
+}
+
+void TraceChecker::walk_trace() {
   std::uint64_t events = 0;
   std::size_t nkeyed = 0, nmemo = 0;
-  AddressSet mods(stats_.live_events / 2);  // the modifiables written (then: or read)
-  AddressSet reads(stats_.live_events / 2);  // the reader list entries: links and slots
-  std::vector<const ModBase*> default_mods;  // one per modifiable whose default reads hang on it
-  for (const Stamp* s = order_.base()->next(); s; s = s->next()) {
+  for (const Stamp* s = rt_.order_.base()->next(); s; s = s->next()) {
     visit_record(s, [&]<StampKind K>(Kind<K>, auto* rec) {
       if constexpr (K == StampKind::ReadStart) {
-        const ReadNode* r = rec;
         ++events;
-        if (!r->end.linked()) fail("I2: read without end stamp");
-        if (!order_.less(&r->start, &r->end)) fail("I2: read end not after start");
-        // Attachment to the version visible at its start is checked below, from the
-        // version side (a read record does not name its modifiable; scanning the visible
-        // version's readers here would also be quadratic in a modifiable's fan-out).
-        if (r->link.qpos != kNotQueued) fail("I7: read still queued");
-        if (r->many()) {
-          // A multi-read hangs on versions through its slots only; each slot is checked
-          // below, with its modifiable, like a read.
-          const detail::ReadManyHeader* h = detail::many_of(r);
-          if (r->link.rpprev) fail("I4: a multi-read's own link is attached");
-          if (h->k == 0 || h->k > detail::kMaxReadMany) fail("I4: a multi-read with a bad slot count");
-          for (std::uint32_t i = 0; i < h->k; ++i) {
-            const ReaderLink* l = &h->slots()[i].link;
-            if (!detail::is_slot(l) || l->qpos != i || owner_of(l) != r) fail("I4: a multi-read's slot is malformed");
-            reads.insert(l);
-            if (const ModBase* m = default_head(l)) default_mods.push_back(m);
-          }
-        } else {
-          reads.insert(&r->link);
-          if (const ModBase* m = default_head(&r->link)) default_mods.push_back(m);
-        }
-        stack.push_back({&r->end, false});
+        walk_read(rec);
       } else if constexpr (K == StampKind::ReadEnd) {
-        if (stack.empty() || stack.back().close != s || stack.back().is_memo)
+        if (stack_.empty() || stack_.back().close != s || stack_.back().is_memo)
           fail("I2: read intervals not well nested");
-        stack.pop_back();
+        stack_.pop_back();
       } else if constexpr (K == StampKind::Write) {
         const VersionBase* v = rec;
         ++events;
-        mods.insert(v->mod());
+        mods_.insert(v->mod());
         bool found = false;
         for (const VersionBase* x = v->mod()->newest(); x; x = x->older())
           if (x == v) found = true;
@@ -151,33 +184,32 @@ void Engine::check_invariants() const {
         const MemoNode* n = rec;
         ++events;
         ++nmemo;
-        if (!n->end.linked() ||
-            !order_.less(&n->start, &n->end))
+        if (!n->end.linked() || !rt_.order_.less(&n->start, &n->end))
           fail("I2: memo entry without a proper end stamp");
-        stack.push_back({&n->end, true});
+        stack_.push_back({&n->end, true});
       } else if constexpr (K == StampKind::MemoEnd) {
-        if (stack.empty() || stack.back().close != s || !stack.back().is_memo)
+        if (stack_.empty() || stack_.back().close != s || !stack_.back().is_memo)
           fail("I2: memo intervals not well nested");
-        stack.pop_back();
+        stack_.pop_back();
       } else {
         fail("I2: unexpected stamp kind");
       }
     });
   }
-  if (!stack.empty()) fail("I2: unclosed intervals at the end of the trace");
-  if (events != stats_.live_events) fail("I6: live event count mismatch");
-  if (nkeyed != allocs_.size()) fail("I6: allocation table size mismatch");
-  if (nmemo != memos_.size()) fail("I6: memo table size mismatch");
+  if (!stack_.empty()) fail("I2: unclosed intervals at the end of the trace");
+  if (events != rt_.stats_.live_events) fail("I6: live event count mismatch");
+  if (nkeyed != rt_.allocs_.size()) fail("I6: allocation table size mismatch");
+  if (nmemo != rt_.memos_.size()) fail("I6: memo table size mismatch");
+}
 
-  // Versions of every written or read modifiable: strictly decreasing time, base last (I3);
-  // readers between this version and the next newer one (so each reader hangs on the version
-  // visible at its time), and every reader a live read of the trace, each exactly once (I4);
-  // each list in the order its flag says (I5).
-  // A live read hangs on a computation's version, a base version or (below) a default with
-  // no version; so these cover every read.
-  for (const VersionBase* b : bases_) mods.insert(b->mod());
-  std::size_t attached = 0;
-  mods.for_each([&](const void* mod) {
+// Versions of every written or read modifiable: strictly decreasing time, base last (I3);
+// readers between this version and the next newer one (so each reader hangs on the version
+// visible at its time), and every reader a live read of the trace (I4); each list in the
+// order its flag says (I5). A live read hangs on a computation's version, a base version or
+// (check_default_readers) a default with no version; so these cover every read.
+void TraceChecker::check_versions() {
+  for (const VersionBase* b : rt_.bases_) mods_.insert(b->mod());
+  mods_.for_each([&](const void* mod) {
     const auto* m = static_cast<const ModBase*>(mod);
     const VersionBase* newer = nullptr;
     for (const VersionBase* v = m->newest(); v; v = v->older()) {
@@ -186,7 +218,7 @@ void Engine::check_invariants() const {
         if (v->older()) fail("I3: base version is not the oldest");
       } else {
         if (!v->stamp.linked()) fail("I3: version with unlinked stamp");
-        if (newer && !order_.less(&v->stamp, &newer->stamp)) fail("I3: versions out of order");
+        if (newer && !rt_.order_.less(&v->stamp, &newer->stamp)) fail("I3: versions out of order");
       }
       for (int list = 0; list < 2; ++list) {
         const ReaderLink* const* back = list == 0 ? &v->readers : &v->unordered_readers;
@@ -194,48 +226,66 @@ void Engine::check_invariants() const {
         for (const ReaderLink* r = *back; r; back = &r->rnext, r = r->rnext) {
           if (r->rpprev != back) fail("I4: a version's reader list has a broken back link");
           // Membership first: only then may r be decoded (a slot's owner from its index).
-          if (!reads.contains(r)) fail("I4: a version's reader is not a live read of the trace");
-          if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
+          if (!reads_.contains(r)) fail("I4: a version's reader is not a live read of the trace");
+          if (is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
             fail("I4: a multi-read's slot hangs on another modifiable's version");
           const Stamp* t = &owner_of(r)->start;
-          if (!v->is_base() && !order_.less(&v->stamp, t)) fail("I4: reader before its version");
-          if (newer && !order_.less(t, &newer->stamp)) fail("I4: reader after the next version");
+          if (!v->is_base() && !rt_.order_.less(&v->stamp, t)) fail("I4: reader before its version");
+          if (newer && !rt_.order_.less(t, &newer->stamp)) fail("I4: reader after the next version");
           if (r->unordered != list)
             fail("I5: a version's reader is on the other list than its flag says");
           if (list == 0) {
-            if (last_ordered && order_.less(last_ordered, t))
+            if (last_ordered && rt_.order_.less(last_ordered, t))
               fail("I5: a version's ordered readers are not newest first");
             last_ordered = t;
           }
-          ++attached;
+          ++attached_;
         }
       }
       newer = v;
     }
   });
-  // I4: reads of a default with no version hang on the modifiable; it has no version then.
-  for (const ModBase* m : default_mods) {
+}
+
+void TraceChecker::check_default_readers() {
+  for (const ModBase* m : default_mods_) {
     if (!m->default_only()) fail("I4: a read hangs on the default of a modifiable that has versions");
     const ReaderLink* first = m->default_readers();
     if (!first || default_head(first) != m) fail("I4: a modifiable's default readers do not start at its head");
     for (const ReaderLink* r = first; r; r = r->rnext) {
       if (r->rnext && r->rnext->rpprev != &r->rnext) fail("I4: a default reader list has a broken back link");
-      if (!reads.contains(r)) fail("I4: a default reader is not a live read of the trace");
-      if (detail::is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
+      if (!reads_.contains(r)) fail("I4: a default reader is not a live read of the trace");
+      if (is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
         fail("I4: a multi-read's slot hangs on another modifiable's default");
-      ++attached;
+      ++attached_;
     }
   }
-  if (attached != reads.size()) fail("I4: read not attached to the version visible at its time");
-  // I1 and I6: the tables' own structure, and that they hold only live records.
-  allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops->hash(n); },
-                           [&](const AllocNode* n) {
-                             if (!n->stamp.linked()) fail("I6: allocation table holds an undone record");
-                           });
-  memos_.check_invariants("memo table", [](const MemoNode* n) { return n->ops->hash(n); },
-                          [&](const MemoNode* n) {
-                            if (!n->start.linked()) fail("I6: memo table holds an undone record");
-                          });
+  if (attached_ != reads_.size()) fail("I4: read not attached to the version visible at its time");
+}
+
+void TraceChecker::check_tables() const {
+  rt_.allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops->hash(n); },
+                               [](const AllocNode* n) {
+                                 if (!n->stamp.linked()) fail("I6: allocation table holds an undone record");
+                               });
+  rt_.memos_.check_invariants("memo table", [](const MemoNode* n) { return n->ops->hash(n); },
+                              [](const MemoNode* n) {
+                                if (!n->start.linked()) fail("I6: memo table holds an undone record");
+                              });
+}
+
+}  // namespace detail
+
+// Every message starts with the number of the invariant it breaks (sac/engine.hpp).
+void Engine::check_invariants() const {
+  if (in_computation_) throw UsageError("sac::Engine::check_invariants: not inside the computation");
+  detail::TraceChecker check(*this);
+  check.check_order_and_queue();  // I1
+  check.check_nothing_left();     // I7
+  check.walk_trace();             // I2, I6 (and what follows needs)
+  check.check_versions();         // I3, I4, I5
+  check.check_default_readers();  // I4
+  check.check_tables();           // I1, I6
 }
 
 }  // namespace sac

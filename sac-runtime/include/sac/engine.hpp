@@ -107,6 +107,10 @@
 
 namespace sac {
 
+namespace detail {
+class TraceChecker;  // src/engine_check.cpp: check_invariants()'s phases
+}  // namespace detail
+
 class Engine {
  public:
   Engine();
@@ -326,6 +330,7 @@ class Engine {
   // Test-only hook: tests/sac/engine_test.cpp defines it to corrupt one part of the trace
   // and see check_invariants() fail. Nothing else may define it.
   friend struct EngineTestAccess;
+  friend class detail::TraceChecker;
 
   using Stamp = detail::Stamp;
   using StampKind = detail::StampKind;

@@ -25,6 +25,10 @@
 
 namespace sac {
 
+namespace detail {
+class TraceChecker;  // src/engine_check.cpp: Engine::check_invariants()'s phases
+}  // namespace detail
+
 class ModBase {
  public:
   ModBase() = default;
@@ -36,6 +40,7 @@ class ModBase {
 
  protected:
   friend class Engine;
+  friend class detail::TraceChecker;
   /// Marks head_ when init_default() gave m a default and no version exists yet; the rest
   /// of head_ is then the first of the reads that see the default (or null).
   static constexpr std::uintptr_t kDefaultOnly = detail::kDefaultOnlyMark;
