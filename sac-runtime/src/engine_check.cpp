@@ -17,20 +17,6 @@
 
 namespace sac {
 
-using detail::AllocNode;
-using detail::Stamp;
-using detail::StampKind;
-using detail::default_head;
-using detail::kNotQueued;
-using detail::Kind;
-using detail::MemoNode;
-using detail::ReaderLink;
-using detail::ReadNode;
-using detail::ReadSlot;
-using detail::VersionBase;
-using detail::owner_of;
-using detail::visit_record;
-
 namespace {
 
 /// The checker's set of record addresses: open addressing in one array, so that the check

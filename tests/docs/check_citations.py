@@ -28,7 +28,7 @@ TEXT_SUFFIXES = ('.hpp', '.cpp', '.h', '.py', '.sh', '.cmake', '.md', '.txt', '.
 SKIP_DIRS = {'.git', 'build', 'corpus', '__pycache__', 'data', 'figures', 'artifacts'}
 TOP_DIRS = ('sac-runtime/', 'dynmesh/', 'tests/', 'bench/', 'docs/', 'cmake/', 'examples/', '.ci/')
 # A comment's line prefix, removed when a quoted section wraps onto the next line.
-WRAP = re.compile(r'\n[ \t]*(?://+|#+|\*+|///)?[ \t]*')
+WRAP = re.compile(r'\n[ \t]*(?://+|#+|\*+)?[ \t]*')
 CITE = re.compile(r'((?:[\w.-]+/)*[A-Z][A-Z0-9_]*\.md)'
                   r'(?:(?:,|\'s)?[ \t]*\(?[ \t]*["“]([^"”]{1,200})["”]|#([\w-]+))?')
 LINK = re.compile(r'\[[^\]\n]*\]\(([^)\s]+)\)')
@@ -126,7 +126,7 @@ def check(root):
         # Map positions of `joined` back to lines: count the newlines removed before each.
         offsets = []  # (joined position, original line)
         jpos, line = 0, 1
-        for piece in re.split(r'(\n[ \t]*(?://+|#+|\*+|///)?[ \t]*)', text):
+        for piece in re.split('(' + WRAP.pattern + ')', text):
             if piece.startswith('\n'):
                 line += 1
                 jpos += 1

@@ -52,14 +52,6 @@ MeshOptions validated(MeshOptions o) {
   return o;
 }
 
-/// Edits that insert `points`, in order.
-std::vector<Edit<2>> insertions(std::span<const Point<2>> points) {
-  std::vector<Edit<2>> edits;
-  edits.reserve(points.size());
-  for (const Point<2>& p : points) edits.push_back(Edit<2>{EditOp::Insert, p});
-  return edits;
-}
-
 /// The meshes' own input rule (mesh_input_rules.hpp: no two points closer than the mesh's
 /// resolution allows) on the counts of present points per cell, next to the quadtree's rules
 /// that InputPoints::validate checks.
@@ -134,7 +126,7 @@ class QuadtreeMeshState final : public MeshState {
   ~QuadtreeMeshState() override { log.closing = true; }  // before core (and its engine) goes
 
   void build(std::span<const Point<2>> points) override {
-    const std::vector<Edit<2>> edits = insertions(points);
+    const std::vector<Edit<2>> edits = inserts_of<2>(points);
     rules.validate(core, log.grid, edits, "point");
     validate_mesh_box(core.box);
     auto* mesh_program = &program;
@@ -221,7 +213,7 @@ class HpuMeshState final : public MeshState {
   ~HpuMeshState() override { cells.feed.close(); }  // before the engine goes
 
   void build(std::span<const Point<2>> points) override {
-    const std::vector<Edit<2>> edits = insertions(points);
+    const std::vector<Edit<2>> edits = inserts_of<2>(points);
     const HpuInputs::Plan plan = validate(edits, "point");
     validate_mesh_box(input_points.box);
     cells.commit(rt, plan);

@@ -98,9 +98,7 @@ std::vector<PointId> checked_update(const DynamicOctreeMesh& mesh, OctreeMeshSta
 
 DynamicOctreeMesh::DynamicOctreeMesh(const Box<3>& box, std::span<const Point<3>> points)
     : s_(std::make_unique<detail::OctreeMeshState>(box)) {
-  std::vector<Edit<3>> edits;
-  edits.reserve(points.size());
-  for (const Point<3>& p : points) edits.push_back(Edit<3>{EditOp::Insert, p});
+  const std::vector<Edit<3>> edits = detail::inserts_of<3>(points);
   s_->validate(edits, "point");
   validate_mesh_box(box);
   auto* program = &s_->program;

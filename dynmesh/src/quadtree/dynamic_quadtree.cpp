@@ -13,14 +13,6 @@
 namespace dynmesh {
 namespace detail {
 
-template <std::size_t d>
-std::vector<Edit<d>> inserts_of(std::span<const Point<d>> points) {
-  std::vector<Edit<d>> edits;
-  edits.reserve(points.size());
-  for (const Point<d>& p : points) edits.push_back(Edit<d>{EditOp::Insert, p});
-  return edits;
-}
-
 /// The length of a leaf's point list.
 template <std::size_t d>
 std::uint32_t count_points(const PNode<d>* p) noexcept {

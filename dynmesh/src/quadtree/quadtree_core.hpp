@@ -236,6 +236,16 @@ struct NoExtraChecks {
   void erase(const Q&) {}
 };
 
+/// The edits that insert `points`, in order: how a constructor validates its initial points
+/// with the same rules (and messages, "point i") as an update.
+template <std::size_t d>
+std::vector<Edit<d>> inserts_of(std::span<const Point<d>> points) {
+  std::vector<Edit<d>> edits;
+  edits.reserve(points.size());
+  for (const Point<d>& p : points) edits.push_back(Edit<d>{EditOp::Insert, p});
+  return edits;
+}
+
 /// The input points: a list of modifiables in insertion order (the root's point list, which
 /// a program reads), mirrored for the mutator, with indexes by located position and by id.
 /// The engine is its owner's, passed to each call that writes the list; the owner sets
