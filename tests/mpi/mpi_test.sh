@@ -1,12 +1,22 @@
 #!/usr/bin/env bash
-# tests/mpi/mpi_test.sh CASE MPIEXEC DYNMESH DYNMESH_MPI MPI_GEN WORK_DIR — end-to-end tests of
-# `dynmesh-mpi quadtree` (docs/FORMATS.md, docs/DISTRIBUTED.md): its `.cells` must equal
-# `dynmesh quadtree`'s byte for byte for every number of ranks; bad input gives one line from
-# rank 0 and a non-zero status on every rank, within a timeout. One ctest per CASE
-# (tests/mpi/CMakeLists.txt). Exit 0 pass, 1 fail.
+# tests/mpi/mpi_test.sh CASE MPIEXEC DYNMESH DYNMESH_MPI MPI_GEN WORK_DIR [MPI_QUADTREE_TEST] —
+# end-to-end tests of `dynmesh-mpi quadtree` (docs/FORMATS.md, docs/DISTRIBUTED.md): its
+# `.cells` must equal `dynmesh quadtree`'s byte for byte for every number of ranks; bad input
+# gives one line of ours from rank 0 and a non-zero status on every rank, within a timeout.
+# The cases differential2 and differential3 run MPI_QUADTREE_TEST on 2 and 3 ranks. One ctest
+# per CASE (tests/mpi/CMakeLists.txt). Exit 0 pass, 1 fail.
+#
+# Every launch is isolated and judged apart from the launcher:
+# - OpenMPI keeps a session directory per user and node; launchers that start and end together
+#   race on it (open-mpi/ompi issue 8510), so each test gets a fresh one of its own.
+# - Each rank appends its own exit status to status.txt, so a launch that failed (mpiexec ran
+#   fewer ranks to the end, or exited non-zero after they all did) is reported as the
+#   launcher's failure, not as a wrong tree.
+# - On stderr, only our lines are asserted. The launcher and the libraries it loads (hwloc,
+#   ORTE, PMIx) may print notices of their own, on every rank; see our_lines below.
 set -uo pipefail
 
-case_name=$1 mpiexec=$2 dynmesh=$3 dmpi=$4 gen=$5 work=$6
+case_name=$1 mpiexec=$2 dynmesh=$3 dmpi=$4 gen=$5 work=$6 unit=${7:-}
 rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
 export DYNMESH_PROGRESS_DELAY_MS=3600000
 
@@ -15,19 +25,61 @@ fail() {
   exit 1
 }
 
-# mpi P ARGS...: dynmesh-mpi on P ranks (more ranks than cores: --oversubscribe; -q: no
-# launcher chatter on stderr), killed after 120 s so that a hang fails instead of blocking.
+# A session directory of this test's own, under /tmp: OpenMPI puts Unix sockets in it, whose
+# paths must stay short (about 100 bytes), so it is not under the build tree.
+session=$(mktemp -d /tmp/sac-mpi.XXXXXX) || fail "mktemp"
+trap 'rm -rf "$session"' EXIT
+export OMPI_MCA_orte_tmpdir_base=$session TMPDIR=$session
+
+# launch P PROGRAM ARGS...: PROGRAM on P ranks (more ranks than cores: --oversubscribe; -q: no
+# launcher chatter), stdout to out.txt and stderr to err.txt, killed after 120 s so that a
+# hang fails instead of blocking. Sets `statuses` to the ranks' exit statuses, sorted. Fails
+# the test on a hang or a failed launch; returns 0 when every rank exited 0, 1 otherwise.
+launch() {
+  local p=$1
+  shift
+  rm -f status.txt
+  timeout 120 "$mpiexec" -q --oversubscribe -np "$p" sh -c '"$0" "$@"; echo "$?" >>status.txt' "$@" \
+    >out.txt 2>err.txt
+  local rc=$?
+  ((rc != 124)) || fail "timed out after 120 s (a rank hangs): -np $p ${*:2}"
+  statuses=$(sort -n status.txt 2>/dev/null)
+  local done=0
+  [[ -z $statuses ]] || done=$(wc -l <<<"$statuses")
+  if ((done != p || rc != 0)); then
+    cat err.txt >&2
+    fail "the launcher failed, not the program: mpiexec exited $rc and $done of $p ranks ran to the end: -np $p ${*:2}"
+  fi
+  [[ $(uniq <<<"$statuses") == 0 ]]
+}
+
+# mpi P ARGS...: dynmesh-mpi ARGS on P ranks; as launch.
 mpi() {
   local p=$1
   shift
-  timeout 120 "$mpiexec" -q --oversubscribe -np "$p" "$dmpi" "$@"
+  launch "$p" "$dmpi" "$@"
+}
+
+# our_lines NOISE ERR: the lines of ERR that are ours, that is, all but the launcher's notices.
+# A notice is a line NOISE holds (what the same launcher printed on stderr for a run of ours
+# that printed nothing: hwloc's warnings, for one, come from every rank), a line of hwloc's
+# ("[hwloc..."), of ORTE's or PMIx's (they open with "[host:pid]" or name themselves), or a
+# line of one of OpenMPI's help boxes (between two rules of dashes).
+our_lines() {
+  awk -v noise="$1" '
+    BEGIN { while ((getline line < noise) > 0) known[line] = 1 }
+    /^--------------------+$/ { inbox = !inbox; next }
+    inbox { next }
+    $0 in known { next }
+    /^\[hwloc/ || /^\[[^] ]+:[0-9]+\]/ || /ORTE_ERROR_LOG|PMIX ERROR|PMIx/ { next }
+    { print }' "$2"
 }
 
 # same P POINTS ARGS...: dynmesh-mpi on P ranks writes the .cells that dynmesh wrote to ref.cells.
 same() {
   local p=$1
   shift
-  mpi "$p" quadtree "$@" --cells mpi.cells >out.txt 2>err.txt || { cat err.txt >&2; fail "exit status $?: -np $p $*"; }
+  mpi "$p" quadtree "$@" --cells mpi.cells || { cat err.txt >&2; fail "a rank failed ($(tr '\n' ' ' <<<"$statuses")): -np $p $*"; }
   cmp -s ref.cells mpi.cells || fail "-np $p $*: .cells differs from dynmesh quadtree's"
 }
 
@@ -44,26 +96,60 @@ exact() {
   same 3 in.xyz --dim "$dim" --edits in.edits "$@"
 }
 
-# expect_error WANT_TEXT ARGS...: on 3 ranks, every rank exits non-zero, stderr is exactly one
-# line "dynmesh-mpi: ..." containing WANT_TEXT (and dynmesh's own message), no .cells.
+# expect_error WANT_TEXT ARGS...: on 3 ranks, every rank exits non-zero, our stderr is exactly
+# one line "dynmesh-mpi: ..." containing WANT_TEXT (and dynmesh's own message), no .cells.
+# noise.txt must hold the launcher's notices (errors_case writes it).
 expect_error() {
   local want=$1
   shift
-  rm -f status.txt err.cells
-  timeout 120 "$mpiexec" -q --oversubscribe -np 3 sh -c '"$0" "$@"; echo "$?" >>status.txt' "$dmpi" quadtree "$@" \
-    --cells err.cells >out.txt 2>err.txt
-  local rc=$?
-  ((rc != 124)) || fail "timed out (a rank hangs): $*"
-  [[ $(wc -l <status.txt) -eq 3 ]] || fail "not every rank finished: $*"
-  grep -qx 0 status.txt && fail "a rank exited 0: $*"
-  [[ $(wc -l <err.txt) -eq 1 ]] || { cat err.txt >&2; fail "stderr is not exactly one line: $*"; }
-  grep -q '^dynmesh-mpi: ' err.txt || fail "stderr does not start with 'dynmesh-mpi: ': $(cat err.txt)"
-  grep -qF -- "$want" err.txt || fail "stderr lacks '$want': $(cat err.txt)"
+  rm -f err.cells
+  mpi 3 quadtree "$@" --cells err.cells && fail "every rank exited 0: $*"
+  grep -qx 0 <<<"$statuses" && fail "a rank exited 0: $*"
+  our_lines noise.txt err.txt >ours.txt
+  [[ $(wc -l <ours.txt) -eq 1 ]] || { cat err.txt >&2; fail "our stderr is not exactly one line: $*"; }
+  grep -q '^dynmesh-mpi: ' ours.txt || fail "stderr does not start with 'dynmesh-mpi: ': $(cat ours.txt)"
+  grep -qF -- "$want" ours.txt || fail "stderr lacks '$want': $(cat ours.txt)"
   [[ ! -e err.cells ]] || fail "a failed run wrote its output: $*"
   # The message is dynmesh quadtree's.
   "$dynmesh" quadtree "$@" --cells err1.cells >/dev/null 2>err1.txt && fail "dynmesh quadtree accepted $*"
-  [[ "$(sed 's/^dynmesh-mpi: //' err.txt)" == "$(sed 's/^dynmesh: //' err1.txt)" ]] ||
-    fail "message differs from dynmesh quadtree's: $(cat err.txt) / $(cat err1.txt)"
+  [[ "$(sed 's/^dynmesh-mpi: //' ours.txt)" == "$(sed 's/^dynmesh: //' err1.txt)" ]] ||
+    fail "message differs from dynmesh quadtree's: $(cat ours.txt) / $(cat err1.txt)"
+}
+
+# errors_case: malformed, NaN, duplicate, outside the box, absent deletion, spread beyond the
+# resolution; first the launcher's notices of a clean run, and our_lines's own check.
+errors_case() {
+  "$gen" uniform 2 300 3 2 s.xyz s.edits 20 || fail "mpi_gen"
+  mpi 3 quadtree s.xyz --edits s.edits --cells ok.cells || { cat err.txt >&2; fail "a clean run failed"; }
+  grep '^dynmesh-mpi' err.txt && fail "a clean run printed a line of ours on stderr"
+  cp err.txt noise.txt
+  # our_lines keeps our lines and any line it cannot place, and drops the launcher's.
+  printf '[hwloc/linux] a notice\n[host:42] [[1,0],0] ORTE_ERROR_LOG: x\n%s\nOpen MPI: in a box\n%s\n' \
+    ---------------------------------------- ---------------------------------------- >notices.txt
+  { cat notices.txt; echo "dynmesh-mpi: one"; cat notices.txt; } >e1.txt
+  [[ $(our_lines noise.txt e1.txt) == "dynmesh-mpi: one" ]] || fail "our_lines lost our line or kept a notice"
+  { cat e1.txt; echo "a second line"; } >e2.txt
+  [[ $(our_lines noise.txt e2.txt | wc -l) -eq 2 ]] || fail "our_lines dropped a line that is not the launcher's"
+  printf '0.5 0.5\n0.5 abc\n' >bad.xyz
+  printf '0.5 0.5\nnan 0.2\n' >nan.xyz
+  printf '0.5 0.5\n0.1 0.2\n0.5 0.5\n' >dup.xyz
+  printf '0.5 0.5\n0.1 0.2\n0.5 0.50000000000000011\n' >res.xyz
+  echo "- 0.123 0.456" >absent.edits
+  echo "+ 5 5" >outside.edits
+  echo "+ 0.2 inf" >inf.edits
+  { head -4 s.edits; echo "- 0.123 0.456"; } >late.edits
+  x=$(sed -n 10p s.xyz | awk '{ printf "%.17g %.17g", $1, $2 + 1e-16 }')
+  echo "+ $x" >res.edits
+  expect_error "malformed number" bad.xyz
+  expect_error "NaN or infinite" nan.xyz
+  expect_error "duplicate point" dup.xyz
+  expect_error "resolution" res.xyz
+  expect_error "not in the set" s.xyz --edits absent.edits
+  expect_error "late.edits:5:" s.xyz --edits late.edits --batch 3
+  expect_error "outside the domain box" s.xyz --edits outside.edits
+  expect_error "NaN or infinite" s.xyz --edits inf.edits
+  expect_error "exceeds the resolution" s.xyz --edits res.edits --batch 2
+  expect_error "cannot open" missing.xyz
 }
 
 case $case_name in
@@ -105,7 +191,7 @@ case $case_name in
     "$gen" uniform 2 2000 1 2 u.xyz u.edits 200 || fail "mpi_gen"
     "$dynmesh" quadtree u.xyz --edits u.edits --cells ref.cells || fail "dynmesh"
     same 3 u.xyz --edits u.edits --ghost-ring 1
-    mpi 3 quadtree u.xyz --edits u.edits --ghost-ring 0 --cells narrow.cells 2>err.txt || fail "ring 0 failed to run"
+    mpi 3 quadtree u.xyz --edits u.edits --ghost-ring 0 --cells narrow.cells || fail "ring 0 failed to run"
     cmp -s ref.cells narrow.cells && fail "a ghost ring of width 0 gave the exact tree: the test input no longer shows the need"
     ;;
   repartition) # edits that empty the lower half and fill the upper one move root cells; still exact
@@ -120,28 +206,19 @@ case $case_name in
     done
     same 2 u.xyz --box 0 0 1 --edits move.edits --batch 50 --rebalance 0
     ;;
-  errors) # malformed, NaN, duplicate, outside the box, absent deletion, spread beyond the resolution
-    "$gen" uniform 2 300 3 2 s.xyz s.edits 20 || fail "mpi_gen"
-    printf '0.5 0.5\n0.5 abc\n' >bad.xyz
-    printf '0.5 0.5\nnan 0.2\n' >nan.xyz
-    printf '0.5 0.5\n0.1 0.2\n0.5 0.5\n' >dup.xyz
-    printf '0.5 0.5\n0.1 0.2\n0.5 0.50000000000000011\n' >res.xyz
-    echo "- 0.123 0.456" >absent.edits
-    echo "+ 5 5" >outside.edits
-    echo "+ 0.2 inf" >inf.edits
-    { head -4 s.edits; echo "- 0.123 0.456"; } >late.edits
-    x=$(sed -n 10p s.xyz | awk '{ printf "%.17g %.17g", $1, $2 + 1e-16 }')
-    echo "+ $x" >res.edits
-    expect_error "malformed number" bad.xyz
-    expect_error "NaN or infinite" nan.xyz
-    expect_error "duplicate point" dup.xyz
-    expect_error "resolution" res.xyz
-    expect_error "not in the set" s.xyz --edits absent.edits
-    expect_error "late.edits:5:" s.xyz --edits late.edits --batch 3
-    expect_error "outside the domain box" s.xyz --edits outside.edits
-    expect_error "NaN or infinite" s.xyz --edits inf.edits
-    expect_error "exceeds the resolution" s.xyz --edits res.edits --batch 2
-    expect_error "cannot open" missing.xyz
+  errors) # bad input: one line of ours from rank 0, every rank non-zero, nothing written
+    errors_case
+    ;;
+  errors_hwloc) # the same where hwloc warns on every rank (no sysfs, as in a minimal container)
+    mkdir -p no-sysfs
+    export HWLOC_FSROOT=$PWD/no-sysfs
+    errors_case
+    grep -q hwloc noise.txt || fail "hwloc printed no warning: the case no longer shows the launcher's notices"
+    ;;
+  differential2 | differential3) # MpiQuadtree against StaticQuadtree after every batch
+    [[ -x $unit ]] || fail "no MPI_QUADTREE_TEST given"
+    launch "${case_name#differential}" "$unit" || { cat out.txt err.txt >&2; fail "mpi_quadtree_test failed"; }
+    cat out.txt
     ;;
   real_world) # data the project did not write: gnuplot's world coastline (gnuplot-doc, dev.sh deps)
     world=/usr/share/doc/gnuplot/examples/world.dat
