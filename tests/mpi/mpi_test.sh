@@ -30,19 +30,21 @@ fail() {
 session=$(mktemp -d /tmp/sac-mpi.XXXXXX) || fail "mktemp"
 trap 'rm -rf "$session"' EXIT
 export OMPI_MCA_orte_tmpdir_base=$session TMPDIR=$session
+limit=600
 
 # launch P PROGRAM ARGS...: PROGRAM on P ranks (more ranks than cores: --oversubscribe; -q: no
-# launcher chatter), stdout to out.txt and stderr to err.txt, killed after 120 s so that a
-# hang fails instead of blocking. Sets `statuses` to the ranks' exit statuses, sorted. Fails
+# launcher chatter), stdout to out.txt and stderr to err.txt, killed after `limit` seconds so
+# that a hang fails instead of blocking. The limit is for hangs, not speed: a launch takes a
+# few seconds, but four ranks on two loaded cores have taken over two minutes. Sets `statuses` to the ranks' exit statuses, sorted. Fails
 # the test on a hang or a failed launch; returns 0 when every rank exited 0, 1 otherwise.
 launch() {
   local p=$1
   shift
   rm -f status.txt
-  timeout 120 "$mpiexec" -q --oversubscribe -np "$p" sh -c '"$0" "$@"; echo "$?" >>status.txt' "$@" \
+  timeout "$limit" "$mpiexec" -q --oversubscribe -np "$p" sh -c '"$0" "$@"; echo "$?" >>status.txt' "$@" \
     >out.txt 2>err.txt
   local rc=$?
-  ((rc != 124)) || fail "timed out after 120 s (a rank hangs): -np $p ${*:2}"
+  ((rc != 124)) || fail "timed out after $limit s (a rank hangs): -np $p ${*:2}"
   statuses=$(sort -n status.txt 2>/dev/null)
   local done=0
   [[ -z $statuses ]] || done=$(wc -l <<<"$statuses")
