@@ -13,15 +13,18 @@
 // build, apply the edits (edit_runner.hpp), --check, write.
 // Every error names the file and line it comes from, as `dynmesh quadtree` does; every output
 // is written aside and renamed into place only after all of them were written
-// (atomic_file.hpp), so a failed run leaves old files untouched. Before anything is read, the
+// (atomic_file.hpp), so a failed run leaves old files untouched. The change feed grows with
+// the session, not with the mesh: it streams to its temporary as the edits propagate, so a
+// long session's feed never has to fit in memory. Before anything is read, the
 // memory guard (memory_guard.hpp) refuses a mesh that cannot fit in memory, unless --force;
 // the long phases (reading, building, --check) show their elapsed time on stderr
 // (progress.hpp). With --edits, --stats also reports the propagations (count, time, trace
 // distance, triangles or tetrahedra changed: propagation_log.hpp).
 // Complexity: construction O(n lg n + |T'|) expected, then O(lg L/s) expected trace distance
 // per edit (DynamicMesh, DynamicOctreeMesh); hpu O(n lg n + m) expected for m vertices; the
-// outputs are linear in the mesh (the SVG O(t log t)); --check adds a from-scratch mesh and
-// the mesh checker, O((t + n) log t).
+// outputs are linear in the mesh (the SVG O(t log t)), the feed linear in the changes it lists
+// and written as they come (memory O(1) for it beyond the largest single update); --check adds
+// a from-scratch mesh and the mesh checker, O((t + n) log t).
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -106,18 +109,17 @@ std::string quality_report(const TetMesh& mesh, std::size_t inputs) {
   return format_stats(tet_mesh_stats(mesh), inputs);
 }
 
-/// Writes the outputs aside and renames them into place together (atomic_file.hpp); then
-/// the duplicate count and --stats. `mesh` is a Mesh (2D) or a TetMesh (3D); `feed` is empty
-/// unless --feed was given; `propagations` is the log of the edits' propagations, null
-/// without --edits (--stats reports them after the quality report).
+/// Writes the mesh's outputs aside, then renames them into place together with whatever
+/// `out` already holds (the feed, written as the run went: atomic_file.hpp); then the
+/// duplicate count and --stats. `mesh` is a Mesh (2D) or a TetMesh (3D); `propagations` is
+/// the log of the edits' propagations, null without --edits (--stats reports them after the
+/// quality report).
 template <std::size_t d, class Canonical>
-void write_outputs(const MeshCommandOptions& o, const Canonical& mesh, const Box<d>& box,
-                   std::span<const Point<d>> inputs, const std::string& feed, std::size_t duplicates_skipped,
+void write_outputs(const MeshCommandOptions& o, AtomicOutputs& out, const Canonical& mesh, const Box<d>& box,
+                   std::span<const Point<d>> inputs, std::size_t duplicates_skipped,
                    const PropagationLog* propagations = nullptr, std::size_t edits = 0) {
-  AtomicOutputs out;
   out.add(o.outbase + ".node", format_node(mesh, box));
   out.add(o.outbase + ".ele", format_ele(mesh));
-  if (!o.feed.empty()) out.add(o.feed, feed);
   if (!o.vtk.empty()) out.add(o.vtk, format_vtk(mesh));
   if (!o.msh.empty()) out.add(o.msh, format_msh(mesh));
   if constexpr (d == 2) {
@@ -180,8 +182,9 @@ int run_hpu_mesh(const MeshCommandOptions& o, Columns columns) {
     const MeshReport report = check_mesh(mesh, box, points, options);
     if (!report.ok()) throw InvariantError("--check failed: " + report.summary());
   }
-  write_outputs<2>(o, mesh, box, std::span<const Point<2>>(points), o.feed.empty() ? std::string() : feed_header(),
-                  initial.duplicates_skipped);
+  AtomicOutputs out;
+  if (!o.feed.empty()) out.add(o.feed, feed_header());  // no edits: the header alone
+  write_outputs<2>(o, out, mesh, box, std::span<const Point<2>>(points), initial.duplicates_skipped);
   return 0;
 }
 
@@ -212,12 +215,20 @@ int run_dynamic(const MeshCommandOptions& o, Columns columns, const std::string&
   }
   Structure& dynamic = *built;
 
-  const bool want_feed = !o.feed.empty();
-  std::string feed = want_feed ? feed_header() : std::string();
+  // The feed goes to its temporary as the edits propagate; a failure from here on removes it
+  // with the outputs not yet written, and the target stays as it was.
+  AtomicOutputs out;
+  AtomicOutputs::Stream* feed = o.feed.empty() ? nullptr : &out.open_stream(o.feed);
+  if (feed) feed->append(feed_header());
+  std::string update;  // one update's lines; reused, so that it stops allocating once grown
   PropagationLog propagations;  // for --stats
   apply_edits<d>(dynamic, script, o.batch, [&] {
     propagations.record(dynamic.last_update(), dynamic.last_change());
-    if (want_feed) feed += format_feed_update(propagations.count(), dynamic.last_change());
+    if (feed) {
+      update.clear();
+      append_feed_update(update, propagations.count(), dynamic.last_change());
+      feed->append(update);
+    }
   });
 
   const auto mesh = dynamic.mesh();
@@ -236,7 +247,7 @@ int run_dynamic(const MeshCommandOptions& o, Columns columns, const std::string&
   }
 
   built.reset();  // as in `dynmesh quadtree`: the outputs are formatted without the trace
-  write_outputs<d>(o, mesh, box, std::span<const Point<d>>(inputs), feed, initial.duplicates_skipped,
+  write_outputs<d>(o, out, mesh, box, std::span<const Point<d>>(inputs), initial.duplicates_skipped,
                    o.edits.empty() ? nullptr : &propagations, script.edits.size());
   return 0;
 }

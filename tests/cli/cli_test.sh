@@ -432,6 +432,89 @@ case $case_name in
     expect_error 2 '-o' "$dynmesh" mesh "$data/points2d.node" "${qt[@]}"
     ;;
 
+  feed_stream) # --feed streams to its temporary as the edits propagate (docs/FORMATS.md, "`dynmesh
+    # mesh` (2D)"): the whole feed, byte for byte, and a run that fails midway (a bad edit, a
+    # failed write, a target that is not a file) leaves the old files and no temporary.
+    # many.txt moves every point of points2d.node a sixteenth of the way to (5, 5), eight
+    # rounds, so that the feed passes the stream's buffer several times before the last edit.
+    awk 'FNR > 2 && NF >= 3 { x[++n] = $2; y[n] = $3 }
+      END { for (r = 1; r <= 8; r++) for (i = 1; i <= n; i++) {
+              printf "- %.17g %.17g\n", x[i], y[i]; x[i] += (5 - x[i]) / 16; y[i] += (5 - y[i]) / 16
+              printf "+ %.17g %.17g\n", x[i], y[i] } }' "$data/points2d.node" >many.txt
+    edits=$(wc -l <many.txt)
+    buffer=$((1 << 20)) # AtomicOutputs::Stream::kBufferBytes
+    # tris_of NODE ELE: one sorted line per triangle, its corners as the .node writes them, in
+    # the .ele's order: the form of the feed's lines.
+    tris_of() {
+      awk 'NR == FNR { if (FNR > 1) xy[$1] = $2 " " $3; next } FNR > 1 { print xy[$2], xy[$3], xy[$4] }' \
+        "$1" "$2" | LC_ALL=C sort
+    }
+    # replay TRIS FEED: TRIS with every update's '-' lines removed and '+' lines added, in order;
+    # fails when a removed triangle is absent or an added one is present.
+    replay() {
+      awk 'NR == FNR { have[$0] = 1; next }
+        /^[-+] / { t = substr($0, 3); if ($1 == "-") { bad = bad || !(t in have); delete have[t] }
+                   else { bad = bad || (t in have); have[t] = 1 } }
+        END { for (t in have) print t; exit bad }' "$1" "$2" | LC_ALL=C sort
+    }
+    for pp in hpu quadtree; do
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits many.txt -o "$pp" --feed "$pp.feed" --check
+      (($(wc -c <"$pp.feed") > 2 * buffer)) || fail "$pp.feed is too small to pass the stream's buffer"
+      [[ $(head -1 "$pp.feed") == '# dynmesh feed v1' ]] || fail "$pp feed header: $(head -1 "$pp.feed")"
+      [[ $(grep -c '^update ' "$pp.feed") -eq $edits ]] || fail "$pp feed: expected $edits updates"
+      # The feed of the first edits, small enough to stay in the buffer until the end, is the
+      # start of the whole feed, byte for byte.
+      head -n 20 many.txt >first.txt
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits first.txt -o first --feed first.feed
+      (($(wc -c <first.feed) < buffer)) || fail "first.feed does not fit in the buffer"
+      cmp first.feed <(head -c "$(wc -c <first.feed)" "$pp.feed") || fail "$pp: the first edits' feed is not its start"
+      # --batch 7: the same final mesh, one update per batch.
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp --edits many.txt --batch 7 -o batch7 \
+        --feed batch7.feed
+      cmp "$pp.node" batch7.node || fail "$pp: --batch 7 .node differs from single edits"
+      cmp "$pp.ele" batch7.ele || fail "$pp: --batch 7 .ele differs from single edits"
+      [[ $(grep -c '^update ' batch7.feed) -eq $(((edits + 6) / 7)) ]] || fail "$pp --batch 7: wrong number of updates"
+      # Replayed on the initial mesh, each feed gives the final one.
+      run "$dynmesh" mesh "$data/points2d.node" --postprocess $pp -o start
+      tris_of start.node start.ele >start.tris
+      tris_of "$pp.node" "$pp.ele" >final.tris
+      for f in "$pp.feed" batch7.feed; do
+        replay start.tris "$f" >replayed.tris || fail "$f removes an absent triangle or adds a present one"
+        cmp replayed.tris final.tris || fail "$f replayed on the initial mesh does not give the final .ele"
+      done
+    done
+    # A run that fails after the feed has passed the buffer: the old files as they were, no
+    # temporary left.
+    for f in node ele feed; do cp "hpu.$f" "saved.$f"; done
+    unchanged() {
+      for f in node ele feed; do cmp "hpu.$f" "saved.$f" || fail "$1: the failed run changed hpu.$f"; done
+      [[ -z $(find . -name '.*.tmp-*') ]] || fail "$1: temporary files left behind: $(find . -name '.*.tmp-*')"
+    }
+    { cat many.txt; echo '- 1.2345 6.789'; } >absent.txt # the last edit deletes an absent point
+    for batch in "" "--batch 7"; do
+      # shellcheck disable=SC2086  # $batch is zero or two words
+      expect_error 1 "absent.txt:$((edits + 1)): " "$dynmesh" mesh "$data/points2d.node" --edits absent.txt $batch \
+        -o hpu --feed hpu.feed
+      grep -q 'not in the set' err.txt || fail "absent point: unclear message: $(cat err.txt)"
+      unchanged "absent point${batch:+ with $batch}"
+    done
+    # A write that fails midway (EFBIG under a file size limit of a quarter of the feed's
+    # buffer, with SIGXFSZ ignored so that the write fails instead of the signal killing us).
+    limited() (
+      trap '' XFSZ
+      ulimit -f $((buffer / 4096)) && exec "$@"
+    )
+    expect_error 1 'hpu.feed: cannot write output: write error: File too large' limited "$dynmesh" mesh \
+      "$data/points2d.node" --edits many.txt -o hpu --feed hpu.feed
+    unchanged "a failed write"
+    # A target that is not a regular file is refused, not replaced.
+    mkdir -p adir
+    expect_error 1 'adir: cannot write output: not a regular file' "$dynmesh" mesh "$data/points2d.node" \
+      --edits many.txt -o hpu --feed adir
+    [[ -d adir ]] || fail "a directory target was replaced"
+    unchanged "a directory target"
+    ;;
+
   atomic) # a failed write (here EFBIG under a file size limit) names the OS reason and leaves
     # the old file byte for byte: quadtree .cells and --svg, mesh -o, the stability CSV and
     # --plot; an existing target that is not a regular file is refused, not replaced.

@@ -319,6 +319,21 @@ TEST(MeshIo, FeedText) {
   EXPECT_EQ(format_feed_update(1, {}), "update 1 removed 0 added 0\n");
 }
 
+TEST(MeshIo, AppendedFeedUpdatesAreTheFormattedOnes) {
+  // `dynmesh mesh --feed` streams the updates through one reused string: the bytes must be
+  // those of format_feed_update, after whatever the string held.
+  MeshChange change;
+  change.removed = {canonical_triangle({0.1, 0.2}, {1.0 / 3, 0}, {1, 1})};
+  change.added = {canonical_triangle({0, 0}, {1e-300, 0}, {0, 2.5e300})};
+  std::string out = feed_header();
+  append_feed_update(out, 1, change);
+  append_feed_update(out, 2, {});
+  EXPECT_EQ(out, feed_header() + format_feed_update(1, change) + format_feed_update(2, {}));
+  out.clear();
+  append_feed_update(out, 7, change);
+  EXPECT_EQ(out, format_feed_update(7, change));
+}
+
 TEST(MeshIo, FeedNumbersRoundTrip) {
   const double third = 1.0 / 3, tenth = 0.1;
   MeshChange change;

@@ -270,6 +270,17 @@ TEST(TetMeshIo, FeedText) {
   EXPECT_EQ(format_feed_update(1, TetMeshChange{}), "update 1 removed 0 added 0\n");
 }
 
+TEST(TetMeshIo, AppendedFeedUpdatesAreTheFormattedOnes) {
+  TetMeshChange change;
+  change.removed = {canonical_tetrahedron({0, 1, 0}, {0, 0, 1}, {0, 0, 0}, {1, 0, 0})};
+  change.added = kuhn({1e-300, 0.2, 0.3}, {1.0 / 3, 1, 2.5e300});
+  std::sort(change.added.begin(), change.added.end());
+  std::string out = feed_header();
+  append_feed_update(out, 4, change);
+  append_feed_update(out, 5, TetMeshChange{});
+  EXPECT_EQ(out, feed_header() + format_feed_update(4, change) + format_feed_update(5, TetMeshChange{}));
+}
+
 TEST(TetMeshIo, FeedLinesHoldTwelveExactNumbers) {
   const double third = 1.0 / 3, tenth = 0.1;
   TetMeshChange change;

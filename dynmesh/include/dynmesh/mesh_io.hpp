@@ -1,7 +1,8 @@
 // dynmesh/mesh_io.hpp — the text forms of a 2D mesh: files, feed, picture and statistics.
 //
 // Purpose: everything `dynmesh mesh` writes (docs/FORMATS.md, "`dynmesh mesh` (2D)"), as pure
-// functions from values to strings; the caller writes files (aside, then renamed).
+// functions from values to strings (the feed's updates also appended to a caller's string, so
+// that a stream of them reuses one); the caller writes files (aside, then renamed).
 //   .node / .ele  Triangle's formats, numbered from 1 in the canonical order of a Mesh;
 //                 coordinates %.17g (they round-trip exactly); node marker 1 on the box
 //                 boundary (x == o1, x == fl(o1+L), y == o2 or y == fl(o2+L)), else 0.
@@ -16,8 +17,9 @@
 //                 an angle histogram in 10-degree bins.
 // Every line ends in '\n'; numbers that must round-trip use format_exact (%.17g, C locale).
 //
-// Invariants: each format_* depends only on its arguments; read_node_ele(format_node(m, b),
-// format_ele(m)) == m for every Mesh m.
+// Invariants: each format_* depends only on its arguments; append_feed_update(out, k, c)
+// appends exactly format_feed_update(k, c); read_node_ele(format_node(m, b), format_ele(m)) == m
+// for every Mesh m.
 // Complexity: linear in the mesh for the text formats; format_svg O(t log t) (edges are
 // sorted to draw each once); read_node_ele linear in the text.
 // Paper: none (Triangle's .node/.ele and -V report; VTK's legacy format; Gmsh's MSH 2.2).
@@ -83,5 +85,8 @@ std::string feed_header();
 /// `update <k> removed <r> added <a>`, then one `- x1 y1 x2 y2 x3 y3` line per removed
 /// triangle and one `+ ...` line per added one, in the change's (sorted) order.
 std::string format_feed_update(std::size_t k, const MeshChange& change);
+/// format_feed_update's text appended to `out`: a caller that streams the feed reuses one
+/// string for every update instead of allocating one per update.
+void append_feed_update(std::string& out, std::size_t k, const MeshChange& change);
 
 }  // namespace dynmesh

@@ -77,5 +77,7 @@ std::string format_stats(const TetMeshStats& stats, std::size_t num_inputs);
 /// per removed tetrahedron and one `+ ...` line per added one, in the change's (sorted) order,
 /// each tetrahedron's corners in its canonical rotation.
 std::string format_feed_update(std::size_t k, const TetMeshChange& change);
+/// format_feed_update's text appended to `out` (mesh_io.hpp's 2D twin says why).
+void append_feed_update(std::string& out, std::size_t k, const TetMeshChange& change);
 
 }  // namespace dynmesh

@@ -243,7 +243,13 @@ std::string format_stats(const MeshStats& s) {
 std::string feed_header() { return "# dynmesh feed v1\n"; }
 
 std::string format_feed_update(std::size_t k, const MeshChange& change) {
-  return detail::feed_update_text<Triangle>(k, change.removed, change.added);
+  std::string out;
+  append_feed_update(out, k, change);
+  return out;
+}
+
+void append_feed_update(std::string& out, std::size_t k, const MeshChange& change) {
+  detail::append_feed_update_text<Triangle>(out, k, change.removed, change.added);
 }
 
 }  // namespace dynmesh

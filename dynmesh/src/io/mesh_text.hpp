@@ -6,7 +6,7 @@
 // .vtk; a feed line per simplex; the -V style statistics' rows and histogram. Writing them
 // once keeps the two dimensions' files identical in form (docs/FORMATS.md, "`dynmesh mesh` (2D)"
 // and "`dynmesh mesh` in 3D") and their number formatting the same (%.17g, C locale).
-// Invariants: every line ends in '\n'; coordinates go through format_exact, so they
+// Invariants: every line ends in '\n'; coordinates are format_exact's text, so they
 // round-trip; read_node_ele_text(node_text(v, box), ele_text(c)) gives back v and c.
 // Complexity: linear in the vertices and cells, and in the text for the reader.
 // Paper: none (Triangle's and TetGen's .node/.ele; VTK's legacy format; Gmsh's MSH 2.2).
@@ -33,7 +33,13 @@ namespace dynmesh::detail {
 
 inline void append_line_end(std::string& out) { out += '\n'; }
 
-inline void append_exact(std::string& out, double x) { out += format_exact(x); }
+/// format_exact's text, formatted in place: most coordinates are longer than a short string,
+/// so going through format_exact's string would cost the feed a heap allocation per number.
+inline void append_exact(std::string& out, double x) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, 17);
+  out.append(buf, r.ptr);
+}
 
 /// A one-digit constant as a character (append_number on a constant trips GCC 12's
 /// -Wrestrict false positive, its bug 105651).
@@ -310,9 +316,11 @@ void read_node_ele_text(const std::string& node_text, const std::string& ele_tex
 
 /// `update <k> removed <r> added <a>`, then a `- ...` line per removed simplex and a `+ ...`
 /// line per added one, each its corners' coordinates in the simplex's (canonical) order.
+/// Appended to `out`, so that a caller streaming the feed can reuse one string.
 template <class Simplex>
-std::string feed_update_text(std::size_t k, std::span<const Simplex> removed, std::span<const Simplex> added) {
-  std::string out = "update ";
+void append_feed_update_text(std::string& out, std::size_t k, std::span<const Simplex> removed,
+                             std::span<const Simplex> added) {
+  out += "update ";
   append_number(out, k);
   out += " removed ";
   append_number(out, removed.size());
@@ -329,7 +337,6 @@ std::string feed_update_text(std::size_t k, std::span<const Simplex> removed, st
   };
   for (const Simplex& s : removed) simplex_line('-', s);
   for (const Simplex& s : added) simplex_line('+', s);
-  return out;
 }
 
 // ---- the statistics report ------------------------------------------------------------------

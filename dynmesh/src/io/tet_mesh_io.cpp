@@ -90,7 +90,13 @@ std::string format_stats(const TetMeshStats& s, std::size_t num_inputs) {
 }
 
 std::string format_feed_update(std::size_t k, const TetMeshChange& change) {
-  return detail::feed_update_text<Tetrahedron>(k, change.removed, change.added);
+  std::string out;
+  append_feed_update(out, k, change);
+  return out;
+}
+
+void append_feed_update(std::string& out, std::size_t k, const TetMeshChange& change) {
+  detail::append_feed_update_text<Tetrahedron>(out, k, change.removed, change.added);
 }
 
 }  // namespace dynmesh
