@@ -12,7 +12,11 @@
 //     is not read ahead: it counts as empty).
 //   * Available memory is the least of MemAvailable (/proc/meminfo) and what remains under
 //     the finite soft limits RLIMIT_AS (`ulimit -v`, less the current VmSize) and RLIMIT_DATA
-//     (`ulimit -d`, less the current VmData). Control-group limits are not read.
+//     (`ulimit -d`, less the current VmData). Control-group limits are not read. Where
+//     /proc/meminfo cannot be read (a container that hides or lacks /proc), the machine's
+//     physical memory (sysconf(_SC_PHYS_PAGES): glibc asks sysinfo(2), not /proc) stands in
+//     for MemAvailable, and the message names it, so that a build larger than the whole
+//     machine is still refused at once rather than left to the OOM killer.
 //   * A build the guard lets go on is held to what it found: the soft RLIMIT_DATA is lowered
 //     to the current VmData plus the available amount (never raised). The estimate is per
 //     point, and some inputs cost more than any constant foresees (points along a line in
@@ -24,7 +28,8 @@
 //     sampled during `dynmesh quadtree FILE --cells o.cells --force`), so the cap stops a
 //     build only when it is close to not fitting.
 // Invariants: the guard throws only when the estimate exceeds a known available amount; when
-// nothing can be read (no /proc) it lets the run go on, uncapped. --force skips both.
+// nothing can be read (no /proc and no physical memory size) it lets the run go on; without
+// /proc/self/status (VmData) it does not cap the data size. --force skips both.
 // Complexity: O(bytes of the point and edit files) for the line counts; O(1) otherwise.
 // Paper: none.
 #pragma once
@@ -43,6 +48,7 @@
 
 #include <sys/resource.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "dynmesh/errors.hpp"
 #include "dynmesh/io.hpp"
@@ -169,6 +175,15 @@ inline std::optional<std::uint64_t> under_limit(int resource, std::optional<std:
   return cap > in_use ? cap - in_use : 0;
 }
 
+// The machine's physical memory in bytes (sysconf, which glibc answers with sysinfo(2), no
+// /proc needed); nullopt when unknown.
+inline std::optional<std::uint64_t> physical_memory() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return std::nullopt;
+  const auto p = static_cast<std::uint64_t>(pages), s = static_cast<std::uint64_t>(page);
+  return p > std::numeric_limits<std::uint64_t>::max() / s ? std::numeric_limits<std::uint64_t>::max() : p * s;
+}
+
 }  // namespace detail
 
 /// The memory a build may use now; nullopt when nothing is known (no /proc, no limits).
@@ -177,7 +192,10 @@ inline std::optional<AvailableMemory> available_memory() {
   auto consider = [&best](std::optional<std::uint64_t> bytes, const char* source) {
     if (bytes && (!best || *bytes < best->bytes)) best = AvailableMemory{*bytes, source};
   };
-  consider(detail::proc_kb("/proc/meminfo", "MemAvailable"), "MemAvailable in /proc/meminfo");
+  if (const auto mem_available = detail::proc_kb("/proc/meminfo", "MemAvailable"))
+    consider(mem_available, "MemAvailable in /proc/meminfo");
+  else  // no /proc/meminfo: the whole machine's memory, an upper bound on what is available
+    consider(detail::physical_memory(), "the machine's physical memory; /proc/meminfo is unreadable");
   consider(detail::under_limit(RLIMIT_AS, detail::proc_kb("/proc/self/status", "VmSize")),
            "under the address-space limit, ulimit -v");
   consider(detail::under_limit(RLIMIT_DATA, detail::proc_kb("/proc/self/status", "VmData")),

@@ -2,8 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <limits>
 #include <filesystem>
 #include <fstream>
@@ -290,15 +293,21 @@ TEST(EscapeControlBytes, EveryControlByteAndOnlyThose) {
 
 // --- files, boxes and duplicates -------------------------------------------------------------
 
+// A fresh directory of its own per test (mkdtemp): not a name derived from the test and the
+// clock (gtest's random_seed() is the time in ms when no seed is given), which two processes
+// running the same test at once, such as two build trees' ctest runs on one machine, could
+// share, one removing the other's files.
 class TempDir : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("dynmesh_io_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
+    const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::string name = (std::filesystem::temp_directory_path() / ("dynmesh_io_test_" + test + "_XXXXXX")).string();
+    ASSERT_NE(::mkdtemp(name.data()), nullptr) << "mkdtemp " << name << ": " << std::strerror(errno);
+    dir_ = name;
   }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
+  void TearDown() override {
+    if (!dir_.empty()) std::filesystem::remove_all(dir_);
+  }
   std::string write(const std::string& name, const std::string& text) {
     const auto p = (dir_ / name).string();
     std::ofstream(p, std::ios::binary) << text;

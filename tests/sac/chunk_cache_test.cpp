@@ -9,6 +9,8 @@
 #include <memory>
 #include <vector>
 
+#include <unistd.h>
+
 #include "sac/chunk_cache.hpp"
 #include "sac/sac.hpp"
 
@@ -38,14 +40,16 @@ struct BigTrace {
 
 constexpr std::size_t kReads = 400'000;
 
-/// Resident bytes (Linux), or 0 when /proc is not there.
+/// Resident bytes (Linux), or 0 when /proc is not there. statm counts pages of the kernel's
+/// size (4 KiB on x86-64, 16 or 64 KiB on some arm64 kernels).
 std::size_t resident_bytes() {
   std::FILE* f = std::fopen("/proc/self/statm", "r");
   if (!f) return 0;
   unsigned long size = 0, resident = 0;
   const int got = std::fscanf(f, "%lu %lu", &size, &resident);
   std::fclose(f);
-  return got == 2 ? resident * 4096 : 0;
+  const long page = ::sysconf(_SC_PAGESIZE);
+  return got == 2 && page > 0 ? resident * static_cast<std::size_t>(page) : 0;
 }
 
 TEST_F(ChunkCache, DefaultBoundIsSmall) {
@@ -76,10 +80,11 @@ TEST_F(ChunkCache, ABoundOfZeroGivesTheMemoryBack) {
   big.rt.reset();  // the engine alone, so the mods' vector does not blur the figure
   const std::size_t after = resident_bytes();
   EXPECT_EQ(sac::chunk_cache_bytes(), 0u);
-  if (before != 0) {
-    EXPECT_GT(before - std::min(before, after), trace / 2)
-        << "resident " << before << " -> " << after << " bytes, trace " << trace;
-  }
+  if (before == 0)
+    GTEST_SKIP() << "/proc/self/statm cannot be read (no or a restricted /proc): the resident-set drop "
+                    "is not checked, only that the cache holds nothing";
+  EXPECT_GT(before - std::min(before, after), trace / 2)
+      << "resident " << before << " -> " << after << " bytes, trace " << trace;
 }
 
 }  // namespace

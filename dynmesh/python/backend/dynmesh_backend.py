@@ -10,7 +10,8 @@ installs, so a second install rebuilds only what changed) with DYNMESH_PYTHON=ON
 benchmarks, examples or command, Release, and Python3_EXECUTABLE = the interpreter pip runs;
 it builds the target dynmesh_python and zips build/python-wheel/python/dynmesh/ (the
 extension and the package's .py files) with the .dist-info the wheel format asks for.
-DYNMESH_WHEEL_BUILD_DIR overrides the build directory; JOBS (as for dev.sh) the parallelism.
+DYNMESH_WHEEL_BUILD_DIR overrides the build directory; JOBS (as for dev.sh) the parallelism,
+by default the CPUs the process may run on.
 Invariants: the wheel holds exactly the package directory CMake laid out; its version is the
 project's (CMakeLists.txt); its tag names this interpreter and platform (the module is
 compiled for them).
@@ -74,6 +75,15 @@ def _run(cmd):
     subprocess.run(list(map(str, cmd)), check=True, stdout=sys.stderr)
 
 
+def _cpus():
+    """The CPUs this process may run on, as dev.sh's nproc counts them: in a container limited
+    to a few CPUs (a cpuset), those, not the host's (os.cpu_count(), which reads /sys or /proc)."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def _build_package():
     """Configures and builds dynmesh_python; returns the package directory CMake laid out."""
     build = pathlib.Path(os.environ.get("DYNMESH_WHEEL_BUILD_DIR", ROOT / "build" / "python-wheel"))
@@ -83,7 +93,7 @@ def _build_package():
     if shutil.which("ninja") and not (build / "CMakeCache.txt").exists():
         configure += ["-G", "Ninja"]
     _run(configure)
-    _run(["cmake", "--build", build, "--target", "dynmesh_python", "-j", os.environ.get("JOBS", os.cpu_count() or 1)])
+    _run(["cmake", "--build", build, "--target", "dynmesh_python", "-j", os.environ.get("JOBS", _cpus())])
     package = build / "python" / NAME
     if not any(package.glob("_dynmesh*.so")):
         raise RuntimeError(f"dynmesh_backend: no extension module in {package}")
