@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <memory>
 #include <random>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <type_traits>
@@ -202,6 +203,13 @@ TEST(MemoryBreakdown, CountsAndBytesFollowTheProgramsEvents) {
   EXPECT_GT(b.alloc_table_bytes, 0u);
   EXPECT_GT(b.memo_table_bytes, 0u);
   EXPECT_GT(b.engine_vectors, 0u);
+  // The printout ends with the reads by block size.
+  std::ostringstream text;
+  text << b;
+  EXPECT_NE(text.str().find("read blocks (bytes x count): " + std::to_string(sizeof(sac::detail::ReadNodeT<StepFn>)) +
+                            'x' + std::to_string(n + 1) + '\n'),
+            std::string::npos)
+      << text.str();
 }
 
 TEST(MemoryBreakdown, KeyBytesAreWhereTheObjectStarts) {

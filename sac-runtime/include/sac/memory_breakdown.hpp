@@ -111,12 +111,15 @@ struct MemoryBreakdown {
     b.for_each_part([&](const char* name, std::uint64_t count, std::size_t bytes) {
       os << name << ": " << count << " / " << bytes << " B\n";
     });
-    return os << "trace: " << b.trace() << " B (unaccounted " << b.unaccounted << ")\n"
+    os << "trace: " << b.trace() << " B (unaccounted " << b.unaccounted << ")\n"
               << "inputs (base versions): " << b.inputs.count << " / " << b.inputs.bytes() << " B\n"
               << "engine vectors: " << b.engine_vectors << " B\n"
               << "pool: reserved " << b.pool_reserved << " B, unused " << b.pool_unused()
               << " B, large blocks " << b.pool_large << " B, size-class rounding "
               << b.size_class_rounding << " B\n";
+    os << "read blocks (bytes x count):";
+    for (const auto& [bytes, count] : b.read_sizes) os << ' ' << bytes << 'x' << count;
+    return os << '\n';
   }
 };
 
