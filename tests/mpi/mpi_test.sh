@@ -35,8 +35,9 @@ limit=600
 # launch P PROGRAM ARGS...: PROGRAM on P ranks (more ranks than cores: --oversubscribe; -q: no
 # launcher chatter), stdout to out.txt and stderr to err.txt, killed after `limit` seconds so
 # that a hang fails instead of blocking. The limit is for hangs, not speed: a launch takes a
-# few seconds, but four ranks on two loaded cores have taken over two minutes. Sets `statuses` to the ranks' exit statuses, sorted. Fails
-# the test on a hang or a failed launch; returns 0 when every rank exited 0, 1 otherwise.
+# few seconds, but four ranks on two loaded cores have taken over two minutes. Sets
+# `statuses` to the ranks' exit statuses, sorted. Fails the test on a hang or a failed
+# launch; returns 0 when every rank exited 0, 1 otherwise.
 launch() {
   local p=$1
   shift
