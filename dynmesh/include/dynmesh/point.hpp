@@ -40,11 +40,17 @@ template <std::size_t d>
 using Position = std::array<std::uint64_t, d>;
 
 /// A double as printf("%.17g") prints it in the C locale (round-trips exactly), independent of
-/// the current locale. Used for every number dynmesh prints.
-inline std::string format_exact(double x) {
+/// the current locale. Used for every number dynmesh prints; appended in place where a long
+/// text is built (the change feed), so that a number costs no string of its own.
+inline void append_exact(std::string& out, double x) {
   char buf[64];
   const auto r = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, 17);
-  return std::string(buf, r.ptr);
+  out.append(buf, r.ptr);
+}
+inline std::string format_exact(double x) {
+  std::string out;
+  append_exact(out, x);
+  return out;
 }
 
 /// A double to `digits` significant digits (%g style, C locale), for sizes and ratios in

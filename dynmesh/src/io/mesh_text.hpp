@@ -33,13 +33,6 @@ namespace dynmesh::detail {
 
 inline void append_line_end(std::string& out) { out += '\n'; }
 
-/// format_exact's text, formatted in place: most coordinates are longer than a short string,
-/// so going through format_exact's string would cost the feed a heap allocation per number.
-inline void append_exact(std::string& out, double x) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::general, 17);
-  out.append(buf, r.ptr);
-}
 
 /// A one-digit constant as a character (append_number on a constant trips GCC 12's
 /// -Wrestrict false positive, its bug 105651).
