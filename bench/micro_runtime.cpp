@@ -118,8 +118,8 @@ struct QElem {
 };
 struct QTraits {
   static const Stamp* stamp(const QElem* e) { return &e->stamp; }
-  static std::uint32_t& pos(QElem* e) { return e->qpos; }
   static std::uint32_t pos(const QElem* e) { return e->qpos; }
+  static void set_pos(QElem* e, std::uint32_t p) { e->qpos = p; }
 };
 
 void BM_StampQueuePushPop(benchmark::State& state) {

@@ -103,15 +103,15 @@ VersionBase* Engine::default_base(ModBase& m, bool defaulted, const detail::Vers
   set_base(m, base, nullptr);
   if (readers) {  // a default's list has no order
     base->unordered_readers = readers;
-    readers->rpprev = &base->unordered_readers;
-    for (ReaderLink* r = readers; r; r = r->rnext) r->unordered = 1;
+    readers->set_rpprev(&base->unordered_readers);
+    for (ReaderLink* r = readers; r; r = r->rnext) r->set_unordered(true);
   }
   return base;
 }
 
 void Engine::link_write(ModBase& m, VersionBase* v) {
   // Readers of the default and a version: the default needs its own version now.
-  if (m.default_readers()) default_base(m, true, v->ops);
+  if (m.default_readers()) default_base(m, true, v->ops());
   order_.insert_after(now_, &v->stamp, StampKind::Write);
   now_ = &v->stamp;
   ++stats_.events_created;
@@ -131,7 +131,7 @@ void Engine::link_write(ModBase& m, VersionBase* v) {
   // Readers of the older version that come after v now see v. When v is the last stamp of
   // the whole trace (every from-scratch write) none can.
   if (older && (older->readers || older->unordered_readers) && v->stamp.next() != nullptr) {
-    const bool same = v->ops->equal(v, older);
+    const bool same = v->ops()->equal(v, older);
     const bool one = !older->unordered_readers ? !older->readers->rnext
                                                : !older->readers && !older->unordered_readers->rnext;
     if (newer && !one && move_readers_between(m, older, v, newer, same)) return;
@@ -159,7 +159,7 @@ void Engine::move_readers_after(ModBase& m, VersionBase* older, VersionBase* v, 
   }
   if (first != stop) {  // cut the run out of older's list
     older->readers = stop;
-    if (stop) stop->rpprev = &older->readers;
+    if (stop) stop->set_rpprev(&older->readers);
     last->rnext = nullptr;
   }
   for (ReaderLink* x : moved) detach(x);
@@ -198,11 +198,11 @@ void Engine::fold_unordered(VersionBase* older) {
     }
     ReaderLink* y = xs[i++];
     detach(y);
-    y->rpprev = at;
+    y->set_rpprev(at);
     y->rnext = x;
     *at = y;
-    if (x) x->rpprev = &y->rnext;
-    y->unordered = 0;
+    if (x) x->set_rpprev(&y->rnext);
+    y->set_unordered(false);
     at = &y->rnext;
   }
   xs.clear();
@@ -220,22 +220,22 @@ void Engine::link_merged(ReaderLink** at, ReaderLink* run, ReaderLink* tail) {
       x = run;
       run = run->rnext;
     }
-    x->rpprev = at;
+    x->set_rpprev(at);
     *at = x;
     at = &x->rnext;
-    x->unordered = 0;
+    x->set_unordered(false);
     ++stats_.readers_relinked;
   }
   xs.clear();
   if (run) {  // what is left of the run is in order and linked: it goes in whole
-    run->rpprev = at;
+    run->set_rpprev(at);
     *at = run;
     if (!tail) return;  // the run ends in null already
     for (; run->rnext; run = run->rnext) ++stats_.readers_relinked;
     at = &run->rnext;
   }
   *at = tail;
-  if (tail) tail->rpprev = at;
+  if (tail) tail->set_rpprev(at);
 }
 
 bool Engine::move_readers_between(ModBase& m, VersionBase* older, VersionBase* v, VersionBase* newer, bool same) {
@@ -253,10 +253,10 @@ bool Engine::move_readers_between(ModBase& m, VersionBase* older, VersionBase* v
     if (s->kind() != StampKind::ReadStart) continue;
     ReadNode* r = detail::read_of_start(s);
     const detail::ReadOps* ops = r->ops();
-    if (ops->value != v->ops) continue;
+    if (ops->value != v->ops()) continue;
     if (!ops->invoke_many) return false;  // a plain read: of m or not, it does not say
     detail::ReadManyHeader* h = detail::many_of(r);
-    for (std::uint32_t i = 0; i < h->k; ++i)
+    for (std::uint32_t i = 0; i < h->k(); ++i)
       if (h->slots()[i].mod == &m) {
         if (n == kMaxFound) return false;
         found[n++] = &h->slots()[i].link;
@@ -275,13 +275,13 @@ void Engine::move_reader(ReaderLink* r, ModBase& m, VersionBase* older, VersionB
 
 void Engine::set_base(ModBase& m, VersionBase* fresh, bool (*assign)(VersionBase*, VersionBase*)) {
   // set() on a default that reads saw: make it a base version, then assign to it.
-  if (assign && m.default_readers()) default_base(m, true, fresh->ops);
+  if (assign && m.default_readers()) default_base(m, true, fresh->ops());
   VersionBase* last = nullptr;
   for (VersionBase* v = m.newest(); v; v = v->older()) last = v;
   if (VersionBase* base = last && last->is_base() ? last : nullptr) {
     // An equal value changes nothing. Otherwise the base takes the new value and, when the
     // values were swapped, fresh keeps the old one for the readers that saw it.
-    if (!base->ops->equal(base, fresh)) {
+    if (!base->ops()->equal(base, fresh)) {
       const bool swapped = assign(base, fresh);
       bool kept = false;
       for (ReaderLink* l : {base->readers, base->unordered_readers})
@@ -296,13 +296,13 @@ void Engine::set_base(ModBase& m, VersionBase* fresh, bool (*assign)(VersionBase
   }
   // A new base version: it precedes every computation write, so nobody saw "nothing" here
   // (such a read would have failed), and no reader is affected.
-  fresh->stamp.link = static_cast<std::uintptr_t>(StampKind::Sentinel);
+  fresh->stamp.reset(nullptr, StampKind::Sentinel);
   fresh->stamp.label = static_cast<std::uint32_t>(bases_.size());
   fresh->link = last ? last->link : end_link(m, m.default_only());
   fresh->readers = nullptr;
   fresh->unordered_readers = nullptr;
   bases_.push_back(fresh);
-  input_bytes_ += (fresh->ops->size + 7) & ~std::size_t{7};
+  input_bytes_ += (fresh->ops()->size + 7) & ~std::size_t{7};
   if (last) last->set_older(fresh);
   else m.set_newest(fresh);
 }
@@ -329,7 +329,7 @@ void Engine::retire(ModBase& m) {
   bases_[i]->stamp.label = i;
   bases_.pop_back();
   m.head_ = 0;
-  input_bytes_ -= (v->ops->size + 7) & ~std::size_t{7};
+  input_bytes_ -= (v->ops()->size + 7) & ~std::size_t{7};
   destroy(v);
 }
 
@@ -384,10 +384,10 @@ void Engine::attach_and_invoke_many(ReadNode* r, bool attached) {
   const detail::VersionOps* ops = r->ops()->value;
   const VersionBase* vs[detail::kMaxReadMany];
   ReadSlot* slots = h->slots();
-  for (std::uint32_t i = 0; i < h->k; ++i) {
+  for (std::uint32_t i = 0; i < h->k(); ++i) {
     const VersionBase* v = visible_or_default(*slots[i].mod, &r->start, ops);
     if (!v) throw UsageError("sac::Engine::read_many: a modifiable has no value at the time of this read");
-    if (!attached || !slots[i].link.rpprev) attach_seen(&slots[i].link, *slots[i].mod, v);
+    if (!attached || !slots[i].link.attached()) attach_seen(&slots[i].link, *slots[i].mod, v);
     vs[i] = v;
   }
   exec_body([&] { r->ops()->invoke_many(*this, r, vs); });
@@ -404,12 +404,12 @@ void Engine::push_close(Stamp* end, TaskKind kind, void* node) {
   if (tasks_.size() > close_floor_ && (tasks_.back().kind == TaskKind::CloseRead ||
                                        tasks_.back().kind == TaskKind::CloseMemo)) {
     Task& top = tasks_.back();
-    end->link = reinterpret_cast<std::uintptr_t>(top.node) |
+    end->link = (end->link & Stamp::kAuxMask) | reinterpret_cast<std::uintptr_t>(top.node) |
                 (top.kind == TaskKind::CloseMemo ? std::uintptr_t{1} : 0);
     top = Task{kind, 0, node};
     return;
   }
-  end->link = 0;
+  end->link &= Stamp::kAuxMask;
   tasks_.push_back(Task{kind, 0, node});
 }
 
@@ -417,7 +417,7 @@ void Engine::close_chain(TaskKind kind, void* node) {
   while (node) {
     Stamp* end = kind == TaskKind::CloseRead ? &static_cast<ReadNode*>(node)->end
                                              : &static_cast<MemoNode*>(node)->end;
-    const std::uintptr_t next = end->link;
+    const std::uintptr_t next = end->link & ~Stamp::kAuxMask;
     order_.insert_after(now_, end, kind == TaskKind::CloseRead ? StampKind::ReadEnd : StampKind::MemoEnd);
     now_ = end;
     kind = (next & 1) ? TaskKind::CloseMemo : TaskKind::CloseRead;
@@ -436,7 +436,7 @@ void Engine::execute(const Task& t) {
     case TaskKind::ExecMemoRead: {
       auto* r = static_cast<ReadNode*>(t.node);
       if (window_end_) {
-        if (ReadNode* hit = find_read_match(*r->link.issued_mod, r->link.ops_id, closure_of(r))) {
+        if (ReadNode* hit = find_read_match(*r->link.issued_mod, r->ops_id(), closure_of(r))) {
           destroy(r);
           memo_hit(&hit->start, &hit->end);
           break;
@@ -448,9 +448,9 @@ void Engine::execute(const Task& t) {
     }
     case TaskKind::ExecMemo: {
       auto* n = static_cast<MemoNode*>(t.node);
-      const std::size_t h = n->ops->hash(n);
+      const std::size_t h = n->ops()->hash(n);
       if (window_end_) {
-        MemoNode* hit = find_memo_match(n->ops, h, reinterpret_cast<const MemoNode*>(n) + 1);
+        MemoNode* hit = find_memo_match(n->ops(), h, reinterpret_cast<const MemoNode*>(n) + 1);
         if (hit && t.arg != detail::kAnyDistance && !within(now_, &hit->start, t.arg)) {
           hit = nullptr;
           ++stats_.memo_far;
@@ -464,7 +464,7 @@ void Engine::execute(const Task& t) {
       }
       link_memo(n, h);
       push_close(&n->end, TaskKind::CloseMemo, n);
-      exec_body([&] { n->ops->invoke(*this, n); });
+      exec_body([&] { n->ops()->invoke(*this, n); });
       break;
     }
     case TaskKind::CloseRead:
@@ -522,14 +522,14 @@ void Engine::discard_pending() noexcept {
 bool Engine::note_change(ReaderLink* l, const ModBase& m, const VersionBase* before, const VersionBase* after,
                          bool lazy) {
   ReadNode* r = owner_of(l);
-  if (r->link.qpos != kNotQueued) {  // queued already (a multi-read with several changed slots)
+  if (r->qpos() != kNotQueued) {  // queued already (a multi-read with several changed slots)
     QueueAux& a = queue_.aux(r);
     if (a.forced()) return false;  // a plain read's always is: it re-runs
     if (!lazy) {
       a.force();
       return false;
     }
-    const std::uint32_t slot = l->qpos;  // a listed read is a multi-read
+    const std::uint32_t slot = l->tag();  // a listed read is a multi-read
     a.mark_again();
     for (std::uint32_t i = a.seen(); i != kSeenNone; i = seen_[i].next)
       if (seen_[i].slot == slot) {  // what it saw last is recorded
@@ -540,7 +540,7 @@ bool Engine::note_change(ReaderLink* l, const ModBase& m, const VersionBase* bef
     a.prepend(static_cast<std::uint32_t>(seen_.size() - 1));
     return true;
   }
-  const std::uint32_t slot = detail::is_slot(l) ? l->qpos : 0;
+  const std::uint32_t slot = detail::is_slot(l) ? l->tag() : 0;
   const auto f = r->ops()->affected;
   if (f && after && !f(r, slot, before, after)) return false;  // no `after`: a default, re-run
   // A plain read is not listed: its value changed and it re-runs; a record per change
@@ -563,7 +563,7 @@ bool Engine::still_affected(ReadNode* r, const QueueAux& a) {
     const Seen& s = seen_[i];
     const VersionBase* now = s.now;
     if (now == s.v) continue;
-    if (now->ops->equal(now, s.v)) continue;
+    if (now->ops()->equal(now, s.v)) continue;
     if (f && !f(r, s.slot, s.v, now)) continue;
     const ModBase* to = r->ops()->follow ? r->ops()->follow(*this, r, s.slot, s.v, now) : nullptr;
     if (!to) return true;
@@ -598,7 +598,7 @@ void Engine::rerun(ReadNode* r, const ModBase* mp) {
   const ModBase& m = *mp;
   const VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable has no value at the time of this read");
-  if (!r->link.rpprev) attach_seen(&r->link, m, v);
+  if (!r->link.attached()) attach_seen(&r->link, m, v);
   exec_body([&] { r->ops()->invoke(*this, r, v); });
 }
 
@@ -673,21 +673,21 @@ ReadNode* Engine::find_read_match(const ModBase& m, std::uint32_t ops_id,
         }
         offer_all(m.default_readers());
       },
-      [&](const ReadNode* r) { return r->link.ops_id == ops_id && ops->equal(r, closure); });
+      [&](const ReadNode* r) { return r->ops_id() == ops_id && ops->equal(r, closure); });
 }
 
 AllocNode* Engine::find_alloc_match(const detail::AllocOps* ops, std::size_t h,
                                     const void* key) const {
   return earliest_match<AllocNode>(
       [&](auto&& offer) { for (AllocNode* n = allocs_.bucket(h); n; n = n->hnext) offer(n); },
-      [&](const AllocNode* n) { return n->ops == ops && ops->key_equal(n, key); });
+      [&](const AllocNode* n) { return n->ops() == ops && ops->key_equal(n, key); });
 }
 
 MemoNode* Engine::find_memo_match(const detail::MemoOps* ops, std::size_t h,
                                   const void* closure) const {
   return earliest_match<MemoNode>(
       [&](auto&& offer) { for (MemoNode* n = memos_.bucket(h); n; n = n->hnext) offer(n); },
-      [&](const MemoNode* n) { return n->ops == ops && ops->equal(n, closure); });
+      [&](const MemoNode* n) { return n->ops() == ops && ops->equal(n, closure); });
 }
 
 bool Engine::within(const Stamp* from, const Stamp* to, std::uint32_t k) const noexcept {
@@ -715,9 +715,9 @@ void Engine::link_alloc(AllocNode* n, std::size_t h) {
   now_ = &n->stamp;
   ++stats_.events_created;
   ++stats_.live_events;
-  if (!n->ops->key_equal) return;
+  if (!n->ops()->key_equal) return;
   if (window_end_) {
-    allocs_.insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
+    allocs_.insert(n, h, [](const AllocNode* x) { return x->ops()->hash(x); });
   } else {
     pending_.push_back(PendingAlloc{n, h});
   }
@@ -726,7 +726,7 @@ void Engine::link_alloc(AllocNode* n, std::size_t h) {
 void Engine::index_pending_allocs() {
   if (pending_.empty()) return;
   allocs_.reserve(allocs_.size() + pending_.size(),
-                  [](const AllocNode* x) { return x->ops->hash(x); });
+                  [](const AllocNode* x) { return x->ops()->hash(x); });
   for (std::size_t i = 0; i < pending_.size(); ++i) {
     const PendingAlloc& p = pending_[i];
     allocs_.insert_reserved(p.node, p.hash);
@@ -739,7 +739,7 @@ void Engine::link_memo(MemoNode* n, std::size_t h) {
   now_ = &n->start;
   ++stats_.events_created;
   ++stats_.live_events;
-  memos_.insert(n, h, [](const MemoNode* x) { return x->ops->hash(x); });
+  memos_.insert(n, h, [](const MemoNode* x) { return x->ops()->hash(x); });
 }
 
 // ------------------------------------------------------------------ undo
@@ -757,11 +757,11 @@ void Engine::undo(Stamp* s) {
       --stats_.live_events;
       if (r->many()) {
         detail::ReadManyHeader* h = detail::many_of(r);
-        for (std::uint32_t i = 0; i < h->k; ++i) detach(&h->slots()[i].link);
+        for (std::uint32_t i = 0; i < h->k(); ++i) detach(&h->slots()[i].link);
       } else {
         detach(&r->link);
       }
-      if (r->link.qpos != kNotQueued) {
+      if (r->qpos() != kNotQueued) {
         queue_.remove(r);
         ++stats_.queue_removes;
       }
@@ -781,8 +781,8 @@ void Engine::undo(Stamp* s) {
         // off when v held the default value too.
         const VersionBase* seen = older;
         if (defaulted)
-          seen = m->default_only() ? v->ops->shared_default() : (older = default_base(*m, true, v->ops));
-        const bool same = seen && v->ops->equal(v, seen);
+          seen = m->default_only() ? v->ops()->shared_default() : (older = default_base(*m, true, v->ops()));
+        const bool same = seen && v->ops()->equal(v, seen);
         if (older) {
           // v's readers are all timed after older's: in order, they go first among older's
           // ordered readers. Mostly older is the re-executed write that replaces v and has
@@ -793,9 +793,9 @@ void Engine::undo(Stamp* s) {
             // Both lists go over whole: those that re-execution attached stay unordered, as
             // merging them into order would relink every reader of a cell that many reads
             // share (docs/DESIGN.md, "Change propagation").
-            if ((older->readers = v->readers)) older->readers->rpprev = &older->readers;
+            if ((older->readers = v->readers)) older->readers->set_rpprev(&older->readers);
             if ((older->unordered_readers = v->unordered_readers))
-              older->unordered_readers->rpprev = &older->unordered_readers;
+              older->unordered_readers->set_rpprev(&older->unordered_readers);
             if (!same)
               for (ReaderLink* l : {older->readers, older->unordered_readers})
                 for (ReaderLink* r = l; r; r = r->rnext) note_change(r, *m, v, seen, seen != nullptr);
@@ -809,7 +809,7 @@ void Engine::undo(Stamp* s) {
           for (ReaderLink* l : {v->readers, v->unordered_readers})
             for (ReaderLink* r = l; r;) {
               ReaderLink* nx = r->rnext;
-              r->rpprev = nullptr;
+              r->set_prev_raw(0);
               r->rnext = nullptr;
               if (defaulted) attach_default(r, *m);
               if (!same) note_change(r, *m, v, seen, seen != nullptr);
@@ -824,13 +824,13 @@ void Engine::undo(Stamp* s) {
       AllocNode* n = rec;
       ++stats_.events_undone;
       --stats_.live_events;
-      if (n->ops->key_equal) allocs_.erase(n, n->ops->hash(n));
+      if (n->ops()->key_equal) allocs_.erase(n, n->ops()->hash(n));
       deferred_.push_back(n);  // objects may still be referenced until propagate() ends
     } else if constexpr (K == StampKind::MemoStart) {
       MemoNode* n = rec;
       ++stats_.events_undone;
       --stats_.live_events;
-      memos_.erase(n, n->ops->hash(n));
+      memos_.erase(n, n->ops()->hash(n));
     }
   });
 }

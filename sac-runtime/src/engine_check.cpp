@@ -123,16 +123,20 @@ void TraceChecker::walk_read(const ReadNode* r) {
   // Attachment to the version visible at its start is checked from the version side
   // (check_versions): a read record does not name its modifiable, and scanning the visible
   // version's readers here would be quadratic in a modifiable's fan-out.
-  if (r->link.qpos != kNotQueued) fail("I7: read still queued");
+  if (r->qpos() != kNotQueued) fail("I7: read still queued");
+  // Its ops number (in its end stamp's spare bits) names a registered table, and its own
+  // link does not say it is a slot.
+  if (r->ops_id() == 0 || !detail::read_ops_table[r->ops_id()]) fail("I4: a read with no ops table");
+  if (r->link.slot()) fail("I4: a read's own link is marked as a slot");
   if (r->many()) {
     // A multi-read hangs on versions through its slots only; each slot is checked with its
     // modifiable, like a read.
     const ReadManyHeader* h = many_of(r);
-    if (r->link.rpprev) fail("I4: a multi-read's own link is attached");
-    if (h->k == 0 || h->k > kMaxReadMany) fail("I4: a multi-read with a bad slot count");
-    for (std::uint32_t i = 0; i < h->k; ++i) {
+    if (r->link.attached()) fail("I4: a multi-read's own link is attached");
+    if (h->k() == 0 || h->k() > kMaxReadMany) fail("I4: a multi-read with a bad slot count");
+    for (std::uint32_t i = 0; i < h->k(); ++i) {
       const ReaderLink* l = &h->slots()[i].link;
-      if (!is_slot(l) || l->qpos != i || owner_of(l) != r) fail("I4: a multi-read's slot is malformed");
+      if (!is_slot(l) || l->tag() != i || owner_of(l) != r) fail("I4: a multi-read's slot is malformed");
       reads_.insert(l);
       if (const ModBase* m = default_head(l)) default_mods_.push_back(m);
     }
@@ -165,7 +169,7 @@ void TraceChecker::walk_trace() {
         if (!found) fail("I3: write not in its modifiable's version list");
       } else if constexpr (K == StampKind::Alloc) {
         ++events;
-        if (rec->ops->key_equal) ++nkeyed;
+        if (rec->ops()->key_equal) ++nkeyed;
       } else if constexpr (K == StampKind::MemoStart) {
         const MemoNode* n = rec;
         ++events;
@@ -210,7 +214,7 @@ void TraceChecker::check_versions() {
         const ReaderLink* const* back = list == 0 ? &v->readers : &v->unordered_readers;
         const Stamp* last_ordered = nullptr;  // the time of the last ordered reader seen
         for (const ReaderLink* r = *back; r; back = &r->rnext, r = r->rnext) {
-          if (r->rpprev != back) fail("I4: a version's reader list has a broken back link");
+          if (r->rpprev() != back) fail("I4: a version's reader list has a broken back link");
           // Membership first: only then may r be decoded (a slot's owner from its index).
           if (!reads_.contains(r)) fail("I4: a version's reader is not a live read of the trace");
           if (is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
@@ -218,7 +222,7 @@ void TraceChecker::check_versions() {
           const Stamp* t = &owner_of(r)->start;
           if (!v->is_base() && !rt_.order_.less(&v->stamp, t)) fail("I4: reader before its version");
           if (newer && !rt_.order_.less(t, &newer->stamp)) fail("I4: reader after the next version");
-          if (r->unordered != list)
+          if (r->unordered() != static_cast<bool>(list))
             fail("I5: a version's reader is on the other list than its flag says");
           if (list == 0) {
             if (last_ordered && rt_.order_.less(last_ordered, t))
@@ -239,7 +243,7 @@ void TraceChecker::check_default_readers() {
     const ReaderLink* first = m->default_readers();
     if (!first || default_head(first) != m) fail("I4: a modifiable's default readers do not start at its head");
     for (const ReaderLink* r = first; r; r = r->rnext) {
-      if (r->rnext && r->rnext->rpprev != &r->rnext) fail("I4: a default reader list has a broken back link");
+      if (r->rnext && r->rnext->rpprev() != &r->rnext) fail("I4: a default reader list has a broken back link");
       if (!reads_.contains(r)) fail("I4: a default reader is not a live read of the trace");
       if (is_slot(r) && reinterpret_cast<const ReadSlot*>(r)->mod != m)
         fail("I4: a multi-read's slot hangs on another modifiable's default");
@@ -250,11 +254,11 @@ void TraceChecker::check_default_readers() {
 }
 
 void TraceChecker::check_tables() const {
-  rt_.allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops->hash(n); },
+  rt_.allocs_.check_invariants("allocation table", [](const AllocNode* n) { return n->ops()->hash(n); },
                                [](const AllocNode* n) {
                                  if (!n->stamp.linked()) fail("I6: allocation table holds an undone record");
                                });
-  rt_.memos_.check_invariants("memo table", [](const MemoNode* n) { return n->ops->hash(n); },
+  rt_.memos_.check_invariants("memo table", [](const MemoNode* n) { return n->ops()->hash(n); },
                               [](const MemoNode* n) {
                                 if (!n->start.linked()) fail("I6: memo table holds an undone record");
                               });

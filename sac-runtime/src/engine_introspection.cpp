@@ -66,23 +66,23 @@ MemoryBreakdown Engine::memory_breakdown() const {
       if constexpr (K == StampKind::ReadStart) {
         const std::size_t size = read_size(rec);
         const std::size_t header =
-            rec->many() ? detail::ReadManyHeader::closure_offset(detail::many_of(rec)->k) : sizeof(ReadNode);
+            rec->many() ? detail::ReadManyHeader::closure_offset(detail::many_of(rec)->k()) : sizeof(ReadNode);
         add(b.reads, size, header, 0);
         ++read_sizes[block_of(size)];
       } else if constexpr (K == StampKind::Write) {
-        add(b.versions, rec->ops->size, sizeof(VersionBase), 0);
+        add(b.versions, rec->ops()->size, sizeof(VersionBase), 0);
       } else if constexpr (K == StampKind::Alloc) {
-        if (rec->ops->key_equal)
-          add(b.keyed_allocs, rec->ops->size, sizeof(AllocNode),
-              reinterpret_cast<const detail::KeyedAllocOps*>(rec->ops)->key_bytes);
+        if (rec->ops()->key_equal)
+          add(b.keyed_allocs, rec->ops()->size, sizeof(AllocNode),
+              reinterpret_cast<const detail::KeyedAllocOps*>(rec->ops())->key_bytes);
         else
-          add(b.plain_allocs, rec->ops->size, sizeof(AllocNode), 0);
+          add(b.plain_allocs, rec->ops()->size, sizeof(AllocNode), 0);
       } else if constexpr (K == StampKind::MemoStart) {
-        add(b.memos, rec->ops->size, sizeof(MemoNode), 0);
+        add(b.memos, rec->ops()->size, sizeof(MemoNode), 0);
       }
     });
   }
-  for (const VersionBase* v : bases_) add(b.inputs, v->ops->size, sizeof(VersionBase), 0);
+  for (const VersionBase* v : bases_) add(b.inputs, v->ops()->size, sizeof(VersionBase), 0);
   b.read_sizes.assign(read_sizes.begin(), read_sizes.end());
   b.unaccounted = static_cast<std::int64_t>(record_bytes()) - static_cast<std::int64_t>(b.records());
   b.order_groups = order_.group_count();
@@ -130,7 +130,7 @@ void Engine::dump_dot(std::ostream& os) const {
         if (const ModBase* m = default_head(l)) note_list(m->default_readers(), m);
       };
       if (r->many())
-        for (std::uint32_t i = 0; i < detail::many_of(r)->k; ++i) note_default(&detail::many_of(r)->slots()[i].link);
+        for (std::uint32_t i = 0; i < detail::many_of(r)->k(); ++i) note_default(&detail::many_of(r)->slots()[i].link);
       else
         note_default(&r->link);
     }

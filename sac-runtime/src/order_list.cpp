@@ -31,7 +31,7 @@ OrderList::OrderList() {
   group_count_ = 1;
   base_.group = 0;
   base_.label = 0;
-  base_.link = static_cast<std::uintptr_t>(StampKind::Sentinel);
+  base_.reset(nullptr, StampKind::Sentinel);
 }
 
 void OrderList::insert_slow(Stamp* pos, Stamp* s) {

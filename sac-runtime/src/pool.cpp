@@ -118,6 +118,13 @@ void Pool::new_chunk() {
     c = std::malloc(size);
   }
   if (!c) throw std::bad_alloc();
+  // Records keep numbers in their links' top 16 bits (sac/detail/trace_nodes.hpp): every
+  // address they link must fit in 48 bits, as user space does on x86-64 and AArch64 Linux.
+  if ((reinterpret_cast<std::uintptr_t>(c) + size) >> 48) {
+    if (size >= kHugeChunk) ::munmap(c, size);
+    else std::free(c);
+    throw std::bad_alloc();
+  }
   chunks_.push_back(Chunk{c, size});
   reserved_ += size;
   cur_ = static_cast<char*>(c);

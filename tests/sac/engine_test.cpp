@@ -1820,10 +1820,10 @@ TEST(EngineChecker, ReaderListWithABrokenBackLink) {
   SmallTrace t;
   ASSERT_NO_THROW(t.rt.check_invariants());
   ReadNode* r = t.inner_read();
-  sac::detail::ReaderLink** saved = r->link.rpprev;
-  r->link.rpprev = &r->link.rnext;
+  sac::detail::ReaderLink** saved = r->link.rpprev();
+  r->link.set_rpprev(&r->link.rnext);
   EXPECT_THAT(invariant_message(t.rt), HasSubstr("broken back link"));
-  r->link.rpprev = saved;
+  r->link.set_rpprev(saved);
   EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
@@ -1852,10 +1852,10 @@ TEST(EngineChecker, DefaultReaderDetachedOrWithABrokenBackLink) {
   ReadNode* first = t.read(1);  // the later read was attached last: it heads the list
   ReadNode* second = t.read(0);
   ASSERT_EQ(first->link.rnext, &second->link);
-  sac::detail::ReaderLink** saved = second->link.rpprev;
-  second->link.rpprev = &second->link.rnext;
+  sac::detail::ReaderLink** saved = second->link.rpprev();
+  second->link.set_rpprev(&second->link.rnext);
   EXPECT_THAT(invariant_message(t.rt), HasSubstr("default reader list has a broken back link"));
-  second->link.rpprev = saved;
+  second->link.set_rpprev(saved);
   ASSERT_NO_THROW(t.rt.check_invariants());
   EngineTestAccess::detach(second);
   EXPECT_THAT(invariant_message(t.rt), HasSubstr("not attached"));
@@ -1893,9 +1893,9 @@ TEST(EngineChecker, ReadersOutOfOrderOrOnTheWrongList) {
   ASSERT_NE(first, nullptr);
   // The list is the second read, then the first: the first's back link is the second's
   // rnext (a ReaderLink's first field), and the second's is the version's head.
-  ReadNode* second = sac::detail::owner_of(reinterpret_cast<sac::detail::ReaderLink*>(first->link.rpprev));
+  ReadNode* second = sac::detail::owner_of(reinterpret_cast<sac::detail::ReaderLink*>(first->link.rpprev()));
   ASSERT_NE(second, first);
-  auto* v = reinterpret_cast<VersionBase*>(reinterpret_cast<char*>(second->link.rpprev) - offsetof(VersionBase, readers));
+  auto* v = reinterpret_cast<VersionBase*>(reinterpret_cast<char*>(second->link.rpprev()) - offsetof(VersionBase, readers));
   EngineTestAccess::detach(first);
   EngineTestAccess::attach(first, v);  // ahead of the newer read
   EXPECT_THAT(invariant_message(rt), HasSubstr("ordered readers are not newest first"));
@@ -1904,9 +1904,9 @@ TEST(EngineChecker, ReadersOutOfOrderOrOnTheWrongList) {
   EngineTestAccess::attach(first, v);
   EngineTestAccess::attach(second, v);
   EXPECT_NO_THROW(rt.check_invariants());
-  second->link.unordered = 1;
+  second->link.set_unordered(true);
   EXPECT_THAT(invariant_message(rt), HasSubstr("on the other list than its flag says"));
-  second->link.unordered = 0;
+  second->link.set_unordered(false);
   EXPECT_NO_THROW(rt.check_invariants());
 }
 
@@ -1959,11 +1959,11 @@ TEST(EngineChecker, AllocationMissingFromItsTable) {
   SmallTrace t;
   ASSERT_NO_THROW(t.rt.check_invariants());
   AllocNode* n = sac::detail::alloc_of(t.stamps(StampKind::Alloc).at(0));
-  const std::size_t h = n->ops->hash(n);
+  const std::size_t h = n->ops()->hash(n);
   EngineTestAccess::allocs(t.rt).erase(n, h);
   EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
   EXPECT_THAT(invariant_message(t.rt), HasSubstr("allocation table size mismatch"));
-  EngineTestAccess::allocs(t.rt).insert(n, h, [](const AllocNode* x) { return x->ops->hash(x); });
+  EngineTestAccess::allocs(t.rt).insert(n, h, [](const AllocNode* x) { return x->ops()->hash(x); });
   EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
@@ -1971,11 +1971,11 @@ TEST(EngineChecker, MemoEntryMissingFromItsTable) {
   SmallTrace t;
   ASSERT_NO_THROW(t.rt.check_invariants());
   MemoNode* n = sac::detail::memo_of_start(t.stamps(StampKind::MemoStart).at(0));
-  const std::size_t h = n->ops->hash(n);
+  const std::size_t h = n->ops()->hash(n);
   EngineTestAccess::memos(t.rt).erase(n, h);
   EXPECT_THROW(t.rt.check_invariants(), sac::InvariantError);
   EXPECT_THAT(invariant_message(t.rt), HasSubstr("memo table size mismatch"));
-  EngineTestAccess::memos(t.rt).insert(n, h, [](const MemoNode* x) { return x->ops->hash(x); });
+  EngineTestAccess::memos(t.rt).insert(n, h, [](const MemoNode* x) { return x->ops()->hash(x); });
   EXPECT_NO_THROW(t.rt.check_invariants());
 }
 
@@ -2255,10 +2255,10 @@ TEST(EngineChecker, MultiReadSlotDetachedOrOnAnotherModifiable) {
   Stamp* s = EngineTestAccess::order(rt).base()->next();
   ASSERT_EQ(s->kind(), StampKind::ReadStart);
   sac::detail::ReadManyHeader* h = sac::detail::many_of(sac::detail::read_of_start(s));
-  ASSERT_EQ(h->k, 2u);
+  ASSERT_EQ(h->k(), 2u);
   // Each slot is the only reader of its modifiable's base version: rpprev is &v->readers.
   auto version_of_slot = [](sac::detail::ReaderLink* l) {
-    return reinterpret_cast<VersionBase*>(reinterpret_cast<char*>(l->rpprev) - offsetof(VersionBase, readers));
+    return reinterpret_cast<VersionBase*>(reinterpret_cast<char*>(l->rpprev()) - offsetof(VersionBase, readers));
   };
   sac::detail::ReaderLink* slot = &h->slots()[1].link;
   VersionBase* va = version_of_slot(&h->slots()[0].link);
@@ -2272,9 +2272,19 @@ TEST(EngineChecker, MultiReadSlotDetachedOrOnAnotherModifiable) {
   EngineTestAccess::detach(slot);
   EngineTestAccess::attach(slot, vbv);
   EXPECT_NO_THROW(rt.check_invariants());
-  h->read.link.qpos = 0;
+  h->read.set_qpos(0);
   EXPECT_THAT(invariant_message(rt), HasSubstr("still queued"));
-  h->read.link.qpos = sac::detail::kNotQueued;
+  h->read.set_qpos(sac::detail::kNotQueued);
+  EXPECT_NO_THROW(rt.check_invariants());
+  // The numbers kept in the links' spare bits: an ops number of no table, a slot mark on
+  // the read's own link.
+  const std::uint16_t ops = h->read.ops_id();
+  h->read.set_ops_id(0);
+  EXPECT_THAT(invariant_message(rt), HasSubstr("a read with no ops table"));
+  h->read.set_ops_id(ops);
+  h->read.link.back |= sac::detail::ReaderLink::kSlotBit;
+  EXPECT_THAT(invariant_message(rt), HasSubstr("marked as a slot"));
+  h->read.link.back &= ~sac::detail::ReaderLink::kSlotBit;
   EXPECT_NO_THROW(rt.check_invariants());
 }
 

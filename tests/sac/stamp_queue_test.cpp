@@ -48,8 +48,8 @@ struct Elem {
 
 struct ElemTraits {
   static const Stamp* stamp(const Elem* e) { return &e->stamp; }
-  static std::uint32_t& pos(Elem* e) { return e->qpos; }
   static std::uint32_t pos(const Elem* e) { return e->qpos; }
+  static void set_pos(Elem* e, std::uint32_t p) { e->qpos = p; }
 };
 
 using Queue = sac::detail::StampQueue<Elem, ElemTraits>;

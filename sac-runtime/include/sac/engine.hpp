@@ -397,7 +397,7 @@ class Engine {
   /// The bytes of a read record: a multi-read's grow with its slots.
   static std::size_t read_size(const detail::ReadNode* r) {
     const detail::ReadOps* ops = r->ops();
-    return ops->size + (ops->invoke_many ? detail::many_of(r)->k * sizeof(detail::ReadSlot) : 0);
+    return ops->size + (ops->invoke_many ? detail::many_of(r)->k() * sizeof(detail::ReadSlot) : 0);
   }
 
   // Trace machinery (engine.cpp).

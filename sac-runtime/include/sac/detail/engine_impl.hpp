@@ -42,7 +42,7 @@ void Engine::destroy(Rec* r) noexcept {
     r->ops()->destroy(r);
     deallocate(r, n);
   } else {
-    const auto* ops = r->ops;
+    const auto* ops = r->ops();
     ops->destroy(r);
     deallocate(r, ops->size);
   }
@@ -56,7 +56,7 @@ void Engine::set(Mod<T>& m, U&& value) {
   require_mutator("set");
   using V = detail::Version<T>;
   V* v = construct<V>(std::forward<U>(value));
-  v->ops = &detail::VersionOpsFor<T>::ops;
+  v->set_ops_id(detail::VersionOpsFor<T>::id());
   // set_base compares the values first (VersionOps::equal): this only moves.
   set_base(m, v, [](detail::VersionBase* old_base, detail::VersionBase* fresh) {
     auto* o = static_cast<V*>(old_base);
@@ -78,7 +78,7 @@ void Engine::init(Mod<T>& m, U&& value) {
   if (m.written()) throw UsageError("sac::Engine::init: the modifiable is already written");
   using V = detail::Version<T>;
   V* v = construct<V>(std::forward<U>(value));
-  v->ops = &detail::VersionOpsFor<T>::ops;
+  v->set_ops_id(detail::VersionOpsFor<T>::id());
   set_base(m, v, nullptr);  // no base yet, so nothing to compare with
 }
 
@@ -116,8 +116,8 @@ void Engine::read(const Mod<T>& m, F&& body) {
   require_computation("read");
   N* r = construct<N>(std::forward<F>(body));
   r->link.issued_mod = &m;
-  r->link.ops_id = static_cast<std::uint16_t>(detail::ReadOpsFor<T, Fn>::id());
-  r->link.qpos = detail::kNotQueued;
+  r->set_ops_id(detail::ReadOpsFor<T, Fn>::id());
+  r->set_qpos(detail::kNotQueued);
   issue(TaskKind::ExecRead, r);
 }
 
@@ -139,14 +139,14 @@ void Engine::read_many(std::span<const Mod<T>* const> mods, F&& body) {
     throw;
   }
   H* h = new (mem) H{};
-  h->k = static_cast<std::uint32_t>(k);
-  h->read.link.ops_id = static_cast<std::uint16_t>(detail::ReadManyOpsFor<T, Fn>::id());
-  h->read.link.qpos = detail::kNotQueued;
+  h->set_k(static_cast<std::uint32_t>(k));
+  h->read.set_ops_id(detail::ReadManyOpsFor<T, Fn>::id());
+  h->read.set_qpos(detail::kNotQueued);
   detail::ReadSlot* slots = h->slots();
   for (std::size_t i = 0; i < k; ++i) {
     detail::ReadSlot* sl = new (&slots[i]) detail::ReadSlot{};
-    sl->link.ops_id = detail::kSlotOps;
-    sl->link.qpos = static_cast<std::uint32_t>(i);
+    sl->link.back = detail::ReaderLink::kSlotBit;
+    sl->link.set_tag(static_cast<std::uint16_t>(i));
     sl->mod = mods[i];
   }
   issue(TaskKind::ExecReadMany, &h->read);
@@ -184,7 +184,7 @@ void Engine::write(Mod<T>& m, U&& value) {
   require_computation("write");
   flush_if_pending();
   V* v = construct<V>(std::forward<U>(value));
-  v->ops = &detail::VersionOpsFor<T>::ops;
+  v->set_ops_id(detail::VersionOpsFor<T>::id());
   link_write(m, v);
 }
 
@@ -196,6 +196,7 @@ T* Engine::alloc(const K& key, A&&... args) {
   require_computation("alloc");
   flush_if_pending();
   const detail::AllocOps* ops = &detail::AllocOpsFor<T, K>::ops;
+  const std::uint16_t ops_id = detail::AllocOpsFor<T, K>::id();
   const std::size_t h = Hash<K>{}(key);
   if (window_end_) {
     if (detail::AllocNode* hit = find_alloc_match(ops, h, &key)) {
@@ -204,7 +205,7 @@ T* Engine::alloc(const K& key, A&&... args) {
     }
   }
   N* n = construct<N>(key, std::forward<A>(args)...);
-  n->ops = ops;
+  n->set_ops_id(ops_id);
   link_alloc(n, h);
   return &n->object;
 }
@@ -215,7 +216,7 @@ T* Engine::make(A&&... args) {
   require_computation("make");
   flush_if_pending();
   N* n = construct<N>(std::forward<A>(args)...);
-  n->ops = &detail::PlainAllocOpsFor<T>::ops;
+  n->set_ops_id(detail::PlainAllocOpsFor<T>::id());
   link_alloc(n, 0);
   return &n->object;
 }
@@ -233,7 +234,7 @@ void Engine::memo_near(std::uint32_t max_skip, F&& f) {
                 "memo needs an equality-comparable, hashable closure: use sac::fn<f>(args...)");
   require_computation("memo");
   N* n = construct<N>(std::forward<F>(f));
-  n->ops = &detail::MemoOpsFor<Fn>::ops;
+  n->set_ops_id(detail::MemoOpsFor<Fn>::id());
   issue(TaskKind::ExecMemo, n, max_skip);
 }
 template <class T, class F>

@@ -33,8 +33,8 @@ inline char kTypeTag = 0;  // not const: distinct objects, never merged
 
 struct ReadQueueTraits {
   static const Stamp* stamp(const ReadNode* r) { return &r->start; }
-  static std::uint32_t& pos(ReadNode* r) { return r->link.qpos; }
-  static std::uint32_t pos(const ReadNode* r) { return r->link.qpos; }
+  static std::uint32_t pos(const ReadNode* r) { return r->qpos(); }
+  static void set_pos(ReadNode* r, std::uint32_t p) { r->set_qpos(p); }
 };
 
 template <class F, class T>
@@ -64,13 +64,17 @@ struct VersionOpsFor {
                                   std::is_default_constructible_v<T> ? &make_default : nullptr,
                                   std::is_default_constructible_v<T> ? &shared_default : nullptr,
                                   sizeof(Version<T>)};
+  static std::uint16_t id() {
+    static const std::uint16_t i = register_version_ops(&ops);
+    return i;
+  }
 };
 
 template <class T>
 VersionBase* VersionOpsFor<T>::make_default(void* mem) {
   if constexpr (std::is_default_constructible_v<T>) {
     auto* v = new (mem) Version<T>();
-    v->ops = &ops;
+    v->set_ops_id(id());
     return v;
   } else {
     return nullptr;
@@ -82,7 +86,7 @@ const VersionBase* VersionOpsFor<T>::shared_default() {
   if constexpr (std::is_default_constructible_v<T>) {
     struct Holder {
       Version<T> v;
-      Holder() { v.ops = &ops; }
+      Holder() { v.set_ops_id(id()); }
     };
     static const Holder h;
     return &h.v;
@@ -108,8 +112,8 @@ struct ReadOpsFor {
                                &VersionOpsFor<T>::ops, sizeof(ReadNodeT<F>)};
   /// ops' number in read_ops_table (numbered on first use: a function-local static, so no
   /// read made during static initialisation can see it unnumbered).
-  static std::uint32_t id() {
-    static const std::uint32_t i = register_read_ops(&ops);
+  static std::uint16_t id() {
+    static const std::uint16_t i = register_read_ops(&ops);
     return i;
   }
 };
@@ -133,10 +137,10 @@ template <class T, class F>
 struct ReadManyOpsFor {
   static F* closure(ReadNode* r) {
     return std::launder(reinterpret_cast<F*>(reinterpret_cast<char*>(r) +
-                                             ReadManyHeader::closure_offset(many_of(r)->k)));
+                                             ReadManyHeader::closure_offset(many_of(r)->k())));
   }
   static void invoke_many(Engine& rt, ReadNode* r, const VersionBase* const* vs) {
-    const std::uint32_t k = many_of(r)->k;
+    const std::uint32_t k = many_of(r)->k();
     const T* vals[kMaxReadMany];
     for (std::uint32_t i = 0; i < k; ++i) vals[i] = &static_cast<const Version<T>*>(vs[i])->value;
     const std::span<const T* const> span(vals, k);
@@ -147,7 +151,7 @@ struct ReadManyOpsFor {
   static void destroy(ReadNode* r) noexcept {
     closure(r)->~F();
     ReadSlot* s = many_of(r)->slots();
-    for (std::uint32_t i = 0; i < many_of(r)->k; ++i) s[i].~ReadSlot();
+    for (std::uint32_t i = 0; i < many_of(r)->k(); ++i) s[i].~ReadSlot();
     many_of(r)->~ReadManyHeader();
   }
   static bool affected(const ReadNode* r, std::uint32_t i, const VersionBase* before, const VersionBase* after) {
@@ -173,8 +177,8 @@ struct ReadManyOpsFor {
                                &invoke_many,
                                ProjectedRead<F, T> ? &affected : nullptr,
                                FollowingRead<F, T, Engine> ? &follow<Engine> : nullptr};
-  static std::uint32_t id() {
-    static const std::uint32_t i = register_read_ops(&ops);
+  static std::uint16_t id() {
+    static const std::uint16_t i = register_read_ops(&ops);
     return i;
   }
 };
@@ -196,12 +200,16 @@ struct AllocOpsFor {
     return static_cast<const N*>(n)->key == *static_cast<const K*>(k);
   }
   static std::size_t hash(const AllocNode* n) { return Hash<K>{}(static_cast<const N*>(n)->key); }
-  // The key follows the 32-byte AllocNode; the object follows the key at its alignment.
+  // The key follows the 24-byte AllocNode; the object follows the key at its alignment.
   static constexpr std::size_t kObjectOffset =
       (sizeof(AllocNode) + sizeof(K) + alignof(T) - 1) / alignof(T) * alignof(T);
   static constexpr KeyedAllocOps keyed{{&destroy, &key_equal, &hash, sizeof(N)},
                                        static_cast<std::uint32_t>(kObjectOffset - sizeof(AllocNode))};
   static constexpr const AllocOps& ops = keyed.ops;
+  static std::uint16_t id() {
+    static const std::uint16_t i = register_alloc_ops(&ops);
+    return i;
+  }
 };
 
 template <class T>
@@ -209,6 +217,10 @@ struct PlainAllocOpsFor {
   using N = PlainAllocNodeT<T>;
   static void destroy(AllocNode* n) noexcept { static_cast<N*>(n)->~N(); }
   static constexpr AllocOps ops{&destroy, nullptr, nullptr, sizeof(N)};
+  static std::uint16_t id() {
+    static const std::uint16_t i = register_alloc_ops(&ops);
+    return i;
+  }
 };
 
 template <class F>
@@ -221,6 +233,10 @@ struct MemoOpsFor {
   static void invoke(Engine& rt, MemoNode* n) { call_thunk(static_cast<N*>(n)->fn, rt); }
   static std::size_t hash(const MemoNode* n) { return Hash<F>{}(static_cast<const N*>(n)->fn); }
   static constexpr MemoOps ops{&invoke, &destroy, &equal, &hash, sizeof(N)};
+  static std::uint16_t id() {
+    static const std::uint16_t i = register_memo_ops(&ops);
+    return i;
+  }
 };
 
 }  // namespace sac::detail

@@ -43,19 +43,32 @@ enum class StampKind : std::uint8_t {
 };
 
 /// A timestamp. 16 bytes; must be 8-byte aligned (the kind lives in the link's low bits).
+/// The link's top 16 bits are free for the record that embeds the stamp (aux(): a record's
+/// ops number, or half a read's queue position), which the list never changes: user-space
+/// addresses fit in 48 bits on every 64-bit target we build for (Pool checks its chunks).
 struct Stamp {
   static constexpr std::uint32_t kUnlinked = 0xffffffffu;
+  static constexpr int kAuxShift = 48;
+  static constexpr std::uintptr_t kAuxMask = ~std::uintptr_t{0} << kAuxShift;
+  static constexpr std::uintptr_t kKindMask = 7;
+  static constexpr std::uintptr_t kNextMask = ~(kAuxMask | kKindMask);
 
-  std::uintptr_t link = 0;             // next stamp | kind
+  std::uintptr_t link = 0;             // aux << 48 | next stamp | kind
   std::uint32_t group = kUnlinked;     // index of the group, kUnlinked when not in a list
   std::uint32_t label = 0;             // label within the group
 
-  Stamp* next() const { return reinterpret_cast<Stamp*>(link & ~std::uintptr_t{7}); }
-  StampKind kind() const { return static_cast<StampKind>(link & 7); }
+  Stamp* next() const { return reinterpret_cast<Stamp*>(link & kNextMask); }
+  StampKind kind() const { return static_cast<StampKind>(link & kKindMask); }
   bool linked() const { return group != kUnlinked; }
+  std::uint16_t aux() const { return static_cast<std::uint16_t>(link >> kAuxShift); }
 
-  void set_next(Stamp* n) { link = reinterpret_cast<std::uintptr_t>(n) | (link & 7); }
-  void set_kind(StampKind k) { link = (link & ~std::uintptr_t{7}) | static_cast<std::uintptr_t>(k); }
+  void set_next(Stamp* n) { link = reinterpret_cast<std::uintptr_t>(n) | (link & ~kNextMask); }
+  void set_kind(StampKind k) { link = (link & ~kKindMask) | static_cast<std::uintptr_t>(k); }
+  void set_aux(std::uint16_t a) { link = (link & ~kAuxMask) | (std::uintptr_t{a} << kAuxShift); }
+  /// Sets next and kind at once, keeping aux.
+  void reset(Stamp* n, StampKind k) {
+    link = (link & kAuxMask) | reinterpret_cast<std::uintptr_t>(n) | static_cast<std::uintptr_t>(k);
+  }
 };
 static_assert(sizeof(Stamp) == 16);
 
@@ -83,7 +96,7 @@ class OrderList {
 
   /// Links s (unlinked) right after pos (linked), with kind k.
   void insert_after(Stamp* pos, Stamp* s, StampKind k) {
-    s->link = static_cast<std::uintptr_t>(k);
+    s->reset(nullptr, k);
     Group& g = groups_[pos->group];
     Stamp* n = pos->next();
     // Fast path: room in the group and between the labels (appends step by kAppendStep).

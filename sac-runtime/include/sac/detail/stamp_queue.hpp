@@ -2,7 +2,7 @@
 //
 // Purpose: affected reads wait here until change propagation re-executes them in time order.
 // A binary min-heap of T* ordered by the OrderList position of Traits::stamp(t); each element
-// stores its heap index (Traits::pos(t)) so that undone reads leave the queue in O(log n).
+// stores its heap index (Traits::pos(t), Traits::set_pos(t, i)) so that undone reads leave the queue in O(log n).
 // An element may carry an Aux value while queued (the engine: the modifiable the read reads,
 // which the read record itself does not keep); Aux = std::nullptr_t costs nothing.
 // Relabelling the order list never changes relative order, so the heap stays valid.
@@ -37,7 +37,7 @@ class StampQueue {
   bool contains(const T* t) const { return Traits::pos(t) != kNotQueued; }
 
   void push(T* t, Aux aux = Aux{}) {
-    Traits::pos(t) = static_cast<std::uint32_t>(heap_.size());
+    Traits::set_pos(t, static_cast<std::uint32_t>(heap_.size()));
     heap_.push_back(Entry{t, aux});
     sift_up(heap_.size() - 1);
   }
@@ -79,10 +79,10 @@ class StampQueue {
     const Entry gone = heap_[i];
     const Entry last = heap_.back();
     heap_.pop_back();
-    Traits::pos(gone.t) = kNotQueued;
+    Traits::set_pos(gone.t, kNotQueued);
     if (gone.t == last.t) return;
     heap_[i] = last;
-    Traits::pos(last.t) = static_cast<std::uint32_t>(i);
+    Traits::set_pos(last.t, static_cast<std::uint32_t>(i));
     if (i > 0 && before(last.t, heap_[(i - 1) / 2].t)) sift_up(i);
     else sift_down(i);
   }
@@ -93,11 +93,11 @@ class StampQueue {
       std::size_t p = (i - 1) / 2;
       if (!before(e.t, heap_[p].t)) break;
       heap_[i] = heap_[p];
-      Traits::pos(heap_[i].t) = static_cast<std::uint32_t>(i);
+      Traits::set_pos(heap_[i].t, static_cast<std::uint32_t>(i));
       i = p;
     }
     heap_[i] = e;
-    Traits::pos(e.t) = static_cast<std::uint32_t>(i);
+    Traits::set_pos(e.t, static_cast<std::uint32_t>(i));
   }
 
   void sift_down(std::size_t i) {
@@ -109,11 +109,11 @@ class StampQueue {
       if (c + 1 < n && before(heap_[c + 1].t, heap_[c].t)) ++c;
       if (!before(heap_[c].t, e.t)) break;
       heap_[i] = heap_[c];
-      Traits::pos(heap_[i].t) = static_cast<std::uint32_t>(i);
+      Traits::set_pos(heap_[i].t, static_cast<std::uint32_t>(i));
       i = c;
     }
     heap_[i] = e;
-    Traits::pos(e.t) = static_cast<std::uint32_t>(i);
+    Traits::set_pos(e.t, static_cast<std::uint32_t>(i));
   }
 
   const OrderList* order_;
