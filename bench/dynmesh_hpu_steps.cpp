@@ -54,7 +54,8 @@ struct Run {
       : state(box), program(engine, state, angle) {
     state.start(engine);
     apply(pts, {});
-    engine.run([this](sac::Engine& rt) { detail::HpuCellsProgram::main(rt, &program); });
+    engine.set_context(&program);
+    engine.run([](sac::Engine& rt) { detail::HpuCellsProgram::main(rt); });
     state.feed.clear_change();
   }
   ~Run() { state.feed.close(); }

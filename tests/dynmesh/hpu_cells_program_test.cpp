@@ -62,7 +62,8 @@ class HpuHarness {
       : box_(box), state_(box), program_(engine_, state_, angle) {
     state_.start(engine_);
     set_list(pts);
-    engine_.run([this](sac::Engine& rt) { HpuCellsProgram::main(rt, &program_); });
+    engine_.set_context(&program_);
+    engine_.run([](sac::Engine& rt) { HpuCellsProgram::main(rt); });
     state_.feed.clear_change();
   }
   ~HpuHarness() { state_.feed.close(); }

@@ -201,7 +201,8 @@ struct HcStepCounts {
   }
 };
 
-/// The program. The mutator keeps `input` equal to the inputs and their side midpoints in
+/// The program. The mutator sets its engine's context to it (Engine::set_context) and runs
+/// main(); it keeps `input` equal to the inputs and their side midpoints in
 /// insertion_less order, and the store's base values equal to the bucket tree of those and
 /// the four corners (HpuInputs with InputCells attached), and calls propagate().
 struct HpuCellsProgram {
@@ -249,6 +250,10 @@ struct HpuCellsProgram {
   /// the program, whose view, store and scratch they use, and the part of run_step's Step
   /// interface that comes from it (step_rounds.hpp). Each step adds its own operands and
   /// run(). A step is its rounds' closure, so it holds pointers only.
+  /// The program, from its engine's context: reads and memo keys do not carry it (8 bytes
+  /// a record). A step does (StepBase): its projection test, affected(), has no engine.
+  static HpuCellsProgram* ctx(sac::Engine& rt) { return rt.context<HpuCellsProgram>(); }
+
   struct StepBase {
     HpuCellsProgram* program;
     CellView* view(sac::Engine&) const { return &program->view; }
@@ -258,7 +263,9 @@ struct HpuCellsProgram {
 
   // ---------------------------------------------------------------- 1. initial vertices
 
-  static void main(sac::Engine& rt, HpuCellsProgram* program) {
+  /// The computation: the owner sets the engine's context to the program first.
+  static void main(sac::Engine& rt) {
+    HpuCellsProgram* const program = ctx(rt);
     program->start = rt.alloc<HcStart>(0);
     std::array<HV, 4> order = program->corners;
     std::sort(order.begin(), order.end(), [program](HV a, HV b) { return morton_less(program->box(), a->p, b->p); });
@@ -270,15 +277,15 @@ struct HpuCellsProgram {
       dest = &c->next;
       if (!head) head = c;
     }
-    rt.memo_read(*program->input, sac::fn<&place>(program, dest));
-    rt.memo_read(program->start->cells, sac::fn<&class_step>(program));
+    rt.memo_read(*program->input, sac::fn<&place>(dest));
+    rt.memo_read(program->start->cells, sac::fn<&class_step>());
     // The corners come first, so the list's head is a fixed cell.
     program->start->blocks = rt.alloc<HcCellBlock>(HV{nullptr}, head);
-    rt.memo(sac::fn<&block_classes>(program->start->blocks->first, program, program->start->blocks, std::uint64_t{0},
+    rt.memo(sac::fn<&block_classes>(program->start->blocks->first, program->start->blocks, std::uint64_t{0},
                                     INT_MIN, INT_MAX));
-    rt.memo(sac::fn<&block_bounds>(program->start->blocks, program, INT_MAX, INT_MIN));
-    rt.memo(sac::fn<&refine_start>(program));
-    rt.memo(sac::fn<&final_start>(program));
+    rt.memo(sac::fn<&block_bounds>(program->start->blocks, INT_MAX, INT_MIN));
+    rt.memo(sac::fn<&refine_start>());
+    rt.memo(sac::fn<&final_start>());
   }
 
   static sac::Mod<HcCell*>* append_cell(sac::Engine& rt, HV v, sac::Mod<HcCell*>* dest) {
@@ -287,10 +294,10 @@ struct HpuCellsProgram {
     return &c->next;
   }
 
-  static void place(sac::Engine& rt, HpuInputNode* n, HpuCellsProgram* program, sac::Mod<HcCell*>* dest) {
+  static void place(sac::Engine& rt, HpuInputNode* n, sac::Mod<HcCell*>* dest) {
     if (!n) return rt.write(*dest, nullptr);
     dest = append_cell(rt, n, dest);
-    rt.memo_read(n->next, sac::fn<&place>(program, dest));
+    rt.memo_read(n->next, sac::fn<&place>(dest));
   }
 
   // ---------------------------------------------------------------- 2. initial classes
@@ -306,22 +313,23 @@ struct HpuCellsProgram {
       if (!v.done()) return false;
       ++program->steps.done[HcStepCounts::FirstClass];
       rt.write(cell->cls, program->first_class);
-      rt.memo_read(cell->next, sac::fn<&class_step>(program));
+      rt.memo_read(cell->next, sac::fn<&class_step>());
       return true;
     }
   };
 
-  static void class_step(sac::Engine& rt, HcCell* cell, HpuCellsProgram* program) {
-    if (cell) run_step(rt, FirstClassStep{{program}, cell});
+  static void class_step(sac::Engine& rt, HcCell* cell) {
+    if (cell) run_step(rt, FirstClassStep{{ctx(rt)}, cell});
   }
 
   // ---------------------------------------------------------------- 3. classes and rounds
 
-  static void refine_start(sac::Engine& rt, HpuCellsProgram* program) {
-    rt.read(program->start->min_class, [program](sac::Engine& rt2, int j) {
+  static void refine_start(sac::Engine& rt) {
+    HpuCellsProgram* const program = ctx(rt);
+    rt.read(program->start->min_class, [](sac::Engine& rt2, int j) {
       HcClass* size_class = rt2.alloc<HcClass>(j, j);
       rt2.write(size_class->cont, nullptr);  // nothing continues into the first class
-      rt2.memo(sac::fn<&class_start>(program, size_class));
+      rt2.memo(sac::fn<&class_start>(size_class));
     });
   }
 
@@ -342,9 +350,9 @@ struct HpuCellsProgram {
   /// max), and the block's vertices linked by class: `cell` goes after the last vertex of its
   /// class mod 64, through that class's tail. A class that changes re-runs the steps after it
   /// in its block only, and the next member's link of the classes it left and joined.
-  static void block_classes(sac::Engine& rt, HcCell* cell, HpuCellsProgram* program, HcCellBlock* block,
+  static void block_classes(sac::Engine& rt, HcCell* cell, HcCellBlock* block,
                             std::uint64_t mask, int max, int min) {
-    rt.read(cell->cls, [cell, program, block, mask, max, min](sac::Engine& rt2, int c) {
+    rt.read(cell->cls, [cell, block, mask, max, min](sac::Engine& rt2, int c) {
       const unsigned k = static_cast<unsigned>(c) & 63;
       if (!((mask >> k) & 1)) {
         rt2.write(block->head[k], cell);
@@ -355,14 +363,14 @@ struct HpuCellsProgram {
           rt3.write(block->tail[k], &cell->next_same);
         });
       }
-      rt2.memo_read(cell->next, sac::fn<&block_classes_next>(program, block, mask | std::uint64_t{1} << k,
+      rt2.memo_read(cell->next, sac::fn<&block_classes_next>(block, mask | std::uint64_t{1} << k,
                                                              std::max(max, c), std::min(min, c)));
     });
   }
 
-  static void block_classes_next(sac::Engine& rt, HcCell* next, HpuCellsProgram* program, HcCellBlock* block,
+  static void block_classes_next(sac::Engine& rt, HcCell* next, HcCellBlock* block,
                                  std::uint64_t mask, int max, int min) {
-    if (next && !opens_block(next->v)) return block_classes(rt, next, program, block, mask, max, min);
+    if (next && !opens_block(next->v)) return block_classes(rt, next, block, mask, max, min);
     rt.write(block->classes, HcClassSet{mask, max, min});
     for (std::uint64_t m = mask; m; m &= m - 1)
       rt.read(block->tail[static_cast<unsigned>(std::countr_zero(m))],
@@ -370,7 +378,7 @@ struct HpuCellsProgram {
     if (!next) return rt.write(block->next, nullptr);
     HcCellBlock* next_block = rt.alloc<HcCellBlock>(next->v, next);
     rt.write(block->next, next_block);
-    block_classes(rt, next, program, next_block, 0, INT_MIN, INT_MAX);
+    block_classes(rt, next, next_block, 0, INT_MIN, INT_MAX);
   }
 
   /// The smallest and the largest initial class, from the blocks' sets, in a walk of the
@@ -379,27 +387,29 @@ struct HpuCellsProgram {
   /// the first-class steps, where a new least class would re-run every one after it; nor
   /// through each class's walk of the blocks ("a block before holds a class above j"), where
   /// a change of the first block above j would re-run that class's walk up to the next.
-  static void block_bounds(sac::Engine& rt, HcCellBlock* block, HpuCellsProgram* program, int least, int greatest) {
-    rt.read(block->classes, [block, program, least, greatest](sac::Engine& rt2, const HcClassSet& set) {
+  static void block_bounds(sac::Engine& rt, HcCellBlock* block, int least, int greatest) {
+    rt.read(block->classes, [block, least, greatest](sac::Engine& rt2, const HcClassSet& set) {
       rt2.memo_read(block->next,
-                    sac::fn<&block_bounds_next>(program, std::min(least, set.min), std::max(greatest, set.max)));
+                    sac::fn<&block_bounds_next>(std::min(least, set.min), std::max(greatest, set.max)));
     });
   }
 
-  static void block_bounds_next(sac::Engine& rt, HcCellBlock* block, HpuCellsProgram* program, int least,
+  static void block_bounds_next(sac::Engine& rt, HcCellBlock* block, int least,
                                 int greatest) {
-    if (block) return block_bounds(rt, block, program, least, greatest);
+    HpuCellsProgram* const program = ctx(rt);
+    if (block) return block_bounds(rt, block, least, greatest);
     rt.write(program->start->min_class, least);
     rt.write(program->start->max_class, greatest);
   }
 
   /// Class j: its initial entries from the blocks that hold some, then its rounds.
-  static void class_start(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class) {
+  static void class_start(sac::Engine& rt, HcClass* size_class) {
+    HpuCellsProgram* const program = ctx(rt);
     HcClass* next_class = rt.alloc<HcClass>(size_class->j + 1, size_class->j + 1);
     HcBlock* class_tail = rt.alloc<HcBlock>(std::tuple{size_class->j, HV{nullptr}});
     rt.write(class_tail->init_tail, &size_class->init);
-    rt.memo(sac::fn<&class_block>(program->start->blocks, program, size_class, class_tail));
-    rt.memo(sac::fn<&round_start>(program, size_class, next_class, &size_class->init, &next_class->cont));
+    rt.memo(sac::fn<&class_block>(program->start->blocks, size_class, class_tail));
+    rt.memo(sac::fn<&round_start>(size_class, next_class, &size_class->init, &next_class->cont));
   }
 
   /// Class j in `block`: its members appended at class_tail's tail, which the next block's
@@ -410,23 +420,23 @@ struct HpuCellsProgram {
   /// block with a member. A tail per block, not one for the whole class: the runtime walks a
   /// modifiable's versions from the newest to read or write at a time, and a block bounds
   /// how many a tail has.
-  static void class_block(sac::Engine& rt, HcCellBlock* block, HpuCellsProgram* program, HcClass* size_class,
+  static void class_block(sac::Engine& rt, HcCellBlock* block, HcClass* size_class,
                           HcBlock* class_tail) {
-    rt.read(block->classes, [block, program, size_class, class_tail](sac::Engine& rt2, const HcClassSet& set) {
+    rt.read(block->classes, [block, size_class, class_tail](sac::Engine& rt2, const HcClassSet& set) {
       if (set.has(size_class->j))
         rt2.memo_read(block->head[static_cast<unsigned>(size_class->j) & 63],
-                      sac::fn<&class_member>(program, size_class, class_tail));
+                      sac::fn<&class_member>(size_class, class_tail));
       HcBlock* next_class_tail = rt2.alloc<HcBlock>(std::tuple{size_class->j, block->first->v});
       rt2.read(class_tail->init_tail, [next_class_tail](sac::Engine& rt3, sac::Mod<HcEntry*>* dest) {
         rt3.write(next_class_tail->init_tail, dest);
       });
-      rt2.memo_read(block->next, sac::fn<&class_block_next>(program, size_class, next_class_tail));
+      rt2.memo_read(block->next, sac::fn<&class_block_next>(size_class, next_class_tail));
     });
   }
 
-  static void class_block_next(sac::Engine& rt, HcCellBlock* block, HpuCellsProgram* program, HcClass* size_class,
+  static void class_block_next(sac::Engine& rt, HcCellBlock* block, HcClass* size_class,
                                HcBlock* class_tail) {
-    if (block) return class_block(rt, block, program, size_class, class_tail);
+    if (block) return class_block(rt, block, size_class, class_tail);
     // Q_j = its initial entries ++ the continuations of class j − 1 (terminated by now).
     rt.read(class_tail->init_tail, [size_class](sac::Engine& rt2, sac::Mod<HcEntry*>* dest) {
       rt2.read(size_class->cont, [dest](sac::Engine& rt3, HcEntry* h) { rt3.write(*dest, h); });
@@ -436,7 +446,7 @@ struct HpuCellsProgram {
   /// One initial vertex of class j mod 64 in a block: appended to Q_j's initial entries if of
   /// class j. The walk passes the block's members of j's class mod 64 only (next_same), not
   /// every vertex of the block.
-  static void class_member(sac::Engine& rt, HcCell* cell, HpuCellsProgram* program, HcClass* size_class,
+  static void class_member(sac::Engine& rt, HcCell* cell, HcClass* size_class,
                            HcBlock* class_tail) {
     if (!cell) return;
     rt.read(cell->cls, [cell, size_class, class_tail](sac::Engine& rt2, int c) {
@@ -447,37 +457,38 @@ struct HpuCellsProgram {
         rt3.write(class_tail->init_tail, &entry->next);
       });
     });
-    rt.memo_read(cell->next_same, sac::fn<&class_member>(program, size_class, class_tail));
+    rt.memo_read(cell->next_same, sac::fn<&class_member>(size_class, class_tail));
   }
 
   /// A round of class j on the entries from `head`: collect all, then process the pairs,
   /// then the next round (the births) or the next class.
-  static void round_start(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcClass* next_class,
+  static void round_start(sac::Engine& rt, HcClass* size_class, HcClass* next_class,
                           sac::Mod<HcEntry*>* head, sac::Mod<HcEntry*>* cont_dest) {
     HcRound* round = rt.alloc<HcRound>(head);
-    rt.memo_read(*head, sac::fn<&collect_step>(program, size_class, round, cont_dest, nullptr, nullptr));
-    rt.memo_read(*head, sac::fn<&process_entry>(program, size_class, round, &round->births, nullptr, nullptr));
-    rt.memo(sac::fn<&round_end>(program, size_class, next_class, round));
+    rt.memo_read(*head, sac::fn<&collect_step>(size_class, round, cont_dest, nullptr, nullptr));
+    rt.memo_read(*head, sac::fn<&process_entry>(size_class, round, &round->births, nullptr, nullptr));
+    rt.memo(sac::fn<&round_end>(size_class, next_class, round));
   }
 
-  static void round_end(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcClass* next_class,
+  static void round_end(sac::Engine& rt, HcClass* size_class, HcClass* next_class,
                         HcRound* round) {
-    rt.read(round->births, [program, size_class, next_class, round](sac::Engine& rt2, HcEntry* births) {
+    rt.read(round->births, [size_class, next_class, round](sac::Engine& rt2, HcEntry* births) {
       rt2.read(round->cont_tail,
-               [program, size_class, next_class, round, births](sac::Engine& rt3, sac::Mod<HcEntry*>* tail) {
+               [size_class, next_class, round, births](sac::Engine& rt3, sac::Mod<HcEntry*>* tail) {
                  if (births)
-                   return rt3.memo(sac::fn<&round_start>(program, size_class, next_class, &round->births, tail));
+                   return rt3.memo(sac::fn<&round_start>(size_class, next_class, &round->births, tail));
                  rt3.write(*tail, nullptr);
-                 rt3.memo(sac::fn<&class_end>(program, size_class, next_class));
+                 rt3.memo(sac::fn<&class_end>(size_class, next_class));
                });
     });
   }
 
   /// The next class when anything is left: continuations, or initial vertices above j.
-  static void class_end(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcClass* next_class) {
-    rt.read(next_class->cont, [program, size_class, next_class](sac::Engine& rt2, HcEntry* cont) {
-      rt2.read(program->start->max_class, [program, size_class, next_class, cont](sac::Engine& rt3, int max) {
-        if (cont || size_class->j < max) rt3.memo(sac::fn<&class_start>(program, next_class));
+  static void class_end(sac::Engine& rt, HcClass* size_class, HcClass* next_class) {
+    rt.read(next_class->cont, [size_class, next_class](sac::Engine& rt2, HcEntry* cont) {
+      HpuCellsProgram* const program = ctx(rt2);
+      rt2.read(program->start->max_class, [size_class, next_class, cont](sac::Engine& rt3, int max) {
+        if (cont || size_class->j < max) rt3.memo(sac::fn<&class_start>(next_class));
       });
     });
   }
@@ -516,16 +527,16 @@ struct HpuCellsProgram {
   /// (Engine::memo_near): an entry that an update moved would match its old collect far
   /// ahead, and the hit would discard all the trace in between.
   static constexpr std::uint32_t kCollectReach = 64;
-  static void collect_entry(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcRound* round,
+  static void collect_entry(sac::Engine& rt, HcClass* size_class, HcRound* round,
                             HcEntry* entry) {
-    run_step(rt, CollectStep{{program}, size_class, round, entry});
+    run_step(rt, CollectStep{{ctx(rt)}, size_class, round, entry});
   }
 
   /// entry was read from owner's `next` (owner null: the round's head). owner's predecessor
   /// is in the key: when an update moves an entry earlier in the list, its own `next` and the
   /// destinations can be those of its old step far ahead, which would then match and discard
   /// everything in between; with the predecessor it runs anew in place.
-  static void collect_step(sac::Engine& rt, HcEntry* entry, HpuCellsProgram* program, HcClass* size_class,
+  static void collect_step(sac::Engine& rt, HcEntry* entry, HcClass* size_class,
                            HcRound* round, sac::Mod<HcEntry*>* cont_dest, HcEntry* owner, HcEntry* owner_pred) {
     // owner_pred is in the memo key only: without it, an entry an update moved earlier
     // could match its old step far ahead (same entry, next and destination), and the hit
@@ -536,14 +547,14 @@ struct HpuCellsProgram {
     // goes changes it for every entry up to the next one that continues. So the collect
     // itself is a memo of its own, which such a change re-runs as a hit, and only this
     // link step runs again.
-    rt.memo_near(kCollectReach, sac::fn<&collect_entry>(program, size_class, round, entry));
-    rt.read(entry->cont, [program, size_class, round, cont_dest, entry, owner](sac::Engine& rt2, HcEntry* cont) {
+    rt.memo_near(kCollectReach, sac::fn<&collect_entry>(size_class, round, entry));
+    rt.read(entry->cont, [size_class, round, cont_dest, entry, owner](sac::Engine& rt2, HcEntry* cont) {
       sac::Mod<HcEntry*>* dest = cont_dest;
       if (cont) {
         rt2.write(*dest, cont);
         dest = &cont->next;
       }
-      rt2.memo_read(entry->next, sac::fn<&collect_step>(program, size_class, round, dest, entry, owner));
+      rt2.memo_read(entry->next, sac::fn<&collect_step>(size_class, round, dest, entry, owner));
     });
   }
 
@@ -559,7 +570,7 @@ struct HpuCellsProgram {
     sac::Mod<HcEntry*>* births_dest;
   };
 
-  static void process_entry(sac::Engine& rt, HcEntry* entry, HpuCellsProgram* program, HcClass* size_class,
+  static void process_entry(sac::Engine& rt, HcEntry* entry, HcClass* size_class,
                             HcRound* round, sac::Mod<HcEntry*>* births_dest, HcEntry* owner, HcEntry* owner_pred) {
     // owner_pred is in the memo key only: without it, an entry an update moved earlier
     // could match its old step far ahead (same entry, next and destination), and the hit
@@ -567,10 +578,10 @@ struct HpuCellsProgram {
     (void)owner_pred;
     if (!entry) return rt.write(*births_dest, nullptr);
     rt.memo_read(entry->pairs,
-                 sac::fn<&process_step>(program, size_class, round, births_dest, entry, owner, nullptr, nullptr));
+                 sac::fn<&process_step>(size_class, round, births_dest, entry, owner, nullptr, nullptr));
   }
 
-  static void process_step(sac::Engine& rt, HcPair* pair, HpuCellsProgram* program, HcClass* size_class, HcRound* round,
+  static void process_step(sac::Engine& rt, HcPair* pair, HcClass* size_class, HcRound* round,
                            sac::Mod<HcEntry*>* births_dest, HcEntry* entry, HcEntry* entry_prev, HcPair* owner,
                            HcPair* owner_pred) {
     // owner_pred is in the memo key only (entry_prev too, for process_entry's): without it,
@@ -579,13 +590,13 @@ struct HpuCellsProgram {
     (void)owner_pred;
     if (!pair)
       return rt.memo_read(entry->next,
-                          sac::fn<&process_entry>(program, size_class, round, births_dest, entry, entry_prev));
+                          sac::fn<&process_entry>(size_class, round, births_dest, entry, entry_prev));
     // The tries are a memo of their own, as a collect is: their key holds neither the births'
     // tail nor the pair's place, which an earlier pair's births or an update to the lists
     // change for every pair after it. They hand their births over in pair->births, and only
     // this link step runs again for such a change.
-    rt.memo_near(kTryReach, sac::fn<&try_pair>(program, size_class, round, pair));
-    rt.read(pair->births, [program, size_class, round, births_dest, entry, entry_prev, pair, owner](
+    rt.memo_near(kTryReach, sac::fn<&try_pair>(size_class, round, pair));
+    rt.read(pair->births, [size_class, round, births_dest, entry, entry_prev, pair, owner](
                               sac::Engine& rt2, const HcBirths& births) {
       sac::Mod<HcEntry*>* dest = births_dest;
       if (births.head) {
@@ -593,13 +604,13 @@ struct HpuCellsProgram {
         dest = births.tail;
       }
       rt2.memo_read(pair->next,
-                    sac::fn<&process_step>(program, size_class, round, dest, entry, entry_prev, pair, owner));
+                    sac::fn<&process_step>(size_class, round, dest, entry, entry_prev, pair, owner));
     });
   }
 
   static constexpr std::uint32_t kTryReach = 64;
-  static void try_pair(sac::Engine& rt, HpuCellsProgram* program, HcClass* size_class, HcRound* round, HcPair* pair) {
-    run_step(rt, TryStep{PairTries{{program}, size_class, round, pair, nullptr, nullptr}});
+  static void try_pair(sac::Engine& rt, HcClass* size_class, HcRound* round, HcPair* pair) {
+    run_step(rt, TryStep{PairTries{{ctx(rt)}, size_class, round, pair, nullptr, nullptr}});
   }
 
   /// The pair is done: its births go to the link step.
@@ -725,25 +736,27 @@ struct HpuCellsProgram {
 
   // ---------------------------------------------------------------- 4. the final mesh
 
-  static void final_start(sac::Engine& rt, HpuCellsProgram* program) {
-    rt.memo(sac::fn<&final_node>(program, program->dir->node(rt, CellKey{})));
+  static void final_start(sac::Engine& rt) {
+    HpuCellsProgram* const program = ctx(rt);
+    rt.memo(sac::fn<&final_node>(program->dir->node(rt, CellKey{})));
   }
 
-  static void final_node(sac::Engine& rt, HpuCellsProgram* program, CellNode* n) {
-    rt.read(n->state, [program, n](sac::Engine& rt2, const CellState& s) {
+  static void final_node(sac::Engine& rt, CellNode* n) {
+    rt.read(n->state, [n](sac::Engine& rt2, const CellState& s) {
+      HpuCellsProgram* const program = ctx(rt2);
       if (s.kind == CellState::Split) {
         for (unsigned k = 0; k < 4; ++k)
-          rt2.memo(sac::fn<&final_node>(program, program->dir->node(rt2, n->key.child(k))));
+          rt2.memo(sac::fn<&final_node>(program->dir->node(rt2, n->key.child(k))));
       } else if (s.kind == CellState::Leaf) {
         // One step a vertex, each memoized on the vertex alone: when the leaf gains or loses
         // a vertex, splits or merges, the others' steps are found again with their reads,
         // and a change near one vertex re-runs its star walk only, not the leaf's.
-        for (std::size_t i = 0; i < s.count; ++i) rt2.memo(sac::fn<&final_vertex>(program, s.items[i]));
+        for (std::size_t i = 0; i < s.count; ++i) rt2.memo(sac::fn<&final_vertex>(s.items[i]));
       }
     });
   }
 
-  static void final_vertex(sac::Engine& rt, HpuCellsProgram* program, HV a) { run_step(rt, FinalStep{{program}, a}); }
+  static void final_vertex(sac::Engine& rt, HV a) { run_step(rt, FinalStep{{ctx(rt)}, a}); }
 
   /// The triangles whose (x, y)-smallest corner is a, as one block.
   struct FinalStep : StepBase {

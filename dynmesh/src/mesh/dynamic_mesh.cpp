@@ -218,8 +218,8 @@ class HpuMeshState final : public MeshState {
     validate_mesh_box(input_points.box);
     cells.commit(rt, plan);
     input_points.link_all(rt, points);
-    auto* hpu_program = &program;
-    rt.run([hpu_program](sac::Engine& rt2) { HpuCellsProgram::main(rt2, hpu_program); });
+    rt.set_context(&program);
+    rt.run([](sac::Engine& rt2) { HpuCellsProgram::main(rt2); });
     cells.feed.clear_change();
     rules.count(grid, input_points.box, edits);
   }
