@@ -120,7 +120,7 @@ void Pool::new_chunk() {
   if (!c) throw std::bad_alloc();
   // Records keep numbers in their links' top 16 bits (sac/detail/trace_nodes.hpp): every
   // address they link must fit in 48 bits, as user space does on x86-64 and AArch64 Linux.
-  if ((reinterpret_cast<std::uintptr_t>(c) + size) >> 48) {
+  if (reinterpret_cast<std::uintptr_t>(c) + size > (std::uintptr_t{1} << 48)) {
     if (size >= kHugeChunk) ::munmap(c, size);
     else std::free(c);
     throw std::bad_alloc();
@@ -130,6 +130,15 @@ void Pool::new_chunk() {
   cur_ = static_cast<char*>(c);
   end_ = cur_ + size;
   if (next_chunk_ < kMaxChunk) next_chunk_ *= 2;
+}
+
+void* Pool::allocate_large(std::size_t n) {
+  void* p = ::operator new(n);
+  if (reinterpret_cast<std::uintptr_t>(p) + n > (std::uintptr_t{1} << 48)) {
+    ::operator delete(p);
+    throw std::bad_alloc();
+  }
+  return p;
 }
 
 void* Pool::acquire_huge_chunk() {

@@ -8,7 +8,9 @@
 // Invariants: live_bytes() == sum of sizes of blocks handed out and not yet returned;
 //             a block is returned with the same size it was requested with.
 // Complexity: allocate/deallocate O(1); chunks are released only when the pool dies.
-// Blocks larger than kMaxSmall bytes go to ::operator new.
+// Blocks larger than kMaxSmall bytes go to ::operator new. Every block lies below 2^48
+// (records keep numbers in their links' top 16 bits): memory above it is refused with
+// std::bad_alloc.
 // Paper: docs/DESIGN.md, "The runtime".
 #pragma once
 
@@ -35,15 +37,17 @@ class Pool {
 
   void* allocate(std::size_t n) {
     n = round(n);
-    live_bytes_ += n;
-    if (n > kMaxSmall) return ::operator new(n);
-    Free*& head = free_[n / kGrain];
-    if (head) {
-      Free* b = head;
-      head = b->next;
-      return b;
+    void* p;
+    if (n > kMaxSmall) {
+      p = allocate_large(n);
+    } else if (Free*& head = free_[n / kGrain]) {
+      p = head;
+      head = head->next;
+    } else {
+      p = carve(n);
     }
-    return carve(n);
+    live_bytes_ += n;  // after: a block that could not be had is not counted
+    return p;
   }
 
   void deallocate(void* p, std::size_t n) noexcept {
@@ -80,6 +84,7 @@ class Pool {
     return p;
   }
   void new_chunk();           // pool.cpp
+  void* allocate_large(std::size_t n);  // pool.cpp
   void release() noexcept;    // pool.cpp
 
   Free* free_[kMaxSmall / kGrain + 1] = {};
