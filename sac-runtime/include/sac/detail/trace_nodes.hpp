@@ -145,8 +145,8 @@ struct ReadOps {
 ///       bit 1 on its version's unordered_readers (VersionBase::readers; on a default's
 ///         list it means nothing),
 ///       bit 2 a multi-read's slot,
-///     and in its top 16 bits a read's ops number (read_ops_table) and the high half of its
-///     queue position, or a slot's index in its multi-read.
+///     and in its top 16 bits the high half of a read's queue position, or a slot's index
+///     in its multi-read.
 struct ReaderLink {
   union {
     ReaderLink* rnext;
@@ -178,9 +178,9 @@ static_assert(sizeof(ReaderLink) == 16);
 /// A read. It does not name its modifiable: a live read hangs on a version of it (whose
 /// chain ends at the modifiable), a queued read's modifiable waits with it in the queue, and
 /// an issued read keeps it in `issued_mod` until it runs (the union's other member). Its ops
-/// table is a number, and its state is its stamps'. Its queue position is split between
-/// its start stamp's aux (low half) and its link's tag (high half): kNotQueued when not
-/// queued. This keeps the record at 48 bytes.
+/// table is a number, in its end stamp's aux, and its state is its stamps'. Its queue
+/// position is split between its start stamp's aux (low half) and its link's tag (high
+/// half): kNotQueued when not queued. This keeps the record at 48 bytes.
 /// A multi-read (Engine::read_many) is a ReadNode too, whose link is never attached: its
 /// slots are (ReadManyHeader).
 struct ReadNode {
