@@ -448,9 +448,10 @@ void Engine::execute(const Task& t) {
     }
     case TaskKind::ExecMemo: {
       auto* n = static_cast<MemoNode*>(t.node);
-      const std::size_t h = n->ops()->hash(n);
+      const detail::MemoOps* ops = n->ops();
+      const std::size_t h = ops->hash(n);
       if (window_end_) {
-        MemoNode* hit = find_memo_match(n->ops(), h, reinterpret_cast<const MemoNode*>(n) + 1);
+        MemoNode* hit = find_memo_match(n->start.aux(), h, reinterpret_cast<const MemoNode*>(n) + 1);
         if (hit && t.arg != detail::kAnyDistance && !within(now_, &hit->start, t.arg)) {
           hit = nullptr;
           ++stats_.memo_far;
@@ -464,7 +465,7 @@ void Engine::execute(const Task& t) {
       }
       link_memo(n, h);
       push_close(&n->end, TaskKind::CloseMemo, n);
-      exec_body([&] { n->ops()->invoke(*this, n); });
+      exec_body([&] { ops->invoke(*this, n); });
       break;
     }
     case TaskKind::CloseRead:
@@ -676,18 +677,20 @@ ReadNode* Engine::find_read_match(const ModBase& m, std::uint32_t ops_id,
       [&](const ReadNode* r) { return r->ops_id() == ops_id && ops->equal(r, closure); });
 }
 
-AllocNode* Engine::find_alloc_match(const detail::AllocOps* ops, std::size_t h,
-                                    const void* key) const {
+// A candidate's type is told by the ops number in its stamp, which is already loaded, not
+// by its table.
+AllocNode* Engine::find_alloc_match(std::uint16_t ops_id, std::size_t h, const void* key) const {
+  const detail::AllocOps* ops = detail::alloc_ops_table[ops_id];
   return earliest_match<AllocNode>(
       [&](auto&& offer) { for (AllocNode* n = allocs_.bucket(h); n; n = n->hnext) offer(n); },
-      [&](const AllocNode* n) { return n->ops() == ops && ops->key_equal(n, key); });
+      [&](const AllocNode* n) { return n->stamp.aux() == ops_id && ops->key_equal(n, key); });
 }
 
-MemoNode* Engine::find_memo_match(const detail::MemoOps* ops, std::size_t h,
-                                  const void* closure) const {
+MemoNode* Engine::find_memo_match(std::uint16_t ops_id, std::size_t h, const void* closure) const {
+  const detail::MemoOps* ops = detail::memo_ops_table[ops_id];
   return earliest_match<MemoNode>(
       [&](auto&& offer) { for (MemoNode* n = memos_.bucket(h); n; n = n->hnext) offer(n); },
-      [&](const MemoNode* n) { return n->ops() == ops && ops->equal(n, closure); });
+      [&](const MemoNode* n) { return n->start.aux() == ops_id && ops->equal(n, closure); });
 }
 
 bool Engine::within(const Stamp* from, const Stamp* to, std::uint32_t k) const noexcept {

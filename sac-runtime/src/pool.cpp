@@ -90,6 +90,12 @@ class ChunkCache {
   std::size_t limit_ = 0;
 };
 
+// Records keep numbers in their links' top 16 bits (sac/detail/trace_nodes.hpp): every
+// address they link must fit in 48 bits, as user space does on x86-64 and AArch64 Linux.
+bool below_2_48(const void* p, std::size_t n) {
+  return reinterpret_cast<std::uintptr_t>(p) + n <= (std::uintptr_t{1} << 48);
+}
+
 void* map_huge(std::size_t size) {
   // Over-map by one huge page and trim, so that the chunk is 2 MiB-aligned.
   const std::size_t align = Pool::kHugeChunk;
@@ -118,9 +124,7 @@ void Pool::new_chunk() {
     c = std::malloc(size);
   }
   if (!c) throw std::bad_alloc();
-  // Records keep numbers in their links' top 16 bits (sac/detail/trace_nodes.hpp): every
-  // address they link must fit in 48 bits, as user space does on x86-64 and AArch64 Linux.
-  if (reinterpret_cast<std::uintptr_t>(c) + size > (std::uintptr_t{1} << 48)) {
+  if (!below_2_48(c, size)) {
     if (size >= kHugeChunk) ::munmap(c, size);
     else std::free(c);
     throw std::bad_alloc();
@@ -134,7 +138,7 @@ void Pool::new_chunk() {
 
 void* Pool::allocate_large(std::size_t n) {
   void* p = ::operator new(n);
-  if (reinterpret_cast<std::uintptr_t>(p) + n > (std::uintptr_t{1} << 48)) {
+  if (!below_2_48(p, n)) {
     ::operator delete(p);
     throw std::bad_alloc();
   }

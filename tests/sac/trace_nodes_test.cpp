@@ -135,7 +135,6 @@ TEST(TraceNodes, QueuePositionUsesBothHalves) {
 }
 
 TEST(TraceNodes, OpsNumbersAreDistinctPerType) {
-  using sac::detail::MemoOpsFor;
   using sac::detail::VersionOpsFor;
   EXPECT_NE(VersionOpsFor<int>::id(), 0);
   EXPECT_NE(VersionOpsFor<int>::id(), VersionOpsFor<double>::id());

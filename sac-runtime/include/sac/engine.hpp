@@ -454,10 +454,8 @@ class Engine {
   void set_base(ModBase& m, detail::VersionBase* fresh, bool (*assign)(detail::VersionBase*, detail::VersionBase*));
   detail::ReadNode* find_read_match(const ModBase& m, std::uint32_t ops_id,
                                     const void* closure) const;
-  detail::AllocNode* find_alloc_match(const detail::AllocOps* ops, std::size_t h,
-                                      const void* key) const;
-  detail::MemoNode* find_memo_match(const detail::MemoOps* ops, std::size_t h,
-                                    const void* closure) const;
+  detail::AllocNode* find_alloc_match(std::uint16_t ops_id, std::size_t h, const void* key) const;
+  detail::MemoNode* find_memo_match(std::uint16_t ops_id, std::size_t h, const void* closure) const;
   /// The earliest record that candidates(offer) offers, matches accepts and the window
   /// holds; null if none (engine.cpp).
   template <class N, class Candidates, class Matches>

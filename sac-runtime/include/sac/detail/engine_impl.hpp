@@ -195,11 +195,10 @@ T* Engine::alloc(const K& key, A&&... args) {
   using N = detail::AllocNodeT<T, K>;
   require_computation("alloc");
   flush_if_pending();
-  const detail::AllocOps* ops = &detail::AllocOpsFor<T, K>::ops;
   const std::uint16_t ops_id = detail::AllocOpsFor<T, K>::id();
   const std::size_t h = Hash<K>{}(key);
   if (window_end_) {
-    if (detail::AllocNode* hit = find_alloc_match(ops, h, &key)) {
+    if (detail::AllocNode* hit = find_alloc_match(ops_id, h, &key)) {
       reuse_alloc(hit);
       return &static_cast<N*>(hit)->object;
     }
