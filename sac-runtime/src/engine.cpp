@@ -543,7 +543,7 @@ bool Engine::note_change(ReaderLink* l, const ModBase& m, const VersionBase* bef
   }
   const std::uint32_t slot = detail::is_slot(l) ? l->tag() : 0;
   const auto f = r->ops()->affected;
-  if (f && after && !f(r, slot, before, after)) return false;  // no `after`: a default, re-run
+  if (f && after && !f(*this, r, slot, before, after)) return false;  // no `after`: a default, re-run
   // A plain read is not listed: its value changed and it re-runs; a record per change
   // would cost it more than it saves.
   QueueAux a = QueueAux::read_of(detail::is_slot(l) ? nullptr : &m);
@@ -565,7 +565,7 @@ bool Engine::still_affected(ReadNode* r, const QueueAux& a) {
     const VersionBase* now = s.now;
     if (now == s.v) continue;
     if (now->ops()->equal(now, s.v)) continue;
-    if (f && !f(r, s.slot, s.v, now)) continue;
+    if (f && !f(*this, r, s.slot, s.v, now)) continue;
     const ModBase* to = r->ops()->follow ? r->ops()->follow(*this, r, s.slot, s.v, now) : nullptr;
     if (!to) return true;
     // The slot reads `to` from now on, with no re-execution.

@@ -53,6 +53,7 @@ testing::AssertionResult agrees(const DynamicMesh& dyn, const std::vector<Point<
       return testing::AssertionFailure() << "triangles differ from the static twin HpuMesh: " << got.size()
                                          << " vs " << twin.triangles().size();
     if (dyn.num_triangles() != got.size()) return testing::AssertionFailure() << "num_triangles() is wrong";
+    if (dyn.mesh() != twin.mesh()) return testing::AssertionFailure() << "mesh() differs from the static twin's";
     return good_mesh(twin.mesh(), dyn.box(), points, bound, true);
   }
   const QuadtreeMesh twin(dyn.box(), points);

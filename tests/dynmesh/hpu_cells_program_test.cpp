@@ -94,12 +94,14 @@ class HpuHarness {
     // The Steiner pool holds exactly the mesh's Steiner vertices (every vertex but the
     // corners and the input list's) once a propagation's released ones are collected.
     EXPECT_EQ(state_.steiner.size() + 4 + state_.inputs.size(), vs.size()) << "the Steiner pool's live vertices";
+    // The feed's mesh without copies is make_mesh's.
+    EXPECT_EQ(state_.feed.mesh(), make_mesh(state_.feed.triangles()));
   }
   const sac::Stats& stats() const { return engine_.stats(); }
   std::size_t record_bytes() const { return engine_.record_bytes(); }
   const detail::CellQuestionStats& questions() const { return program_.stats; }
   const detail::HcStepCounts& steps() const { return program_.steps; }
-  /// For the checker's negative test.
+  /// For the checker's negative test, and the feed's logging.
   detail::HpuMeshFeed& feed() { return state_.feed; }
 
  private:
@@ -590,6 +592,33 @@ TEST(HpuMeshFeed, CheckerCatchesAWrongLiveCount) {
   ASSERT_NO_THROW(h.check());
   h.feed().corrupt_live_count_for_testing();
   EXPECT_THROW(h.check(), InvariantError);
+}
+
+/// With logging off, the feed keeps its live triangles and logs no change; on again, the next
+/// change takes the triangles from the ones then to the new ones.
+TEST(HpuMeshFeed, LoggingOffKeepsTheTrianglesAndLogsNothing) {
+  const Box<2> box{{0, 0}, 1};
+  const auto a = generate<2>(Distribution::Uniform, kSanitized ? 60 : 200, 7);
+  auto b = a;
+  b.resize(b.size() / 2);
+  auto c = generate<2>(Distribution::Clusters, kSanitized ? 40 : 100, 8);
+  c.insert(c.end(), b.begin(), b.end());
+  HpuHarness h(box, a, kHpuDefaultMinAngle);
+  h.feed().set_logging(false);
+  h.set_points(b);
+  const MeshChange none = h.take_change();
+  EXPECT_TRUE(none.added.empty() && none.removed.empty());
+  EXPECT_TRUE(same_triangles(h.triangles(), HpuMesh(box, b, kHpuDefaultMinAngle).triangles()));
+  EXPECT_NO_THROW(h.check());
+  h.feed().set_logging(true);
+  std::vector<Triangle> tris = h.triangles();
+  h.set_points(c);
+  const MeshChange change = h.take_change();
+  EXPECT_FALSE(change.added.empty());
+  ASSERT_TRUE(apply_change(tris, change));
+  EXPECT_EQ(tris, h.triangles());
+  EXPECT_TRUE(same_triangles(h.triangles(), HpuMesh(box, c, kHpuDefaultMinAngle).triangles()));
+  EXPECT_NO_THROW(h.check());
 }
 
 }  // namespace

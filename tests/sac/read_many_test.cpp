@@ -17,6 +17,7 @@
 #include <memory>
 #include <random>
 #include <span>
+#include <type_traits>
 #include <vector>
 
 #include "../sanitized.hpp"
@@ -639,6 +640,56 @@ TEST(ReadManyProjection, ReRunsOnlyWhenTheProjectionChanges) {
   change(sel, 0, 4, 32);
   // The base value b sees changes its digit while the read is attached to it.
   change(b, 28, 5, 38);
+  rt.check_invariants();
+}
+
+// LastDigits with its modulus and counters in the engine's context: affected() gets the
+// engine for it, so the closure holds nothing.
+struct DigitsContext {
+  Mod<int>* out;
+  int runs = 0;
+  int asked = 0;
+  int modulus = 10;
+};
+struct LastDigitsInContext {
+  void operator()(Engine& rt, Vals v) const {
+    DigitsContext* c = rt.context<DigitsContext>();
+    ++c->runs;
+    int s = 0;
+    for (const int* p : v) s = s * c->modulus + *p % c->modulus;
+    rt.write(*c->out, s);
+  }
+  bool affected(const Engine& rt, std::size_t, const int& before, const int& after) const {
+    DigitsContext* c = rt.context<DigitsContext>();
+    ++c->asked;
+    return before % c->modulus != after % c->modulus;
+  }
+};
+static_assert(std::is_empty_v<LastDigitsInContext>);
+
+TEST(ReadManyProjection, AffectedMayTakeTheEngineForItsContext) {
+  Mod<int> a, b, out;
+  DigitsContext c{&out};
+  Engine rt;
+  rt.set_context(&c);
+  rt.set(a, 11);
+  rt.set(b, 22);
+  rt.run([&a, &b](Engine& rt2) { rt2.read_many({&a, &b}, LastDigitsInContext{}); });
+  EXPECT_EQ(out.get(), 12);
+  EXPECT_EQ(c.runs, 1);
+  rt.set(a, 41);  // the same last digit: asked, not re-run
+  rt.propagate();
+  EXPECT_EQ(c.runs, 1);
+  EXPECT_GE(c.asked, 1);
+  EXPECT_EQ(out.get(), 12);
+  c.modulus = 100;  // the context's state is what affected() answers from
+  rt.set(b, 122);  // the same two last digits: not re-run
+  rt.propagate();
+  EXPECT_EQ(c.runs, 1);
+  rt.set(b, 133);
+  rt.propagate();
+  EXPECT_EQ(c.runs, 2);
+  EXPECT_EQ(out.get(), 41 * 100 + 33);
   rt.check_invariants();
 }
 

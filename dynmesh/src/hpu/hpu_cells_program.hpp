@@ -170,11 +170,14 @@ struct HcBlock {
   sac::Mod<sac::Mod<HcEntry*>*> init_tail;
 };
 
-/// A round, keyed by the modifiable holding its first entry.
+/// A round, keyed by the modifiable holding its first entry, which also names its class (a
+/// class's initial list, or a round's births). It holds its class, so the steps and list
+/// steps of the round name the round only.
 struct HcRound {
-  HcRound() = default;
+  explicit HcRound(HcClass* c) : size_class(c) {}
   HcRound(const HcRound&) = delete;
   HcRound& operator=(const HcRound&) = delete;
+  HcClass* size_class;
   sac::Mod<HcEntry*> births;               // the next round
   sac::Mod<sac::Mod<HcEntry*>*> cont_tail;  // Q_{j+1}'s tail after this round's collect
 };
@@ -246,19 +249,18 @@ struct HpuCellsProgram {
   /// The distance scale of class j.
   static double scale_of(int j) noexcept { return std::ldexp(1.0, std::clamp(j, -1070, 1020)); }
 
-  /// What the five steps (FirstClassStep, CollectStep, TryStep, InsertStep, FinalStep) share:
-  /// the program, whose view, store and scratch they use, and the part of run_step's Step
-  /// interface that comes from it (step_rounds.hpp). Each step adds its own operands and
-  /// run(). A step is its rounds' closure, so it holds pointers only.
-  /// The program, from its engine's context: reads and memo keys do not carry it (8 bytes
-  /// a record). A step does (StepBase): its projection test, affected(), has no engine.
-  static HpuCellsProgram* ctx(sac::Engine& rt) { return rt.context<HpuCellsProgram>(); }
+  /// The program, from its engine's context: no closure carries it (8 bytes a record). The
+  /// steps' projection test gets the engine for it too (sac::Engine::read_many).
+  static HpuCellsProgram* ctx(const sac::Engine& rt) { return rt.context<HpuCellsProgram>(); }
 
+  /// What the five steps (FirstClassStep, CollectStep, TryStep, InsertStep, FinalStep) share:
+  /// the part of run_step's Step interface that comes from the program, whose view, store and
+  /// scratch they use (step_rounds.hpp). Each step adds its own operands and run(). A step is
+  /// its rounds' closure, so it holds pointers only.
   struct StepBase {
-    HpuCellsProgram* program;
-    CellView* view(sac::Engine&) const { return &program->view; }
-    const Box<2>& box() const noexcept { return program->box(); }
-    const CellDirectory& dir() const noexcept { return *program->dir; }
+    static CellView* view(const sac::Engine& rt) { return &ctx(rt)->view; }
+    static const Box<2>& box(const sac::Engine& rt) { return ctx(rt)->box(); }
+    static const CellDirectory& dir(const sac::Engine& rt) { return *ctx(rt)->dir; }
   };
 
   // ---------------------------------------------------------------- 1. initial vertices
@@ -309,6 +311,7 @@ struct HpuCellsProgram {
   struct FirstClassStep : StepBase {
     HcCell* cell;
     bool run(sac::Engine& rt, CellView& v) const {
+      HpuCellsProgram* const program = ctx(rt);
       if (!v.kept()) program->first_class = program->questions.first_class(cell->v, program->box().side / 4);
       if (!v.done()) return false;
       ++program->steps.done[HcStepCounts::FirstClass];
@@ -319,7 +322,7 @@ struct HpuCellsProgram {
   };
 
   static void class_step(sac::Engine& rt, HcCell* cell) {
-    if (cell) run_step(rt, FirstClassStep{{ctx(rt)}, cell});
+    if (cell) run_step(rt, FirstClassStep{{}, cell});
   }
 
   // ---------------------------------------------------------------- 3. classes and rounds
@@ -464,9 +467,9 @@ struct HpuCellsProgram {
   /// then the next round (the births) or the next class.
   static void round_start(sac::Engine& rt, HcClass* size_class, HcClass* next_class,
                           sac::Mod<HcEntry*>* head, sac::Mod<HcEntry*>* cont_dest) {
-    HcRound* round = rt.alloc<HcRound>(head);
-    rt.memo_read(*head, sac::fn<&collect_step>(size_class, round, cont_dest, nullptr, nullptr));
-    rt.memo_read(*head, sac::fn<&process_entry>(size_class, round, &round->births, nullptr, nullptr));
+    HcRound* round = rt.alloc<HcRound>(head, size_class);
+    rt.memo_read(*head, sac::fn<&collect_step>(round, cont_dest, nullptr, nullptr));
+    rt.memo_read(*head, sac::fn<&process_entry>(round, &round->births, nullptr, nullptr));
     rt.memo(sac::fn<&round_end>(size_class, next_class, round));
   }
 
@@ -498,11 +501,11 @@ struct HpuCellsProgram {
   /// The twin's collect(v, j, birth): loose pairs (both sides, of class j, ≤ j at a birth) in
   /// (x, y) order, and v's continuation into Q_{j+1}.
   struct CollectStep : StepBase {
-    HcClass* size_class;
     HcRound* round;
     HcEntry* entry;
     bool run(sac::Engine& rt, CellView& v) const {
-      const int j = size_class->j;
+      HpuCellsProgram* const program = ctx(rt);
+      const int j = round->size_class->j;
       if (!v.kept()) program->go_on = program->questions.collect(entry->v, j, entry->birth, program->pairs);
       if (!v.done()) return false;
       ++program->steps.done[HcStepCounts::Collect];
@@ -527,17 +530,16 @@ struct HpuCellsProgram {
   /// (Engine::memo_near): an entry that an update moved would match its old collect far
   /// ahead, and the hit would discard all the trace in between.
   static constexpr std::uint32_t kCollectReach = 64;
-  static void collect_entry(sac::Engine& rt, HcClass* size_class, HcRound* round,
-                            HcEntry* entry) {
-    run_step(rt, CollectStep{{ctx(rt)}, size_class, round, entry});
+  static void collect_entry(sac::Engine& rt, HcRound* round, HcEntry* entry) {
+    run_step(rt, CollectStep{{}, round, entry});
   }
 
   /// entry was read from owner's `next` (owner null: the round's head). owner's predecessor
   /// is in the key: when an update moves an entry earlier in the list, its own `next` and the
   /// destinations can be those of its old step far ahead, which would then match and discard
   /// everything in between; with the predecessor it runs anew in place.
-  static void collect_step(sac::Engine& rt, HcEntry* entry, HcClass* size_class,
-                           HcRound* round, sac::Mod<HcEntry*>* cont_dest, HcEntry* owner, HcEntry* owner_pred) {
+  static void collect_step(sac::Engine& rt, HcEntry* entry, HcRound* round, sac::Mod<HcEntry*>* cont_dest,
+                           HcEntry* owner, HcEntry* owner_pred) {
     // owner_pred is in the memo key only: without it, an entry an update moved earlier
     // could match its old step far ahead (same entry, next and destination), and the hit
     // would discard the trace in between; with it the step runs anew in place.
@@ -547,14 +549,14 @@ struct HpuCellsProgram {
     // goes changes it for every entry up to the next one that continues. So the collect
     // itself is a memo of its own, which such a change re-runs as a hit, and only this
     // link step runs again.
-    rt.memo_near(kCollectReach, sac::fn<&collect_entry>(size_class, round, entry));
-    rt.read(entry->cont, [size_class, round, cont_dest, entry, owner](sac::Engine& rt2, HcEntry* cont) {
+    rt.memo_near(kCollectReach, sac::fn<&collect_entry>(round, entry));
+    rt.read(entry->cont, [round, cont_dest, entry, owner](sac::Engine& rt2, HcEntry* cont) {
       sac::Mod<HcEntry*>* dest = cont_dest;
       if (cont) {
         rt2.write(*dest, cont);
         dest = &cont->next;
       }
-      rt2.memo_read(entry->next, sac::fn<&collect_step>(size_class, round, dest, entry, owner));
+      rt2.memo_read(entry->next, sac::fn<&collect_step>(round, dest, entry, owner));
     });
   }
 
@@ -563,40 +565,38 @@ struct HpuCellsProgram {
   /// Where a pair's tries stand: the pair, and the births so far (the first, and where the
   /// next goes; null: none yet).
   struct PairTries : StepBase {
-    HcClass* size_class;
     HcRound* round;
     HcPair* pair;
     HcEntry* head;
     sac::Mod<HcEntry*>* births_dest;
   };
 
-  static void process_entry(sac::Engine& rt, HcEntry* entry, HcClass* size_class,
-                            HcRound* round, sac::Mod<HcEntry*>* births_dest, HcEntry* owner, HcEntry* owner_pred) {
+  static void process_entry(sac::Engine& rt, HcEntry* entry, HcRound* round, sac::Mod<HcEntry*>* births_dest,
+                            HcEntry* owner, HcEntry* owner_pred) {
     // owner_pred is in the memo key only: without it, an entry an update moved earlier
     // could match its old step far ahead (same entry, next and destination), and the hit
     // would discard the trace in between; with it the step runs anew in place.
     (void)owner_pred;
     if (!entry) return rt.write(*births_dest, nullptr);
     rt.memo_read(entry->pairs,
-                 sac::fn<&process_step>(size_class, round, births_dest, entry, owner, nullptr, nullptr));
+                 sac::fn<&process_step>(round, births_dest, entry, owner, nullptr, nullptr));
   }
 
-  static void process_step(sac::Engine& rt, HcPair* pair, HcClass* size_class, HcRound* round,
-                           sac::Mod<HcEntry*>* births_dest, HcEntry* entry, HcEntry* entry_prev, HcPair* owner,
-                           HcPair* owner_pred) {
+  static void process_step(sac::Engine& rt, HcPair* pair, HcRound* round, sac::Mod<HcEntry*>* births_dest,
+                           HcEntry* entry, HcEntry* entry_prev, HcPair* owner, HcPair* owner_pred) {
     // owner_pred is in the memo key only (entry_prev too, for process_entry's): without it,
     // a pair an update moved earlier could match its old step far ahead (same pair, next and
     // destination), and the hit would discard the trace in between.
     (void)owner_pred;
     if (!pair)
       return rt.memo_read(entry->next,
-                          sac::fn<&process_entry>(size_class, round, births_dest, entry, entry_prev));
+                          sac::fn<&process_entry>(round, births_dest, entry, entry_prev));
     // The tries are a memo of their own, as a collect is: their key holds neither the births'
     // tail nor the pair's place, which an earlier pair's births or an update to the lists
     // change for every pair after it. They hand their births over in pair->births, and only
     // this link step runs again for such a change.
-    rt.memo_near(kTryReach, sac::fn<&try_pair>(size_class, round, pair));
-    rt.read(pair->births, [size_class, round, births_dest, entry, entry_prev, pair, owner](
+    rt.memo_near(kTryReach, sac::fn<&try_pair>(round, pair));
+    rt.read(pair->births, [round, births_dest, entry, entry_prev, pair, owner](
                               sac::Engine& rt2, const HcBirths& births) {
       sac::Mod<HcEntry*>* dest = births_dest;
       if (births.head) {
@@ -604,13 +604,13 @@ struct HpuCellsProgram {
         dest = births.tail;
       }
       rt2.memo_read(pair->next,
-                    sac::fn<&process_step>(size_class, round, dest, entry, entry_prev, pair, owner));
+                    sac::fn<&process_step>(round, dest, entry, entry_prev, pair, owner));
     });
   }
 
   static constexpr std::uint32_t kTryReach = 64;
-  static void try_pair(sac::Engine& rt, HcClass* size_class, HcRound* round, HcPair* pair) {
-    run_step(rt, TryStep{PairTries{{ctx(rt)}, size_class, round, pair, nullptr, nullptr}});
+  static void try_pair(sac::Engine& rt, HcRound* round, HcPair* pair) {
+    run_step(rt, TryStep{PairTries{{}, round, pair, nullptr, nullptr}});
   }
 
   /// The pair is done: its births go to the link step.
@@ -620,7 +620,7 @@ struct HpuCellsProgram {
 
   /// v was inserted: its birth entry joins the next round, after the pair's births before it.
   static PairTries birth(sac::Engine& rt, PairTries tries, HV v) {
-    HcEntry* entry = rt.alloc<HcEntry>(std::tuple{v, tries.size_class->j, true}, v, true);
+    HcEntry* entry = rt.alloc<HcEntry>(std::tuple{v, tries.round->size_class->j, true}, v, true);
     if (tries.head) rt.write(*tries.births_dest, entry);
     else tries.head = entry;
     tries.births_dest = &entry->next;
@@ -643,7 +643,8 @@ struct HpuCellsProgram {
   /// One try of the twin's process(p, q, j) loop.
   struct TryStep : PairTries {
     bool run(sac::Engine& rt, CellView& v) const {
-      if (!v.kept()) program->decision = program->questions.decide(pair->p, pair->q, size_class->j);
+      HpuCellsProgram* const program = ctx(rt);
+      if (!v.kept()) program->decision = program->questions.decide(pair->p, pair->q, round->size_class->j);
       if (!v.done()) return false;
       const CellDecision<HV> decision = program->decision;  // a copy: the steps it issues use the scratch
       ++program->steps.done[HcStepCounts::Try];
@@ -661,7 +662,7 @@ struct HpuCellsProgram {
         }
         case CellDecision<HV>::Insert: {
           const CellVertex* off_center = steiner_at(rt, program, decision.at);
-          run_step(rt, InsertStep<AfterOffCenter>{{program}, off_center, size_class->j, AfterOffCenter{*this}});
+          run_step(rt, InsertStep<AfterOffCenter>{{}, off_center, round->size_class->j, AfterOffCenter{*this}});
           break;
         }
       }
@@ -678,8 +679,8 @@ struct HpuCellsProgram {
   static void split_next(sac::Engine& rt, const PairTries& tries, const Splits& splits, std::uint32_t i) {
     if (i == splits.n) return run_step(rt, TryStep{tries});
     const Point<2> mid = side_midpoint(splits.s[i][0]->p, splits.s[i][1]->p);
-    const CellVertex* m = steiner_at(rt, tries.program, mid);
-    run_step(rt, InsertStep<AfterSplit>{{tries.program}, m, tries.size_class->j, AfterSplit{tries, splits, i}});
+    const CellVertex* m = steiner_at(rt, ctx(rt), mid);
+    run_step(rt, InsertStep<AfterSplit>{{}, m, tries.round->size_class->j, AfterSplit{tries, splits, i}});
   }
 
   struct AfterSplit {
@@ -697,6 +698,7 @@ struct HpuCellsProgram {
     int j;
     Then then;
     bool run(sac::Engine& rt, CellView& v) const {
+      HpuCellsProgram* const program = ctx(rt);
       if (!v.kept())
         std::tie(program->at_node, program->at_state) = v.locate(program->dir->position(vertex->p), scale_of(j));
       if (!v.done()) return false;
@@ -756,12 +758,13 @@ struct HpuCellsProgram {
     });
   }
 
-  static void final_vertex(sac::Engine& rt, HV a) { run_step(rt, FinalStep{{ctx(rt)}, a}); }
+  static void final_vertex(sac::Engine& rt, HV a) { run_step(rt, FinalStep{{}, a}); }
 
   /// The triangles whose (x, y)-smallest corner is a, as one block.
   struct FinalStep : StepBase {
     HV a;
     bool run(sac::Engine& rt, CellView& v) const {
+      HpuCellsProgram* const program = ctx(rt);
       if (!v.kept()) {
         program->block.clear();
         // The view's nearest search starts at a's leaf and ignores the scale, so the step

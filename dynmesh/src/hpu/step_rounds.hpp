@@ -120,8 +120,8 @@ struct CellRound {
     }
   }
 
-  bool affected(std::size_t i, const CellState& before, const CellState& after) const {
-    return interest_changed(step.box(), c.cells[i]->key, c.used[i], before, after);
+  bool affected(const sac::Engine& rt, std::size_t i, const CellState& before, const CellState& after) const {
+    return interest_changed(step.box(rt), c.cells[i]->key, c.used[i], before, after);
   }
 
   /// S6: a leaf that split or merged away: its read moves to the cell that holds what the
@@ -129,7 +129,7 @@ struct CellRound {
   const sac::Mod<CellState>* follow(std::size_t i, const CellState& seen, const CellState& now,
                                     const sac::Engine::At& at) const {
     CellInterest in = c.used[i];
-    CellNode* d = follow_cell(step.box(), step.dir(), c.cells[i], &in, seen, now,
+    CellNode* d = follow_cell(step.box(at.engine()), step.dir(at.engine()), c.cells[i], &in, seen, now,
                               [&](const CellNode* node) { return at.value(node->state); });
     if (!d) return nullptr;
     c.cells[i] = d;
@@ -162,15 +162,29 @@ void issue_round(sac::Engine& rt, const Step& step, const CellRoundHead* parent,
   if (misses.empty()) throw InvariantError("dynmesh: a step failed without a pending cell");
   if (misses.size() > kCellsPerRead) misses = misses.first(kCellsPerRead);  // the rest next round
   step.view(rt)->count_round(misses.size());
-  if (misses.size() <= 2) return issue_round_n<Step, 2>(rt, step, parent, serial, misses);
-  if (misses.size() <= 4) return issue_round_n<Step, 4>(rt, step, parent, serial, misses);
-  if (misses.size() <= 8) return issue_round_n<Step, 8>(rt, step, parent, serial, misses);
-  issue_round_n<Step, kCellsPerRead>(rt, step, parent, serial, misses);
+  // Closures of 1, 2, 3, 4, 6, 8, 12 or 16 cells: a round holds at most a third more room than
+  // it reads (12 bytes a cell), against twice as much with powers of two.
+  switch (misses.size()) {
+    case 1: return issue_round_n<Step, 1>(rt, step, parent, serial, misses);
+    case 2: return issue_round_n<Step, 2>(rt, step, parent, serial, misses);
+    case 3: return issue_round_n<Step, 3>(rt, step, parent, serial, misses);
+    case 4: return issue_round_n<Step, 4>(rt, step, parent, serial, misses);
+    case 5:
+    case 6: return issue_round_n<Step, 6>(rt, step, parent, serial, misses);
+    case 7:
+    case 8: return issue_round_n<Step, 8>(rt, step, parent, serial, misses);
+    case 9:
+    case 10:
+    case 11:
+    case 12: return issue_round_n<Step, 12>(rt, step, parent, serial, misses);
+    default: return issue_round_n<Step, kCellsPerRead>(rt, step, parent, serial, misses);
+  }
 }
 
 /// Runs a step: S1, then S2 to S5 as the header states. Step: copyable (it is each round's
-/// closure), with CellView* view(Engine&), const Box<2>& box() and const CellDirectory& dir()
-/// (the store's) and bool run(Engine&, CellView&), which returns false when CellView::done()
+/// closure), with CellView* view(const Engine&), const Box<2>& box(const Engine&) and const
+/// CellDirectory& dir(const Engine&) (the store's, from the engine's context), and bool
+/// run(Engine&, CellView&), which returns false when CellView::done()
 /// does (S2 failed: it has written, allocated and issued nothing) and otherwise acts (S5).
 template <class Step>
 void run_step(sac::Engine& rt, const Step& step) {

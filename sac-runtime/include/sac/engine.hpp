@@ -155,14 +155,15 @@ class Engine {
   /// Reads the k modifiables mods (1 <= k <= 16; repeats allowed) as one event: runs
   /// body(vals) (or body(Engine&, vals)) with vals a std::span<const T* const> of the k
   /// values visible now, vals[i] that of mods[i]. The same as k nested reads of mods in
-  /// order with body innermost, but one record (64 + 32k bytes + closure), one interval
+  /// order with body innermost, but one record (48 + 24k bytes + closure), one interval
   /// and one event in the statistics: when any of the k visible values changes (cut-off
   /// writes excepted), propagate() re-runs body once, seeing all k current values. The
   /// pointers to vals are valid during the call only. Not memoized (no memo_read analogue).
   /// UsageError for k outside [1, 16]. O(k) plus the version walks of the k modifiables.
   ///
   /// A read of a projection: when body's closure has
-  ///   bool affected(std::size_t i, const T& before, const T& after) const,
+  ///   bool affected(std::size_t i, const T& before, const T& after) const
+  /// (or affected(const Engine& rt, i, before, after), rt for its context<T>() only),
   /// a change of the value mods[i] shows (a write, a set() or an undone write; before !=
   /// after) re-runs body only if affected() says so. false promises that body, run on after,
   /// would have the same effects as it had on before: the read then sees after without
@@ -317,6 +318,8 @@ class Engine {
     /// The value of m visible at the read's time; null when m has no version there.
     template <class T>
     const T* value(const Mod<T>& m) const;
+    /// The engine, for its context (context<T>()) only.
+    const Engine& engine() const noexcept { return *rt_; }
 
    private:
     const Engine* rt_;

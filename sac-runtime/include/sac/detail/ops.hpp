@@ -119,8 +119,14 @@ struct ReadOpsFor {
 };
 
 /// Does closure F of a multi-read of T values narrow what it depends on (Engine::read_many)?
+/// Its affected() may also take the engine first, for the engine's context (a closure that
+/// reaches its program through Engine::context rather than holding a pointer to it).
 template <class F, class T>
-concept ProjectedRead = requires(const F& f, std::size_t i, const T& a, const T& b) {
+concept ProjectedReadWithEngine = requires(const F& f, const Engine& rt, std::size_t i, const T& a, const T& b) {
+  { f.affected(rt, i, a, b) } -> std::convertible_to<bool>;
+};
+template <class F, class T>
+concept ProjectedRead = ProjectedReadWithEngine<F, T> || requires(const F& f, std::size_t i, const T& a, const T& b) {
   { f.affected(i, a, b) } -> std::convertible_to<bool>;
 };
 
@@ -154,10 +160,14 @@ struct ReadManyOpsFor {
     for (std::uint32_t i = 0; i < many_of(r)->k(); ++i) s[i].~ReadSlot();
     many_of(r)->~ReadManyHeader();
   }
-  static bool affected(const ReadNode* r, std::uint32_t i, const VersionBase* before, const VersionBase* after) {
-    if constexpr (ProjectedRead<F, T>)
-      return closure(const_cast<ReadNode*>(r))
-          ->affected(i, static_cast<const Version<T>*>(before)->value, static_cast<const Version<T>*>(after)->value);
+  static bool affected(const Engine& rt, const ReadNode* r, std::uint32_t i, const VersionBase* before,
+                       const VersionBase* after) {
+    const T& b = static_cast<const Version<T>*>(before)->value;
+    const T& a = static_cast<const Version<T>*>(after)->value;
+    if constexpr (ProjectedReadWithEngine<F, T>)
+      return closure(const_cast<ReadNode*>(r))->affected(rt, i, b, a);
+    else if constexpr (ProjectedRead<F, T>)
+      return closure(const_cast<ReadNode*>(r))->affected(i, b, a);
     else
       return true;
   }

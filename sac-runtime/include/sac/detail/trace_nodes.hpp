@@ -126,8 +126,9 @@ struct ReadOps {
   void (*invoke_many)(Engine&, ReadNode*, const VersionBase* const*) = nullptr;
   /// A read of a projection (Engine::read_many with a closure that has affected()): does
   /// replacing the value slot i sees, `before`, by `after` change what the body depends on?
-  /// Null: every change does.
-  bool (*affected)(const ReadNode*, std::uint32_t slot, const VersionBase* before, const VersionBase* after) = nullptr;
+  /// Null: every change does. The engine is there for its context only.
+  bool (*affected)(const Engine&, const ReadNode*, std::uint32_t slot, const VersionBase* before,
+                   const VersionBase* after) = nullptr;
   /// A multi-read whose closure has follow(): after a change of slot i from `seen` to `now`
   /// that affects it, the modifiable that holds what it used of `seen` at its time, which
   /// slot i then reads instead of re-running; null: re-run. Null: never.
