@@ -27,6 +27,7 @@ namespace {
 
 using sac::Engine;
 using sac::Mod;
+using sac::ReadSlots;
 using Vals = std::span<const int* const>;
 
 int sum(Vals v) {
@@ -956,6 +957,56 @@ TEST(ReadManyFollow, AReadMovesToAModifiableThatHoldsWhatItSaw) {
   rt.propagate();
   EXPECT_EQ(runs, 2);
   EXPECT_EQ(out.get(), 32);
+  rt.check_invariants();
+}
+
+// FollowingSum whose body takes its modifiables (ReadSlots) and keeps them, rather than
+// holding copies: the view shows what each slot reads, a followed slot's new modifiable too.
+struct SlotsSum {
+  Mod<int>* out;
+  std::span<Mod<int>> pool;
+  std::vector<const Mod<int>*>* seen;  // what the body's slots named, its last run (test-owned)
+  const Mod<int>** moved_from;         // the kept view's slot, asked in follow() (test-owned)
+  mutable ReadSlots<int> kept;
+  void operator()(Engine& rt, Vals v, ReadSlots<int> slots) const {
+    kept = slots;
+    seen->clear();
+    for (std::size_t i = 0; i < v.size(); ++i) seen->push_back(&slots[i]);
+    rt.write(*out, sum(v));
+  }
+  bool affected(std::size_t, const int& before, const int& after) const { return before != after; }
+  const Mod<int>* follow(std::size_t i, const int& seen_value, const int&, const Engine::At& at) const {
+    *moved_from = &kept[i];
+    for (Mod<int>& m : pool)
+      if (const int* v = at.value(m); v && *v == seen_value) return &m;
+    return nullptr;
+  }
+};
+
+TEST(ReadManySlots, TheBodySeesItsModifiablesAndAFollowedSlotsNewOne) {
+  Mod<int> out;
+  std::array<Mod<int>, 3> pool;
+  Engine rt;
+  rt.set(pool[0], 1);
+  rt.set(pool[1], 2);
+  rt.set(pool[2], 1);
+  std::vector<const Mod<int>*> seen;
+  const Mod<int>* moved_from = nullptr;
+  rt.run([&](Engine& rt2) {
+    rt2.read_many({&pool[0], &pool[1]}, SlotsSum{&out, std::span<Mod<int>>(pool).last(1), &seen, &moved_from, {}});
+  });
+  EXPECT_EQ(seen, (std::vector<const Mod<int>*>{&pool[0], &pool[1]}));
+  // pool[0] becomes 5: slot 0, as the kept view names it, moves to pool[2], which holds 1.
+  rt.set(pool[0], 5);
+  rt.propagate();
+  EXPECT_EQ(moved_from, &pool[0]);
+  EXPECT_EQ(rt.stats().reads_followed, 1u);
+  // pool[2] becomes 7: the read re-runs, and its slots name pool[2] and pool[1].
+  rt.set(pool[2], 7);
+  rt.propagate();
+  EXPECT_EQ(moved_from, &pool[2]);  // asked first: 7 is held by no member
+  EXPECT_EQ(seen, (std::vector<const Mod<int>*>{&pool[2], &pool[1]}));
+  EXPECT_EQ(out.get(), 72);  // sum() writes the values as digits
   rt.check_invariants();
 }
 

@@ -35,6 +35,7 @@
 #include <deque>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <vector>
 
@@ -148,6 +149,11 @@ class CellDirectory {
   CellDirectory(const CellDirectory&) = delete;
   CellDirectory& operator=(const CellDirectory&) = delete;
 
+  /// The node whose state is m (a read's slot names its cell by its state).
+  static CellNode* node_of(const sac::Mod<CellState>& m) noexcept {
+    static_assert(std::is_standard_layout_v<CellNode>);
+    return reinterpret_cast<CellNode*>(reinterpret_cast<std::uintptr_t>(&m) - offsetof(CellNode, state));
+  }
   /// The cell's node, made (with the default value) if new. Mutator or computation.
   CellNode* node(sac::Engine& rt, const CellKey& k) {
     const std::uint64_t h = k.hash();

@@ -55,6 +55,7 @@
 
 #include <sac/engine.hpp>
 #include <sac/mod.hpp>
+#include <sac/read_slots.hpp>
 
 #include "dynmesh/errors.hpp"
 #include "hpu/cell_interest.hpp"
@@ -65,31 +66,32 @@ namespace dynmesh::detail {
 
 inline constexpr std::size_t kCellsPerRead = 16;  // Engine::read_many's most
 
-/// The part of a round's closure that later rounds look through: the round before, and how
-/// many cells this one read (the cells follow it in CellRound).
+/// The part of a round's closure that later rounds look through: the round before, how many
+/// cells this one read, and its read's modifiables (the cells' states), which the round
+/// learns when it first runs: the cells are not copied into the closure.
 struct CellRoundHead {
   const CellRoundHead* parent;
   std::uint16_t n;    // cells read
   std::uint16_t cap;  // N
   std::uint32_t serial;  // a first round: its step's first run, which issued it (S3)
+  mutable sac::ReadSlots<CellState> slots;  // the read's own record; follow() moves a slot
+  CellNode* cell(std::size_t i) const { return CellDirectory::node_of(slots[i]); }
 };
 
-/// A round's cells, and what the step used of each (the read's own state: the step's last
-/// run that did not fail wrote it, CellView::done(); the read asks it on every change).
+/// A round's head, and what the step used of each cell (the read's own state: the step's
+/// last run that did not fail wrote it, CellView::done(); the read asks it on every change).
 template <std::size_t N>
 struct CellRoundCells {
   CellRoundHead head;
-  mutable std::array<CellNode*, N> cells;  // follow() may move a read to another cell
   mutable std::array<CellInterest, N> used;
 };
 
-// Every CellRound<Step, N> starts with a CellRoundCells<N> (standard layout), whose cells
-// follow the head at the same offset for every N, and whose `used` follows the N cells. Both
-// arrays are mutable members, so a const round hands out writable cells.
-inline CellNode** cells_of(const CellRoundHead* h) {
-  return reinterpret_cast<const CellRoundCells<1>*>(h)->cells.data();
+// Every CellRound<Step, N> starts with a CellRoundCells<N> (standard layout), whose `used`
+// follows the head at the same offset for every N. It is a mutable member, so a const round
+// hands out writable interests.
+inline CellInterest* used_of(const CellRoundHead* h) {
+  return reinterpret_cast<const CellRoundCells<1>*>(h)->used.data();
 }
-inline CellInterest* used_of(const CellRoundHead* h) { return reinterpret_cast<CellInterest*>(cells_of(h) + h->cap); }
 
 template <class Step>
 void issue_round(sac::Engine& rt, const Step& step, const CellRoundHead* parent, std::uint32_t serial,
@@ -103,15 +105,18 @@ struct CellRound {
   CellRoundCells<N> c;
   Step step;
 
-  void operator()(sac::Engine& rt, std::span<const CellState* const> vals) const {
+  void operator()(sac::Engine& rt, std::span<const CellState* const> vals, sac::ReadSlots<CellState> slots) const {
+    c.head.slots = slots;
     CellView& v = *step.view(rt);
     const bool kept = v.begin_run(c.head.parent, c.head.serial);  // S4a kept, or S4b rebuilt
-    for (std::uint32_t i = 0; i < c.head.n; ++i) v.add(c.cells[i], vals[i], &c.used[i]);
+    for (std::uint32_t i = 0; i < c.head.n; ++i) v.add(c.head.cell(i), vals[i], &c.used[i]);
     if (!kept)
       for (const CellRoundHead* outer = c.head.parent; outer; outer = outer->parent) {
-        CellNode* const* cells = cells_of(outer);
         CellInterest* used = used_of(outer);
-        for (std::uint32_t i = 0; i < outer->n; ++i) v.add(cells[i], &rt.current(cells[i]->state), &used[i]);
+        for (std::uint32_t i = 0; i < outer->n; ++i) {
+          CellNode* cell = outer->cell(i);
+          v.add(cell, &rt.current(cell->state), &used[i]);
+        }
       }
     v.settle();
     if (!step.run(rt, v)) {  // S2 failed: S3
@@ -121,7 +126,7 @@ struct CellRound {
   }
 
   bool affected(const sac::Engine& rt, std::size_t i, const CellState& before, const CellState& after) const {
-    return interest_changed(step.box(rt), c.cells[i]->key, c.used[i], before, after);
+    return interest_changed(step.box(rt), c.head.cell(i)->key, c.used[i], before, after);
   }
 
   /// S6: a leaf that split or merged away: its read moves to the cell that holds what the
@@ -129,11 +134,10 @@ struct CellRound {
   const sac::Mod<CellState>* follow(std::size_t i, const CellState& seen, const CellState& now,
                                     const sac::Engine::At& at) const {
     CellInterest in = c.used[i];
-    CellNode* d = follow_cell(step.box(at.engine()), step.dir(at.engine()), c.cells[i], &in, seen, now,
+    CellNode* d = follow_cell(step.box(at.engine()), step.dir(at.engine()), c.head.cell(i), &in, seen, now,
                               [&](const CellNode* node) { return at.value(node->state); });
     if (!d) return nullptr;
-    c.cells[i] = d;
-    c.used[i] = in;
+    c.used[i] = in;  // the runtime moves slot i to d's state
     return &d->state;
   }
 };
@@ -142,15 +146,11 @@ template <class Step, std::size_t N>
 void issue_round_n(sac::Engine& rt, const Step& step, const CellRoundHead* parent, std::uint32_t serial,
                    std::span<CellNode* const> misses) {
   static_assert(std::is_standard_layout_v<CellRoundCells<N>>);
-  static_assert(offsetof(CellRoundCells<N>, cells) == offsetof(CellRoundCells<1>, cells));
-  static_assert(offsetof(CellRoundCells<N>, used) == offsetof(CellRoundCells<N>, cells) + N * sizeof(CellNode*));
+  static_assert(offsetof(CellRoundCells<N>, used) == offsetof(CellRoundCells<1>, used));
   CellRound<Step, N> round{
-      {{parent, static_cast<std::uint16_t>(misses.size()), static_cast<std::uint16_t>(N), serial}, {}, {}}, step};
+      {{parent, static_cast<std::uint16_t>(misses.size()), static_cast<std::uint16_t>(N), serial, {}}, {}}, step};
   std::array<const sac::Mod<CellState>*, N> mods;
-  for (std::size_t i = 0; i < misses.size(); ++i) {
-    round.c.cells[i] = misses[i];
-    mods[i] = &misses[i]->state;
-  }
+  for (std::size_t i = 0; i < misses.size(); ++i) mods[i] = &misses[i]->state;
   rt.read_many(std::span<const sac::Mod<CellState>* const>(mods.data(), misses.size()), std::move(round));
 }
 

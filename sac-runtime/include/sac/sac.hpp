@@ -12,4 +12,5 @@
 #include "sac/hash.hpp"
 #include "sac/memory_breakdown.hpp"
 #include "sac/mod.hpp"
+#include "sac/read_slots.hpp"
 #include "sac/stats.hpp"

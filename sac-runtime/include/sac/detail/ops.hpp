@@ -21,6 +21,7 @@
 #include "sac/detail/order_list.hpp"
 #include "sac/detail/trace_nodes.hpp"
 #include "sac/hash.hpp"
+#include "sac/read_slots.hpp"
 
 namespace sac::detail {
 
@@ -138,7 +139,8 @@ concept FollowingRead = requires(const F& f, std::size_t i, const T& a, const T&
 };
 
 /// A multi-read of k modifiables of type T with closure F (ReadManyHeader): the body gets
-/// (Engine&,) std::span<const T* const> of the k values, in the order of the modifiables.
+/// (Engine&,) std::span<const T* const> of the k values, in the order of the modifiables,
+/// and, when it takes them, the modifiables (ReadSlots<T>).
 template <class T, class F>
 struct ReadManyOpsFor {
   static F* closure(ReadNode* r) {
@@ -151,8 +153,12 @@ struct ReadManyOpsFor {
     for (std::uint32_t i = 0; i < k; ++i) vals[i] = &static_cast<const Version<T>*>(vs[i])->value;
     const std::span<const T* const> span(vals, k);
     F& f = *closure(r);
-    if constexpr (std::is_invocable_v<F&, Engine&, std::span<const T* const>>) f(rt, span);
-    else f(span);
+    if constexpr (std::is_invocable_v<F&, Engine&, std::span<const T* const>, ReadSlots<T>>)
+      f(rt, span, ReadSlots<T>(many_of(r)->slots()));
+    else if constexpr (std::is_invocable_v<F&, Engine&, std::span<const T* const>>)
+      f(rt, span);
+    else
+      f(span);
   }
   static void destroy(ReadNode* r) noexcept {
     closure(r)->~F();
