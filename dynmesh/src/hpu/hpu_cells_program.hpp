@@ -243,7 +243,6 @@ struct HpuCellsProgram {
   CellDecision<HV> decision;
   CellNode* at_node = nullptr;
   const CellState* at_state = nullptr;
-  std::vector<Triangle> block;
 
   const Box<2>& box() const noexcept { return dir->box(); }
   /// The distance scale of class j.
@@ -765,16 +764,13 @@ struct HpuCellsProgram {
     HV a;
     bool run(sac::Engine& rt, CellView& v) const {
       HpuCellsProgram* const program = ctx(rt);
-      if (!v.kept()) {
-        program->block.clear();
-        // The view's nearest search starts at a's leaf and ignores the scale, so the step
-        // is a function of a alone, whichever leaf holds it.
-        program->questions.triangles_of(a, 0.0, program->tris);
-        for (const auto& [b, c] : program->tris) program->block.push_back(canonical_triangle(a->p, b->p, c->p));
-      }
+      // The view's nearest search starts at a's leaf and ignores the scale, so the step is a
+      // function of a alone, whichever leaf holds it.
+      if (!v.kept()) program->questions.triangles_of(a, 0.0, program->tris);
       if (!v.done()) return false;
       ++program->steps.done[HcStepCounts::Final];
-      if (!program->block.empty()) rt.make<HpuTriBlock>(program->feed, std::span<const Triangle>(program->block));
+      // (a, b, c) counter-clockwise with a the (x, y)-smallest: canonical as it is.
+      program->feed->make(rt, a, std::span<const HpuCorners>(program->tris));
       return true;
     }
   };

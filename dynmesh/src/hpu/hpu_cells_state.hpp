@@ -61,7 +61,7 @@ struct HpuCellsState {
   }
 
   std::size_t bytes() const noexcept {
-    return inputs.bytes() + feed.bytes() + cells.bytes() + input_cells.bytes() + steiner.bytes();
+    return inputs.bytes() + cells.bytes() + input_cells.bytes() + steiner.bytes();
   }
   void check_invariants(std::span<const Point<2>> present) const {
     feed.check_invariants();

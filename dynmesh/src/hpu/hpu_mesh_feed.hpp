@@ -7,45 +7,74 @@
 // blocks of the steps it re-runs or discards and makes new ones, so the feed falls out of
 // the trace: each block's birth logs +1 per triangle and its destruction −1, and the net
 // count of a triangle over an update is its change (a block re-made unchanged nets 0).
+// A block holds its vertex and, per triangle, the other two corners' vertices, inline: 16
+// bytes a triangle where its points would take 48, and no allocation of its own. The
+// vertices outlive it: a vertex leaves the mesh only when the cells that held it change,
+// which re-runs the steps that read them and so destroys their blocks in the same
+// propagation, and its object is freed only after that propagation (HpuCellsState::release).
 // Invariants (check_invariants): every live block is on the live list once; the live count
-// is the sum of the live blocks' sizes; after an update every triangle nets −1, 0 or +1.
-// Complexity: O(t) per block made or destroyed; take_change O(e log e) for e logged. A
-// block's triangles come from the feed's pool (std::pmr::unsynchronized_pool_resource), not
-// from a heap allocation per block.
+// is the sum of the live blocks' sizes; a block's corners are (x, y)-greater than its vertex
+// (it is their canonical first corner); after an update every triangle nets −1, 0 or +1.
+// Complexity: O(t) per block made or destroyed; take_change O(e log e) for e logged.
 // Paper: Acar & Hudson, Section 4 (the output as the trace's allocations).
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
-#include <memory_resource>
+#include <cstdint>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#include <sac/engine.hpp>
+
 #include "dynmesh/errors.hpp"
 #include "dynmesh/mesh.hpp"
+#include "hpu/cell_store.hpp"
 
 namespace dynmesh::detail {
 
 class HpuMeshFeed;
 
-/// One leaf's triangles (canonical). Made with Engine::make, so its lifetime is the step's.
-class HpuTriBlock {
- public:
-  HpuTriBlock(HpuMeshFeed* feed, std::span<const Triangle> tris);
-  ~HpuTriBlock();
-  HpuTriBlock(const HpuTriBlock&) = delete;
-  HpuTriBlock& operator=(const HpuTriBlock&) = delete;
-  std::span<const Triangle> triangles() const noexcept { return tris_; }
+/// A block's other two corners of one triangle: (vertex, b, c) counter-clockwise.
+using HpuCorners = std::array<const CellVertex*, 2>;
 
- private:
-  friend class HpuMeshFeed;
-  HpuMeshFeed* feed_;
-  std::pmr::vector<Triangle> tris_;  // from the feed's pool
-  HpuTriBlock* prev_ = nullptr;
-  HpuTriBlock* next_ = nullptr;
+/// What every block starts with; its triangles follow it (HpuTriBlockOf<K>).
+struct HpuTriBlockHead {
+  HpuMeshFeed* feed;
+  const CellVertex* vertex;  // every triangle's first corner
+  HpuTriBlockHead* prev;
+  HpuTriBlockHead* next;
+  std::uint32_t n;  // triangles
+  std::span<const HpuCorners> corners() const noexcept;
+  Triangle triangle(std::size_t i) const noexcept {
+    const HpuCorners& c = corners()[i];
+    return Triangle{{vertex->p, c[0]->p, c[1]->p}};
+  }
 };
+
+/// A block of up to K triangles. Made with Engine::make, so its lifetime is the step's.
+template <std::size_t K>
+struct HpuTriBlockOf {
+  HpuTriBlockOf(HpuMeshFeed* feed, const CellVertex* v, std::span<const HpuCorners> tris);
+  ~HpuTriBlockOf();
+  HpuTriBlockOf(const HpuTriBlockOf&) = delete;
+  HpuTriBlockOf& operator=(const HpuTriBlockOf&) = delete;
+  HpuTriBlockHead head;
+  std::array<HpuCorners, K> tris;
+};
+
+inline std::span<const HpuCorners> HpuTriBlockHead::corners() const noexcept {
+  // Every HpuTriBlockOf<K> is standard layout with its array at the same offset.
+  const char* base = reinterpret_cast<const char*>(this) + offsetof(HpuTriBlockOf<1>, tris);
+  return {reinterpret_cast<const HpuCorners*>(base), n};
+}
+
+/// The block capacities: at most a third more room than triangles.
+inline constexpr std::size_t kBlockClasses[] = {1, 2, 3, 4, 6, 8, 12, 16};
 
 class HpuMeshFeed {
  public:
@@ -53,11 +82,22 @@ class HpuMeshFeed {
   HpuMeshFeed(const HpuMeshFeed&) = delete;
   HpuMeshFeed& operator=(const HpuMeshFeed&) = delete;
 
+  /// Makes the blocks of vertex v's triangles (v, b, c), in the running step (blocks of up to
+  /// 16; a vertex has fewer in a quality mesh).
+  void make(sac::Engine& rt, const CellVertex* v, std::span<const HpuCorners> tris) {
+    while (!tris.empty()) {
+      const std::span<const HpuCorners> part = tris.first(std::min<std::size_t>(tris.size(), 16));
+      make_of(rt, v, part);
+      tris = tris.subspan(part.size());
+    }
+  }
+
   /// The live triangles, canonical and sorted. O(t log t).
   std::vector<Triangle> triangles() const {
     std::vector<Triangle> out;
     out.reserve(live_);
-    for (const HpuTriBlock* b = head_; b; b = b->next_) out.insert(out.end(), b->tris_.begin(), b->tris_.end());
+    for (const HpuTriBlockHead* b = head_; b; b = b->next)
+      for (std::size_t i = 0; i < b->n; ++i) out.push_back(b->triangle(i));
     std::sort(out.begin(), out.end());
     return out;
   }
@@ -69,8 +109,6 @@ class HpuMeshFeed {
   /// against about 130. O(t log t).
   Mesh mesh() const;
   std::size_t live_count() const noexcept { return live_; }
-  /// Bytes held by the live blocks outside the trace records (their triangle arrays).
-  std::size_t bytes() const noexcept { return live_ * sizeof(Triangle); }
 
   /// The change since the last call: removed and added triangles, each sorted.
   MeshChange take_change() {
@@ -101,9 +139,12 @@ class HpuMeshFeed {
   /// Throws InvariantError naming the first broken rule (see the header).
   void check_invariants() const {
     std::size_t n = 0, k = 0;
-    for (const HpuTriBlock* b = head_; b; b = b->next_) {
-      if (b->next_ && b->next_->prev_ != b) throw InvariantError("dynmesh: HpuMeshFeed: a broken live list");
-      n += b->tris_.size();
+    for (const HpuTriBlockHead* b = head_; b; b = b->next) {
+      if (b->next && b->next->prev != b) throw InvariantError("dynmesh: HpuMeshFeed: a broken live list");
+      for (const HpuCorners& c : b->corners())
+        if (!xy_less(b->vertex->p, c[0]->p) || !xy_less(b->vertex->p, c[1]->p))
+          throw InvariantError("dynmesh: HpuMeshFeed: a block's triangle does not start at its vertex");
+      n += b->n;
       ++k;
     }
     if (n != live_ || k != blocks_)
@@ -112,58 +153,77 @@ class HpuMeshFeed {
   }
 
  private:
-  friend class HpuTriBlock;
-  void born(HpuTriBlock* b) {
-    b->next_ = head_;
-    if (head_) head_->prev_ = b;
+  template <std::size_t K>
+  friend struct HpuTriBlockOf;
+
+  template <std::size_t I = 0>
+  void make_of(sac::Engine& rt, const CellVertex* v, std::span<const HpuCorners> tris) {
+    constexpr std::size_t K = kBlockClasses[I];
+    if constexpr (I + 1 < std::size(kBlockClasses)) {
+      if (tris.size() > K) return make_of<I + 1>(rt, v, tris);
+    }
+    static_assert(std::is_standard_layout_v<HpuTriBlockOf<K>>);
+    static_assert(offsetof(HpuTriBlockOf<K>, tris) == offsetof(HpuTriBlockOf<1>, tris));
+    rt.make<HpuTriBlockOf<K>>(this, v, tris);
+  }
+
+  void born(HpuTriBlockHead* b) {
+    b->next = head_;
+    if (head_) head_->prev = b;
     head_ = b;
-    live_ += b->tris_.size();
+    live_ += b->n;
     ++blocks_;
     if (!logging_) return;
-    for (const Triangle& t : b->tris_) events_.emplace_back(t, +1);
+    for (std::size_t i = 0; i < b->n; ++i) events_.emplace_back(b->triangle(i), +1);
   }
-  void died(HpuTriBlock* b) noexcept {
-    if (b->prev_) b->prev_->next_ = b->next_;
-    else head_ = b->next_;
-    if (b->next_) b->next_->prev_ = b->prev_;
-    live_ -= b->tris_.size();
+  void died(HpuTriBlockHead* b) noexcept {
+    if (b->prev) b->prev->next = b->next;
+    else head_ = b->next;
+    if (b->next) b->next->prev = b->prev;
+    live_ -= b->n;
     --blocks_;
     if (closing_ || !logging_) return;
     try {
-      for (const Triangle& t : b->tris_) events_.emplace_back(t, -1);
+      for (std::size_t i = 0; i < b->n; ++i) events_.emplace_back(b->triangle(i), -1);
     } catch (...) {
       // Out of memory while logging (a destructor must not throw): this update's feed
       // loses these removals; the live list, and so triangles(), stays right.
     }
   }
 
-  // The live blocks' triangle arrays come from it: the blocks die with the engine's trace,
-  // so the feed must outlive the engine (its owner declares it, in HpuCellsState, before
-  // the engine).
-  std::pmr::unsynchronized_pool_resource pool_;
-  HpuTriBlock* head_ = nullptr;
+  HpuTriBlockHead* head_ = nullptr;
   std::size_t live_ = 0, blocks_ = 0;
   bool closing_ = false;
   bool logging_ = true;
   std::vector<std::pair<Triangle, int>> events_;
 };
 
+template <std::size_t K>
+HpuTriBlockOf<K>::HpuTriBlockOf(HpuMeshFeed* feed, const CellVertex* v, std::span<const HpuCorners> t)
+    : head{feed, v, nullptr, nullptr, static_cast<std::uint32_t>(t.size())} {
+  std::copy(t.begin(), t.end(), tris.begin());
+  feed->born(&head);
+}
+template <std::size_t K>
+HpuTriBlockOf<K>::~HpuTriBlockOf() {
+  head.feed->died(&head);
+}
+
 inline Mesh HpuMeshFeed::mesh() const {
   const auto same = [](const Point<2>& a, const Point<2>& b) { return !xy_less(a, b) && !xy_less(b, a); };
   Mesh out;
-  std::vector<const HpuTriBlock*> blocks;
+  std::vector<const HpuTriBlockHead*> blocks;
   blocks.reserve(blocks_);
   {
     std::vector<Point<2>> corners;
     corners.reserve(2 * live_ + blocks_);
-    for (const HpuTriBlock* b = head_; b; b = b->next_) {
-      if (b->tris_.empty()) continue;
+    for (const HpuTriBlockHead* b = head_; b; b = b->next) {
+      if (b->n == 0) continue;
       blocks.push_back(b);
-      const Point<2>* first = nullptr;
-      for (const Triangle& t : b->tris_) {
-        if (!first || !same(*first, t.v[0])) corners.push_back(*(first = &t.v[0]));
-        corners.push_back(t.v[1]);
-        corners.push_back(t.v[2]);
+      corners.push_back(b->vertex->p);
+      for (const HpuCorners& c : b->corners()) {
+        corners.push_back(c[0]->p);
+        corners.push_back(c[1]->p);
       }
     }
     std::sort(corners.begin(), corners.end(), xy_less);
@@ -184,27 +244,25 @@ inline Mesh HpuMeshFeed::mesh() const {
     if (it == v.end() || !same(*it, p)) throw InvariantError("dynmesh: HpuMeshFeed: a corner is not a vertex");
     return static_cast<std::uint32_t>(it - v.begin());
   };
-  std::sort(blocks.begin(), blocks.end(),
-            [](const HpuTriBlock* a, const HpuTriBlock* b) { return xy_less(a->tris_[0].v[0], b->tris_[0].v[0]); });
+  std::sort(blocks.begin(), blocks.end(), [](const HpuTriBlockHead* a, const HpuTriBlockHead* b) {
+    return xy_less(a->vertex->p, b->vertex->p);
+  });
   out.triangles.reserve(live_);
   std::uint32_t last = 0;
-  for (const HpuTriBlock* b : blocks)
-    for (const Triangle& t : b->tris_) {
-      if (xy_less(t.v[1], t.v[0]) || xy_less(t.v[2], t.v[0]))
+  for (const HpuTriBlockHead* b : blocks) {
+    // Blocks in order of their vertices, so the first corner's index only grows (a vertex
+    // split over two blocks comes twice).
+    const Point<2>& p = b->vertex->p;
+    const std::uint32_t i0 = xy_less(p, v[last]) ? find_from(0, p) : find_from(last, p);
+    last = i0;
+    for (const HpuCorners& c : b->corners()) {
+      if (!xy_less(p, c[0]->p) || !xy_less(p, c[1]->p))
         throw InvariantError("dynmesh: HpuMeshFeed: a triangle that is not canonical");
-      // Blocks in order of their first corners, so the first corner's index only grows.
-      const std::uint32_t i0 = xy_less(t.v[0], v[last]) ? find_from(0, t.v[0]) : find_from(last, t.v[0]);
-      last = i0;
-      out.triangles.push_back({i0, find_from(i0, t.v[1]), find_from(i0, t.v[2])});
+      out.triangles.push_back({i0, find_from(i0, c[0]->p), find_from(i0, c[1]->p)});
     }
+  }
   std::sort(out.triangles.begin(), out.triangles.end());
   return out;
 }
-
-inline HpuTriBlock::HpuTriBlock(HpuMeshFeed* feed, std::span<const Triangle> tris)
-    : feed_(feed), tris_(tris.begin(), tris.end(), &feed->pool_) {
-  feed_->born(this);
-}
-inline HpuTriBlock::~HpuTriBlock() { feed_->died(this); }
 
 }  // namespace dynmesh::detail
