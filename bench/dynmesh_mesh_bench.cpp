@@ -27,13 +27,15 @@
 // for sizes whose sorted tetrahedra do not fit in memory (uniform 10^5 in 3D: about 14 GB,
 // twice that while the list grows): static_s, overhead, speedup, vertices_per_point,
 // verified and the final angles are then nan, and cells_per_point is the self-adjusting
-// mesh's count.
+// mesh's count. --breakdown prints, after each row, the engine's trace by record kind
+// (sac::MemoryBreakdown) after the build.
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -71,6 +73,7 @@ struct Row {
   // 3D only: the final mesh's dihedral angles, and the peer's figures (nan without one).
   double min_dihedral = kNan, max_dihedral = kNan;
   double peer_s = kNan, peer_cells_pp = kNan, peer_min_dihedral = kNan, peer_max_dihedral = kNan;
+  std::string breakdown;  // --breakdown: printed after the row
 };
 
 /// What the bench needs of one dimension's meshes: the self-adjusting mesh and the number of
@@ -163,7 +166,8 @@ void measure_peer(const std::string& tetgen, const Box<3>& box, const std::vecto
 /// final mesh's angles are nan, and the cells per point are the self-adjusting mesh's count.
 template <int d>
 Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std::uint64_t seed,
-            const MeshOptions& options, std::size_t tail, const std::string& tetgen, bool with_twin) {
+            const MeshOptions& options, std::size_t tail, const std::string& tetgen, bool with_twin,
+            bool breakdown) {
   using M = Meshes<d>;
   Row row;
   row.dist = std::string(distribution_name(dist));
@@ -198,6 +202,11 @@ Row measure(Distribution dist, std::size_t n, std::size_t updates, int reps, std
   }
   row.scratch_s = median(sc);
   row.bytes_pp = static_cast<double>(mesh->trace_bytes()) / static_cast<double>(n);
+  if (breakdown) {
+    std::ostringstream os;
+    os << mesh->memory_breakdown();
+    row.breakdown = os.str();
+  }
   if (!with_twin) row.cells_pp = static_cast<double>(M::num_cells(*mesh)) / static_cast<double>(n);
 
   Rng rng(seed ^ 0x5eed);
@@ -318,6 +327,7 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   bool csv = false;
   bool no_twin = false;
+  bool breakdown = false;
   std::string postprocess;
   std::string peer;
   double min_angle = kHpuDefaultMinAngle;
@@ -334,6 +344,7 @@ int main(int argc, char** argv) {
   app.add_option("--reps", reps, "timed from-scratch builds (median)")->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "seed");
   app.add_flag("--csv", csv, "CSV output");
+  app.add_flag("--breakdown", breakdown, "after each row, the engine's trace by record kind after the build");
   app.add_flag("--no-twin", no_twin,
                "never build the static twin (no static_s, vertices, verified, final angles): for sizes whose "
                "twin does not fit in memory: in 3D its tetrahedra take 96 bytes each, about 140 MB per 1,000 "
@@ -365,9 +376,10 @@ int main(int argc, char** argv) {
   const MeshOptions options{.postprocess = postprocess == "hpu" ? Postprocess::Hpu : Postprocess::Quadtree,
                             .min_angle = min_angle};
   for (std::size_t n : sizes) {
-    const Row r = dim == 3 ? measure<3>(*dist, n, updates, reps, seed, options, tail, tetgen, !no_twin)
-                           : measure<2>(*dist, n, updates, reps, seed, options, tail, tetgen, !no_twin);
+    const Row r = dim == 3 ? measure<3>(*dist, n, updates, reps, seed, options, tail, tetgen, !no_twin, breakdown)
+                           : measure<2>(*dist, n, updates, reps, seed, options, tail, tetgen, !no_twin, breakdown);
     print_row(r, csv, dim);
+    std::fputs(r.breakdown.c_str(), stdout);
     if (r.verified == 0) return 1;
   }
   return 0;

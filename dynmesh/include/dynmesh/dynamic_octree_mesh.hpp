@@ -29,6 +29,7 @@
 #include <utility>
 #include <vector>
 
+#include <sac/memory_breakdown.hpp>
 #include <sac/stats.hpp>
 
 #include "dynmesh/box.hpp"
@@ -82,6 +83,9 @@ class DynamicOctreeMesh {
   /// change feed; not the input's validation).
   const UpdateStats& last_update() const noexcept;
   const sac::Stats& engine_stats() const noexcept;
+  /// The engine's trace by record kind (bench --breakdown); the rest of trace_bytes() is the
+  /// program's state outside the trace.
+  sac::MemoryBreakdown memory_breakdown() const;
   std::size_t trace_bytes() const;
   std::size_t record_bytes() const;
   std::uint64_t live_events() const;

@@ -353,6 +353,7 @@ std::vector<Leaf<2>> DynamicMesh::refined_leaves() const { return s_->refined_le
 
 const UpdateStats& DynamicMesh::last_update() const noexcept { return s_->last_update(); }
 const sac::Stats& DynamicMesh::engine_stats() const noexcept { return s_->engine().stats(); }
+sac::MemoryBreakdown DynamicMesh::memory_breakdown() const { return s_->engine().memory_breakdown(); }
 std::size_t DynamicMesh::trace_bytes() const { return s_->trace_bytes(); }
 std::size_t DynamicMesh::record_bytes() const { return s_->engine().record_bytes(); }
 std::uint64_t DynamicMesh::live_events() const { return s_->engine().live_events(); }

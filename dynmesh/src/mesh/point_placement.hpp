@@ -28,6 +28,7 @@
 #include <sac/fn.hpp>
 
 #include "dynmesh/cell.hpp"
+#include "dynmesh/detail/cell_table.hpp"
 #include "quadtree/quadtree_refine.hpp"
 
 namespace dynmesh::detail {
@@ -50,18 +51,21 @@ struct PointPlacement {
     });
   }
 
+  // The closures hold their cell packed (8·d bytes, not 8·d + 8): T' makes one split or mark
+  // read for each of its cells.
   static void split(sac::Engine& rt, Program* program, const CellId<d>& c) {
-    rt.read(program->slot(rt, c).split, [program, c](sac::Engine& rt2, std::uint8_t v) {
+    rt.read(program->slot(rt, c).split, [program, k = pack_cell<d>(c)](sac::Engine& rt2, std::uint8_t v) {
       if (any_split(v)) return;
-      rt2.write(program->slot(rt2, c).split, kRefineSplit);
-      if (c.level > 0) for_each_coarser_touching(c, [&](const CellId<d>& u) { split(rt2, program, u); });
+      const CellId<d> cell = unpack_cell<d>(k);
+      rt2.write(program->slot(rt2, cell).split, kRefineSplit);
+      if (cell.level > 0) for_each_coarser_touching(cell, [&](const CellId<d>& u) { split(rt2, program, u); });
     });
   }
 
   static void mark(sac::Engine& rt, Program* program, const CellId<d>& c, std::uint8_t value) {
-    rt.read(program->slot(rt, c).split, [program, c, value](sac::Engine& rt2, std::uint8_t v) {
+    rt.read(program->slot(rt, c).split, [program, k = pack_cell<d>(c), value](sac::Engine& rt2, std::uint8_t v) {
       // A split value here would break the closure's rule; the checkers report it.
-      if (!any_split(v)) rt2.write(program->slot(rt2, c).split, value);
+      if (!any_split(v)) rt2.write(program->slot(rt2, unpack_cell<d>(k)).split, value);
     });
   }
 };

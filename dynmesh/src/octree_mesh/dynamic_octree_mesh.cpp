@@ -186,6 +186,7 @@ std::vector<Leaf<3>> DynamicOctreeMesh::refined_leaves() const {
 
 const UpdateStats& DynamicOctreeMesh::last_update() const noexcept { return s_->core.last; }
 const sac::Stats& DynamicOctreeMesh::engine_stats() const noexcept { return s_->core.rt.stats(); }
+sac::MemoryBreakdown DynamicOctreeMesh::memory_breakdown() const { return s_->core.rt.memory_breakdown(); }
 std::size_t DynamicOctreeMesh::trace_bytes() const {
   return s_->core.bytes() + s_->counts.size() * (sizeof(CellId<3>) + 2 * sizeof(void*) + sizeof(std::int64_t));
 }

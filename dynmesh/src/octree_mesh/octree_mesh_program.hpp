@@ -175,12 +175,14 @@ struct OctreeMeshProgram {
   static void gather(sac::Engine& rt, OctreeMeshProgram* program, CellId<3> c) {
     std::array<const sac::Mod<std::uint8_t>*, 8> kids;
     for (unsigned w = 0; w < 8; ++w) kids[w] = &program->slot(rt, child(c, w)).split;
-    rt.read_many(std::span<const sac::Mod<std::uint8_t>* const>(kids), [program, c](sac::Engine& rt2, std::span<const std::uint8_t* const> v) {
+    // The closures hold their cell packed (24 bytes, not 32): a split cell of T' makes two.
+    rt.read_many(std::span<const sac::Mod<std::uint8_t>* const>(kids), [program, k = pack_cell<3>(c)](sac::Engine& rt2, std::span<const std::uint8_t* const> v) {
+      const CellId<3> cell = unpack_cell<3>(k);
       std::uint64_t word = 0;
       for (unsigned w = 0; w < 8; ++w) word |= std::uint64_t{*v[w]} << (8 * w);
-      rt2.write(program->slot(rt2, c).kids, word);
+      rt2.write(program->slot(rt2, cell).kids, word);
       for (unsigned w = 0; w < 8; ++w)
-        if (any_split(*v[w])) rt2.memo(sac::fn<&gather>(program, child(c, w)));
+        if (any_split(*v[w])) rt2.memo(sac::fn<&gather>(program, child(cell, w)));
     });
   }
 
@@ -198,13 +200,14 @@ struct OctreeMeshProgram {
   }
 
   static void emit(sac::Engine& rt, OctreeMeshProgram* program, CellId<3> c) {
-    rt.read(program->slot(rt, c).kids, [program, c](sac::Engine& rt2, std::uint64_t own) {
+    rt.read(program->slot(rt, c).kids, [program, k = pack_cell<3>(c)](sac::Engine& rt2, std::uint64_t own) {
+      const CellId<3> cell = unpack_cell<3>(k);
       bool leaves = false;
       for (unsigned w = 0; w < 8; ++w) {
-        if (any_split(kid(own, w))) rt2.memo(sac::fn<&emit>(program, child(c, w)));
+        if (any_split(kid(own, w))) rt2.memo(sac::fn<&emit>(program, child(cell, w)));
         else leaves = true;
       }
-      if (leaves) group(rt2, program, c, own);
+      if (leaves) group(rt2, program, cell, own);
     });
   }
 
@@ -240,13 +243,15 @@ struct OctreeMeshProgram {
     if (nb.n == 0) return finish(rt, program, c, own, nb);  // the root has no neighbours
     const unsigned first = (nb.n + 1) / 2;
     rt.read_many(std::span<const Kids* const>(nb.mods.data(), first),
-                 [program, c, own](sac::Engine& rt2, std::span<const std::uint64_t* const>) {
-                   const Near all = near_of(rt2, program, c, has_owner(own));
+                 [program, k = pack_cell<3>(c), own](sac::Engine& rt2, std::span<const std::uint64_t* const>) {
+                   const CellId<3> cell = unpack_cell<3>(k);
+                   const Near all = near_of(rt2, program, cell, has_owner(own));
                    const unsigned half = (all.n + 1) / 2;
-                   if (all.n == half) return finish(rt2, program, c, own, all);
+                   if (all.n == half) return finish(rt2, program, cell, own, all);
                    rt2.read_many(std::span<const Kids* const>(all.mods.data() + half, all.n - half),
-                                 [program, c, own](sac::Engine& rt3, std::span<const std::uint64_t* const>) {
-                                   finish(rt3, program, c, own, near_of(rt3, program, c, has_owner(own)));
+                                 [program, k, own](sac::Engine& rt3, std::span<const std::uint64_t* const>) {
+                                   const CellId<3> at = unpack_cell<3>(k);
+                                   finish(rt3, program, at, own, near_of(rt3, program, at, has_owner(own)));
                                  });
                  });
   }
