@@ -71,8 +71,7 @@ inline constexpr std::size_t kCellsPerRead = 16;  // Engine::read_many's most
 /// learns when it first runs: the cells are not copied into the closure.
 struct CellRoundHead {
   const CellRoundHead* parent;
-  std::uint16_t n;    // cells read
-  std::uint16_t cap;  // N
+  std::uint32_t n;       // cells read
   std::uint32_t serial;  // a first round: its step's first run, which issued it (S3)
   mutable sac::ReadSlots<CellState> slots;  // the read's own record; follow() moves a slot
   CellNode* cell(std::size_t i) const { return CellDirectory::node_of(slots[i]); }
@@ -148,7 +147,7 @@ void issue_round_n(sac::Engine& rt, const Step& step, const CellRoundHead* paren
   static_assert(std::is_standard_layout_v<CellRoundCells<N>>);
   static_assert(offsetof(CellRoundCells<N>, used) == offsetof(CellRoundCells<1>, used));
   CellRound<Step, N> round{
-      {{parent, static_cast<std::uint16_t>(misses.size()), static_cast<std::uint16_t>(N), serial, {}}, {}}, step};
+      {{parent, static_cast<std::uint32_t>(misses.size()), serial, {}}, {}}, step};
   std::array<const sac::Mod<CellState>*, N> mods;
   for (std::size_t i = 0; i < misses.size(); ++i) mods[i] = &misses[i]->state;
   rt.read_many(std::span<const sac::Mod<CellState>* const>(mods.data(), misses.size()), std::move(round));
@@ -163,7 +162,7 @@ void issue_round(sac::Engine& rt, const Step& step, const CellRoundHead* parent,
   if (misses.size() > kCellsPerRead) misses = misses.first(kCellsPerRead);  // the rest next round
   step.view(rt)->count_round(misses.size());
   // Closures of 1, 2, 3, 4, 6, 8, 12 or 16 cells: a round holds at most a third more room than
-  // it reads (12 bytes a cell), against twice as much with powers of two.
+  // it reads (a cell's interest, 4 bytes), against twice as much with powers of two.
   switch (misses.size()) {
     case 1: return issue_round_n<Step, 1>(rt, step, parent, serial, misses);
     case 2: return issue_round_n<Step, 2>(rt, step, parent, serial, misses);

@@ -156,8 +156,9 @@ class Engine {
   /// body(vals) (or body(Engine&, vals), or body(Engine&, vals, slots)) with vals a
   /// std::span<const T* const> of the k values visible now, vals[i] that of mods[i], and
   /// slots a ReadSlots<T> (sac/read_slots.hpp): the modifiables as the record holds them,
-  /// valid while the read lives, for a closure that must know them without copying them. The same as k nested reads of mods in
-  /// order with body innermost, but one record (48 + 24k bytes + closure), one interval
+  /// valid while the read lives, for a closure that must know them without copying them.
+  /// The same as k nested reads of mods in order with body innermost, but one record
+  /// (48 + 24k bytes + closure), one interval
   /// and one event in the statistics: when any of the k visible values changes (cut-off
   /// writes excepted), propagate() re-runs body once, seeing all k current values. The
   /// pointers to vals are valid during the call only. Not memoized (no memo_read analogue).
