@@ -928,13 +928,23 @@ struct FollowingSum {
   }
 };
 
-TEST(ReadManyFollow, AReadMovesToAModifiableThatHoldsWhatItSaw) {
+// The follow tests' start: a pool of 1, 2, 1 (pool[2] holds what pool[0] does), and an output.
+struct FollowPool {
   Mod<int> out;
   std::array<Mod<int>, 3> pool;
-  Engine rt;
-  rt.set(pool[0], 1);
-  rt.set(pool[1], 2);
-  rt.set(pool[2], 1);
+  Engine rt;  // after the modifiables: it goes first
+  FollowPool() {
+    rt.set(pool[0], 1);
+    rt.set(pool[1], 2);
+    rt.set(pool[2], 1);
+  }
+};
+
+TEST(ReadManyFollow, AReadMovesToAModifiableThatHoldsWhatItSaw) {
+  FollowPool p;
+  Mod<int>& out = p.out;
+  std::array<Mod<int>, 3>& pool = p.pool;
+  Engine& rt = p.rt;
   int runs = 0;
   std::array<int, 4> names{0, 1, 0, 0};
   rt.run([&](Engine& rt2) { rt2.read_many({&pool[0], &pool[1]}, FollowingSum{&out, &runs, pool, &names}); });
@@ -984,12 +994,10 @@ struct SlotsSum {
 };
 
 TEST(ReadManySlots, TheBodySeesItsModifiablesAndAFollowedSlotsNewOne) {
-  Mod<int> out;
-  std::array<Mod<int>, 3> pool;
-  Engine rt;
-  rt.set(pool[0], 1);
-  rt.set(pool[1], 2);
-  rt.set(pool[2], 1);
+  FollowPool p;
+  Mod<int>& out = p.out;
+  std::array<Mod<int>, 3>& pool = p.pool;
+  Engine& rt = p.rt;
   std::vector<const Mod<int>*> seen;
   const Mod<int>* moved_from = nullptr;
   rt.run([&](Engine& rt2) {

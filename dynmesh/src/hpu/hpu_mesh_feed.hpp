@@ -168,6 +168,8 @@ class HpuMeshFeed {
   }
 
   void born(HpuTriBlockHead* b) {
+    // Room for the log first: a block is linked only once nothing can throw.
+    if (logging_) events_.reserve(events_.size() + b->n);
     b->next = head_;
     if (head_) head_->prev = b;
     head_ = b;
