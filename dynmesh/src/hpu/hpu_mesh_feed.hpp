@@ -23,6 +23,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
 #include <span>
 #include <string>
 #include <type_traits>
@@ -83,10 +84,11 @@ class HpuMeshFeed {
   HpuMeshFeed& operator=(const HpuMeshFeed&) = delete;
 
   /// Makes the blocks of vertex v's triangles (v, b, c), in the running step (blocks of up to
-  /// 16; a vertex has fewer in a quality mesh).
+  /// the largest class; a vertex has fewer in a quality mesh).
   void make(sac::Engine& rt, const CellVertex* v, std::span<const HpuCorners> tris) {
+    constexpr std::size_t kMost = kBlockClasses[std::size(kBlockClasses) - 1];
     while (!tris.empty()) {
-      const std::span<const HpuCorners> part = tris.first(std::min<std::size_t>(tris.size(), 16));
+      const std::span<const HpuCorners> part = tris.first(std::min(tris.size(), kMost));
       make_of(rt, v, part);
       tris = tris.subspan(part.size());
     }
