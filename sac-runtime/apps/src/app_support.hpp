@@ -119,6 +119,10 @@ class ListApp : public App {
     conventional_ = std::move(result);
   }
   void drop_stale() { stale_.clear(); }
+  void release_conventional() override {
+    stale_.clear();
+    conventional_ = {};
+  }
 
   std::unique_ptr<State> s_;
 

@@ -31,6 +31,11 @@ class App {
 
   /// The conventional (plain C++) computation on the current input; timed by the suite.
   virtual void run_conventional() = 0;
+  /// Frees the conventional result kept by run_conventional() (untimed), so that the next
+  /// run allocates from memory the allocator already holds, as a self-adjusting run starts
+  /// on chunks a previous engine freed (sac/chunk_cache.hpp). Without it the first app of a
+  /// process pays the kernel's first touch of fresh heap pages and the next ones do not.
+  virtual void release_conventional() {}
   /// The self-adjusting computation from scratch (Engine::run); timed by the suite.
   virtual void run_self_adjusting() = 0;
 
