@@ -19,9 +19,13 @@
 // whose cells handed it another vertex re-runs in the program only if it used that
 // vertex), so beside the program's measured update it says how much of that update the
 // rules' own change could explain (bench/RESULTS.md).
+// --held-stars prints instead what stars held from one walk to the next would save: the
+// collects whose walk repeats the vertex's previous one, and the final walks of a star the
+// vertex's last collect walked whole, with their left searches.
 //
 //   dynmesh_hpu_locality [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
 //                        [--seed 1] [--angle 20.7] [--csv] [--by-class] [--reach] [--time] [--profile]
+//                        [--held-stars]
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -111,7 +115,42 @@ int main(int argc, char** argv) {
                "also print the changed collects and processings per update by their distance from the updated point, "
                "in units of 2^(their size class)");
   app.add_flag("--profile", profile, "also print, per step kind, the leaves one step reads (mean, median, p99, max)");
+  bool held = false;
+  app.add_flag("--held-stars", held,
+               "only print, per (distribution, n), the left searches that stars held from one walk to the next would "
+               "save: collects whose walk repeats the vertex's previous one, final walks of a star its last collect "
+               "walked whole");
   CLI11_PARSE(app, argc, argv);
+
+  if (held) {
+    std::printf("%-8s %7s %9s %10s %9s %9s %9s %9s %9s %9s\n", "dist", "n", "collects", "asks/coll", "held col",
+                "held ask", "final", "asks/fin", "held fin", "held ask");
+    for (const std::string& name : dists) {
+      const auto dist = parse_distribution(name);
+      if (!dist) {
+        std::fprintf(stderr, "dynmesh_hpu_locality: unknown distribution %s\n", name.c_str());
+        return 2;
+      }
+      for (const std::size_t n : sizes) {
+        const auto pts = generate<2>(*dist, n, seed);
+        const Box<2> box = derive_box<2>(pts);
+        const auto q = detail::cell_refine(box, pts, angle, detail::CellRefineOptions{.held_stars = true}).questions;
+        const auto pct = [](std::size_t a, std::size_t b) { return b ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+        const auto per = [](std::size_t a, std::size_t b) { return b ? static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+        std::printf("%-8s %7zu %9zu %10.2f %8.1f%% %8.1f%% %9zu %9.2f %8.1f%% %8.1f%%\n", name.c_str(), n, q.collects,
+                    per(q.collect_asks, q.collects), pct(q.held_collects, q.collects), pct(q.held_asks, q.collect_asks),
+                    q.final_stars, per(q.final_asks, q.final_stars), pct(q.held_final, q.final_stars),
+                    pct(q.held_final_asks, q.final_asks));
+        std::printf("%-8s %7zu   left searches: %zu in all, %zu (%.1f%%) in collects and final walks a held star "
+                    "answers; %.1f%% of the collects (%.1f%% of their searches) follow a whole walk of their vertex; "
+                    "%.1f%% of the collects' triangles were found by their vertex's previous walk\n",
+                    name.c_str(), n, q.neighbour_asks, q.held_asks + q.held_final_asks,
+                    pct(q.held_asks + q.held_final_asks, q.neighbour_asks), pct(q.kept_collects, q.collects),
+                    pct(q.kept_asks, q.collect_asks), pct(q.repeated_triangles, q.walk_triangles));
+      }
+    }
+    return 0;
+  }
 
   if (csv)
     std::printf("dist,n,steps,mean_changed,median_changed,max_changed,mean_changed_leaves,"

@@ -176,6 +176,35 @@ TEST(CellRefiner, TreeCheckedAfterEveryInsertion) {
   }
 }
 
+TEST(CellRefiner, HeldStarsCountsWhatARepeatedWalkWouldSaveAndLeavesTheMeshAlone) {
+  // The count behind the held-stars figure (bench/RESULTS.md): the option changes no
+  // question, and each count is a part of its whole. A final star is held only when the
+  // vertex's last collect walked it whole, so the held share is below one on uniform points
+  // (new vertices arrive after most collects) and above zero (the last classes' vertices).
+  const auto pts = generate<2>(Distribution::Uniform, kSanitized ? 100 : 400, 5);
+  const Box<2> box = derive_box<2>(pts);
+  const auto plain = detail::cell_refine(box, pts, 20.7);
+  const auto held = detail::cell_refine(box, pts, 20.7, detail::CellRefineOptions{.held_stars = true});
+  EXPECT_EQ(held.triangles, plain.triangles);
+  const auto& q = held.questions;
+  EXPECT_EQ(q.collects, held.stats.entries);
+  std::set<std::array<double, 2>> vertices;
+  for (const Triangle& t : held.triangles)
+    for (const Point<2>& p : t.v) vertices.insert({p[0], p[1]});
+  EXPECT_EQ(q.final_stars, vertices.size());
+  EXPECT_LE(q.held_collects, q.collects);
+  EXPECT_LE(q.held_asks, q.collect_asks);
+  EXPECT_GT(q.held_final, 0u);
+  EXPECT_LT(q.held_final, q.final_stars);
+  EXPECT_LE(q.held_final_asks, q.final_asks);
+  EXPECT_LE(q.collect_asks + q.final_asks, q.neighbour_asks);
+  EXPECT_LE(q.kept_collects, q.collects);
+  EXPECT_LE(q.kept_asks, q.collect_asks);
+  EXPECT_GT(q.repeated_triangles, 0u);  // a vertex collected twice keeps part of its star
+  EXPECT_LT(q.repeated_triangles, q.walk_triangles);
+  EXPECT_EQ(plain.questions.collects, 0u);  // counted only when asked
+}
+
 struct Case {
   Distribution dist;
   std::size_t n;

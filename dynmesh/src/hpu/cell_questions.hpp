@@ -76,6 +76,21 @@ struct CellQuestionStats {
   // Leaves read by the collects, by the pairs' processing and by the final mesh (kept by
   // the static refiner's step log).
   std::size_t leaves_collect = 0, leaves_process = 0, leaves_final = 0;
+  // With CellRefineOptions::held_stars: what stars held from one walk to the next would save.
+  // A collect's walk is held when it closed (the whole star) or stopped at a cap no larger
+  // than the one before, with the same neighbours: its left searches are then repeats.
+  std::size_t collects = 0, collect_asks = 0;       // every collect, and its left searches
+  std::size_t held_collects = 0, held_asks = 0;     // collects a held star answers
+  // Collects whose vertex had walked its whole star before: what a star kept up to date by
+  // the insertions (the held star with each cavity applied) could answer, at most.
+  std::size_t kept_collects = 0, kept_asks = 0;
+  // Triangles (consecutive neighbours) of a collect's walk, and those its vertex's previous
+  // walk had found already: each is a left search a walk resumed from its last one would
+  // not repeat, at most.
+  std::size_t walk_triangles = 0, repeated_triangles = 0;
+  std::size_t final_stars = 0, held_final = 0;      // vertices, and those whose last collect
+                                                    // walked their whole final star
+  std::size_t final_asks = 0, held_final_asks = 0;  // the final walks' left searches
 };
 
 namespace cellq {
@@ -401,6 +416,8 @@ class CellQuestions {
   }
 
   const std::vector<V>& star() const noexcept { return star_; }
+  /// The last star_of's walks that stopped at its cap (0: the star is whole).
+  int star_gap_ends() const noexcept { return gap_ends_; }
 
   /// The class of v's shortest Delaunay edge. edge_class is ⌊log2 |pq|⌋ but where rounding
   /// moves |pq|² across a power of four, so an edge longer than the nearest one by more

@@ -49,7 +49,8 @@ class CellRefiner {
   CellRefiner(const Box<2>& box, double min_angle_deg, std::size_t max_vertices, CellRefinement& out,
               const CellRefineOptions& options)
       : box_(box), tree_(box), questions_(box, min_angle_deg, tree_, Coords{&pts_}, kNone, out.questions),
-        max_vertices_(max_vertices), out_(out), check_tree_(options.check_tree), log_steps_(options.log_steps) {
+        max_vertices_(max_vertices), out_(out), check_tree_(options.check_tree), log_steps_(options.log_steps),
+        held_stars_(options.held_stars) {
     const double lo[2] = {box.origin[0], box.origin[1]}, hi[2] = {box.origin[0] + box.side, box.origin[1] + box.side};
     // The corners first (vertices 0-3: the first entries' order puts them ahead).
     for (const Point<2>& c : {Point<2>{lo[0], lo[1]}, Point<2>{hi[0], lo[1]}, Point<2>{hi[0], hi[1]},
@@ -86,7 +87,9 @@ class CellRefiner {
     for (Vid v = 0; v < pts_.size(); ++v) {
       step_begin();
       std::uint64_t answer = 0;
+      const std::size_t asks = out_.questions.neighbour_asks;
       questions_.triangles_of(v, 0.0, mine);
+      if (held_stars_) final_asks_.push_back(out_.questions.neighbour_asks - asks);
       for (const auto& [a, b] : mine) {
         out.push_back(canonical_triangle(pts_[v], pts_[a], pts_[b]));
         answer = mix(mix(answer, pts_[a]), pts_[b]);
@@ -95,6 +98,7 @@ class CellRefiner {
     }
     std::sort(out.begin(), out.end());
     out_.questions.leaves_final += out_.questions.leaves_read - before;
+    if (held_stars_) count_held_final(out);
     return out;
   }
 
@@ -146,7 +150,9 @@ class CellRefiner {
     ++out_.stats.entries;
     step_begin();
     const std::size_t before = out_.questions.leaves_read;
+    const std::size_t asks = out_.questions.neighbour_asks;
     const bool go_on = questions_.collect(v, j, birth, local_pairs_);
+    if (held_stars_) count_held(v, j, out_.questions.neighbour_asks - asks);
     pairs_.insert(pairs_.end(), local_pairs_.begin(), local_pairs_.end());
     if (go_on) queues_[j + 1].push_back({v, false});
     std::uint64_t answer = go_on;
@@ -190,13 +196,74 @@ class CellRefiner {
     queues_[j].push_back({v, true});
   }
 
+  // The held-stars count: v's last collected walk, compared with the next one and with v's
+  // neighbours in the final mesh.
+  struct HeldStar {
+    int j = 0;
+    bool whole = false;
+    bool ever_whole = false;  // an earlier walk was whole
+    std::vector<Vid> star;    // sorted
+    std::vector<std::pair<Vid, Vid>> tris;  // the walk's triangles, sorted
+  };
+  void count_held(Vid v, int j, std::size_t asks) {
+    CellQuestionStats& q = out_.questions;
+    ++q.collects;
+    q.collect_asks += asks;
+    const std::vector<Vid>& walked = questions_.star();
+    std::vector<Vid> now = walked;
+    std::sort(now.begin(), now.end());
+    const bool whole = questions_.star_gap_ends() == 0;
+    HeldStar& h = held_[v];
+    // The walk's triangles as (ccw neighbour pairs): consecutive in star(), and around the
+    // end for an interior vertex's whole star.
+    std::vector<std::pair<Vid, Vid>> tris;
+    for (std::size_t i = 0; i + 1 < walked.size(); ++i) tris.emplace_back(walked[i], walked[i + 1]);
+    if (whole && !questions_.on_boundary(v) && walked.size() > 2) tris.emplace_back(walked.back(), walked.front());
+    std::sort(tris.begin(), tris.end());
+    q.walk_triangles += tris.size();
+    for (const auto& t : tris)
+      if (std::binary_search(h.tris.begin(), h.tris.end(), t)) ++q.repeated_triangles;
+    if (!h.star.empty() && h.star == now && (h.whole ? whole : !whole && h.j >= j)) {
+      ++q.held_collects;
+      q.held_asks += asks;
+    }
+    if (h.whole || h.ever_whole) {
+      ++q.kept_collects;
+      q.kept_asks += asks;
+    }
+    const bool ever = h.whole || h.ever_whole;
+    h = HeldStar{j, whole, ever, std::move(now), std::move(tris)};
+  }
+  void count_held_final(const std::vector<Triangle>& tris) {
+    std::map<std::pair<double, double>, Vid> id;
+    for (Vid v = 0; v < pts_.size(); ++v) id[{pts_[v][0], pts_[v][1]}] = v;
+    std::vector<std::vector<Vid>> nb(pts_.size());
+    for (const Triangle& t : tris)
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          if (a != b) nb[id.at({t.v[a][0], t.v[a][1]})].push_back(id.at({t.v[b][0], t.v[b][1]}));
+    for (Vid v = 0; v < pts_.size(); ++v) {
+      ++out_.questions.final_stars;
+      std::sort(nb[v].begin(), nb[v].end());
+      nb[v].erase(std::unique(nb[v].begin(), nb[v].end()), nb[v].end());
+      out_.questions.final_asks += final_asks_[v];
+      const auto it = held_.find(v);
+      if (it != held_.end() && it->second.whole && it->second.star == nb[v]) {
+        ++out_.questions.held_final;
+        out_.questions.held_final_asks += final_asks_[v];
+      }
+    }
+  }
+
   Box<2> box_;
   BucketTree tree_;
   std::vector<Point<2>> pts_;
   CellQuestions<BucketTree, Vid, Coords> questions_;
   std::size_t max_vertices_;
   CellRefinement& out_;
-  bool check_tree_, log_steps_;
+  bool check_tree_, log_steps_, held_stars_;
+  std::map<Vid, HeldStar> held_;
+  std::vector<std::size_t> final_asks_;  // by vertex
   std::uint64_t seen_ = 0;
   std::vector<std::uint32_t> step_leaf_ids_;
   std::map<int, std::vector<Entry>> queues_;

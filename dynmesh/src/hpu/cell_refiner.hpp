@@ -75,6 +75,7 @@ struct CellRefinement {
 struct CellRefineOptions {
   bool check_tree = false;  // BucketTree::check_invariants after every insertion (O(n) each)
   bool log_steps = false;   // fill CellRefinement::steps
+  bool held_stars = false;  // count what stars held by the cells would save (CellQuestionStats)
 };
 
 /// The hpu mesh of the points (validated as HpuMesh validates them) by cell questions.
