@@ -338,9 +338,8 @@ void Engine::retire(ModBase& m) {
 void Engine::flush() {
   // A write/alloc/make follows calls this body issued: run them first, so that events keep
   // program order.
-  const std::size_t floor = tasks_.size();
-  for (std::size_t i = issued_.size(); i-- > body_mark_;) tasks_.push_back(issued_[i]);
-  issued_.resize(body_mark_);
+  const std::size_t floor = body_mark_;
+  std::reverse(tasks_.begin() + static_cast<std::ptrdiff_t>(floor), tasks_.end());
   // The close below the floor belongs to the body that is still running: nothing flushed
   // here may be chained onto it.
   const std::size_t saved = close_floor_;
@@ -363,7 +362,9 @@ void Engine::exec_read(ReadNode* r) {
   ++stats_.events_created;
   ++stats_.live_events;
   const ModBase& m = *r->link.issued_mod;
-  const VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
+  // At the trace's end (every from-scratch read) the newest version is the one visible.
+  const VersionBase* v = r->start.next() == nullptr ? m.newest() : nullptr;
+  if (!v) v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
   attach_seen(&r->link, m, v);
   push_close(&r->end, TaskKind::CloseRead, r);
@@ -395,22 +396,6 @@ void Engine::attach_and_invoke_many(ReadNode* r, bool attached) {
 
 void Engine::throw_read_many_size() {
   throw UsageError("sac::Engine::read_many: reads 1 to 16 modifiables");
-}
-
-void Engine::push_close(Stamp* end, TaskKind kind, void* node) {
-  // A call that was the last one issued by its parent closes right before the parent does:
-  // chain it onto the parent's pending close (through the unlinked end stamp's link field)
-  // instead of stacking one task per level, so a chain of a million tail reads needs one task.
-  if (tasks_.size() > close_floor_ && (tasks_.back().kind == TaskKind::CloseRead ||
-                                       tasks_.back().kind == TaskKind::CloseMemo)) {
-    Task& top = tasks_.back();
-    end->link = (end->link & Stamp::kAuxMask) | reinterpret_cast<std::uintptr_t>(top.node) |
-                (top.kind == TaskKind::CloseMemo ? std::uintptr_t{1} : 0);
-    top = Task{kind, 0, node};
-    return;
-  }
-  end->link &= Stamp::kAuxMask;
-  tasks_.push_back(Task{kind, 0, node});
 }
 
 void Engine::close_chain(TaskKind kind, void* node) {
@@ -511,9 +496,7 @@ void Engine::discard_pending() noexcept {
     }
   };
   for (const Task& t : tasks_) discard(t);
-  for (const Task& t : issued_) discard(t);
   tasks_.clear();
-  issued_.clear();
   reruns_.clear();
   body_mark_ = 0;
   close_floor_ = 0;
@@ -711,19 +694,6 @@ void Engine::reuse_alloc(AllocNode* n) {
   order_.insert_after(now_, &n->stamp, StampKind::Alloc);
   now_ = &n->stamp;
   ++stats_.alloc_reuses;
-}
-
-void Engine::link_alloc(AllocNode* n, std::size_t h) {
-  order_.insert_after(now_, &n->stamp, StampKind::Alloc);
-  now_ = &n->stamp;
-  ++stats_.events_created;
-  ++stats_.live_events;
-  if (!n->ops()->key_equal) return;
-  if (window_end_) {
-    allocs_.insert(n, h, [](const AllocNode* x) { return x->ops()->hash(x); });
-  } else {
-    pending_.push_back(PendingAlloc{n, h});
-  }
 }
 
 void Engine::index_pending_allocs() {

@@ -93,7 +93,7 @@ MemoryBreakdown Engine::memory_breakdown() const {
   b.deferred_bytes = deferred_.capacity() * sizeof(AllocNode*) + dead_versions_.capacity() * sizeof(VersionBase*) +
                      seen_.capacity() * sizeof(Seen);
   b.engine_vectors = bases_.capacity() * sizeof(VersionBase*) + tasks_.capacity() * sizeof(Task) +
-                     reruns_.capacity() * sizeof(RerunContext) + issued_.capacity() * sizeof(Task) +
+                     reruns_.capacity() * sizeof(RerunContext) +
                      pending_.directory_bytes();
   b.pool_reserved = pool_.reserved_bytes();
   return b;

@@ -83,6 +83,7 @@
 // Chen, "CEAL" (PLDI'09); docs/DESIGN.md, "The runtime".
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
@@ -407,9 +408,9 @@ class Engine {
   }
 
   // Trace machinery (engine.cpp).
-  void issue(TaskKind k, void* node, std::uint32_t arg = 0) { issued_.push_back(Task{k, arg, node}); }
+  void issue(TaskKind k, void* node, std::uint32_t arg = 0) { tasks_.push_back(Task{k, arg, node}); }
   void flush_if_pending() {
-    if (issued_.size() > body_mark_) [[unlikely]]
+    if (tasks_.size() > body_mark_) [[unlikely]]
       flush();
   }
   void flush();
@@ -549,8 +550,9 @@ class Engine {
   const void* context_type_ = nullptr;  // its type's tag
   [[noreturn]] static void throw_bad_context();
   std::vector<RerunContext> reruns_;           // contexts saved by the running re-executions
-  std::vector<Task> issued_;                   // calls issued by the running bodies
-  std::size_t body_mark_ = 0;                  // issued_ entries below this belong to callers
+  // The running body's issued calls are the tasks at and above this index, in issue order
+  // until the body returns (or flushes) and they are reversed to run first to last.
+  std::size_t body_mark_ = 0;
   std::size_t close_floor_ = 0;                // closes below this may not be chained onto
 
   Stamp* now_ = nullptr;          // events are inserted after this stamp

@@ -175,7 +175,7 @@ void Engine::memo_read(const Mod<T>& m, F&& body) {
   static_assert(std::equality_comparable<Fn>,
                 "memo_read needs an equality-comparable closure: use sac::fn<f>(args...)");
   read(m, std::forward<F>(body));
-  issued_.back().kind = TaskKind::ExecMemoRead;  // matched against the old trace when run
+  tasks_.back().kind = TaskKind::ExecMemoRead;  // matched against the old trace when run
 }
 
 template <class T, class U>
@@ -263,15 +263,47 @@ const T* Engine::At::value(const Mod<T>& m) const {
 
 // ------------------------------------------------------------------ the trampoline
 
+// Inline: every from-scratch allocation and read passes here, and a call's register saves
+// cost as much as their bodies.
+inline void Engine::link_alloc(detail::AllocNode* n, std::size_t h) {
+  order_.insert_after(now_, &n->stamp, detail::StampKind::Alloc);
+  now_ = &n->stamp;
+  ++stats_.events_created;
+  ++stats_.live_events;
+  if (!n->ops()->key_equal) return;
+  if (window_end_) {
+    allocs_.insert(n, h, [](const detail::AllocNode* x) { return x->ops()->hash(x); });
+  } else {
+    pending_.push_back(PendingAlloc{n, h});
+  }
+}
+
+inline void Engine::push_close(detail::Stamp* end, TaskKind kind, void* node) {
+  // A call that was the last one issued by its parent closes right before the parent does:
+  // chain it onto the parent's pending close (through the unlinked end stamp's link field)
+  // instead of stacking one task per level, so a chain of a million tail reads needs one task.
+  if (tasks_.size() > close_floor_ && (tasks_.back().kind == TaskKind::CloseRead ||
+                                       tasks_.back().kind == TaskKind::CloseMemo)) {
+    Task& top = tasks_.back();
+    end->link = (end->link & detail::Stamp::kAuxMask) | reinterpret_cast<std::uintptr_t>(top.node) |
+                (top.kind == TaskKind::CloseMemo ? std::uintptr_t{1} : 0);
+    top = Task{kind, 0, node};
+    return;
+  }
+  end->link &= detail::Stamp::kAuxMask;
+  tasks_.push_back(Task{kind, 0, node});
+}
+
 template <class Body>
 void Engine::exec_body(Body&& body) {
-  // Calls issued by this body are queued above body_mark_ and handed to the trampoline in
-  // issue order once it returns.
+  // Calls issued by this body are pushed on the trampoline's stack above body_mark_, and
+  // reversed once it returns so that they run in issue order. One call, the usual case,
+  // needs nothing: it is already where it runs next.
   const std::size_t saved = body_mark_;
-  body_mark_ = issued_.size();
+  body_mark_ = tasks_.size();
   body();
-  for (std::size_t i = issued_.size(); i-- > body_mark_;) tasks_.push_back(issued_[i]);
-  issued_.resize(body_mark_);
+  if (tasks_.size() - body_mark_ > 1)
+    std::reverse(tasks_.begin() + static_cast<std::ptrdiff_t>(body_mark_), tasks_.end());
   body_mark_ = saved;
 }
 

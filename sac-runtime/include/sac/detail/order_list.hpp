@@ -99,6 +99,16 @@ class OrderList {
     s->reset(nullptr, k);
     Group& g = groups_[pos->group];
     Stamp* n = pos->next();
+    // Appends at the list's end (every from-scratch step) step the label by kAppendStep
+    // while the group has room; the general path below gives the same label.
+    if (!n && g.count < kAppendFill && pos->label < kBottomRange - kAppendStep) {
+      s->label = pos->label + static_cast<std::uint32_t>(kAppendStep);
+      s->group = pos->group;
+      pos->set_next(s);
+      ++g.count;
+      ++size_;
+      return;
+    }
     // Fast path: room in the group and between the labels (appends step by kAppendStep).
     if (g.count < kGroupCap && (n || g.count < kAppendFill)) {
       std::uint64_t lo = pos->label;

@@ -1,9 +1,11 @@
 // sac/detail/trampoline.hpp — the units of work of the Engine's trampoline.
 //
-// Purpose: read/memo_read/memo calls are recorded as Tasks when issued and run after the
-// issuing body returns, from an explicit stack (Engine::tasks_), so that deep recursion never
-// grows the C++ stack; closing an interval, re-executing a read and jumping over a reused
-// stretch are Tasks on the same stack.
+// Purpose: read/memo_read/memo calls are pushed as Tasks on an explicit stack
+// (Engine::tasks_) when issued, and run after the issuing body returns, so that deep
+// recursion never grows the C++ stack; closing an interval, re-executing a read and jumping
+// over a reused stretch are Tasks on the same stack. A body's calls lie above
+// Engine::body_mark_ in issue order until it returns, and are then reversed in place, so a
+// body's one tail call is never copied.
 // Invariants: an Exec* task carries a record that is not in the trace yet; a Close* task's
 // record has its start stamp linked and not its end, whose link field chains the records to
 // close right after it (low bit set: a memo entry; 0 ends the chain); Engine::reruns_ holds
