@@ -407,7 +407,8 @@ class Engine {
     return ops->size + (ops->invoke_many ? detail::many_of(r)->k() * sizeof(detail::ReadSlot) : 0);
   }
 
-  // Trace machinery (engine.cpp).
+  // Trace machinery (engine.cpp; the hot steps of a from-scratch run, exec_body, push_close
+  // and link_alloc, inline in sac/detail/engine_impl.hpp).
   void issue(TaskKind k, void* node, std::uint32_t arg = 0) { tasks_.push_back(Task{k, arg, node}); }
   void flush_if_pending() {
     if (tasks_.size() > body_mark_) [[unlikely]]
