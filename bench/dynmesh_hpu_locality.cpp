@@ -93,6 +93,22 @@ std::vector<detail::CellStep> run(const Box<2>& box, const std::vector<Point<2>>
   return std::move(r.steps);
 }
 
+/// One --held-stars row: what stars held from one walk to the next would answer.
+void print_held_stars(const std::string& name, std::size_t n, const detail::CellQuestionStats& q) {
+  const auto pct = [](std::size_t a, std::size_t b) { return b ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+  const auto per = [](std::size_t a, std::size_t b) { return b ? static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+  std::printf("%-8s %7zu %9zu %10.2f %8.1f%% %8.1f%% %9zu %9.2f %8.1f%% %8.1f%%\n", name.c_str(), n, q.collects,
+              per(q.collect_asks, q.collects), pct(q.held_collects, q.collects), pct(q.held_asks, q.collect_asks),
+              q.final_stars, per(q.final_asks, q.final_stars), pct(q.held_final, q.final_stars),
+              pct(q.held_final_asks, q.final_asks));
+  std::printf("%-8s %7zu   left searches: %zu in all, %zu (%.1f%%) in collects and final walks a held star "
+              "answers; %.1f%% of the collects (%.1f%% of their searches) follow a whole walk of their vertex; "
+              "%.1f%% of the collects' triangles were found by their vertex's previous walk\n",
+              name.c_str(), n, q.neighbour_asks, q.held_asks + q.held_final_asks,
+              pct(q.held_asks + q.held_final_asks, q.neighbour_asks), pct(q.kept_collects, q.collects),
+              pct(q.kept_asks, q.collect_asks), pct(q.repeated_triangles, q.walk_triangles));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -122,37 +138,11 @@ int main(int argc, char** argv) {
                "walked whole");
   CLI11_PARSE(app, argc, argv);
 
-  if (held) {
+
+  if (held)
     std::printf("%-8s %7s %9s %10s %9s %9s %9s %9s %9s %9s\n", "dist", "n", "collects", "asks/coll", "held col",
                 "held ask", "final", "asks/fin", "held fin", "held ask");
-    for (const std::string& name : dists) {
-      const auto dist = parse_distribution(name);
-      if (!dist) {
-        std::fprintf(stderr, "dynmesh_hpu_locality: unknown distribution %s\n", name.c_str());
-        return 2;
-      }
-      for (const std::size_t n : sizes) {
-        const auto pts = generate<2>(*dist, n, seed);
-        const Box<2> box = derive_box<2>(pts);
-        const auto q = detail::cell_refine(box, pts, angle, detail::CellRefineOptions{.held_stars = true}).questions;
-        const auto pct = [](std::size_t a, std::size_t b) { return b ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; };
-        const auto per = [](std::size_t a, std::size_t b) { return b ? static_cast<double>(a) / static_cast<double>(b) : 0.0; };
-        std::printf("%-8s %7zu %9zu %10.2f %8.1f%% %8.1f%% %9zu %9.2f %8.1f%% %8.1f%%\n", name.c_str(), n, q.collects,
-                    per(q.collect_asks, q.collects), pct(q.held_collects, q.collects), pct(q.held_asks, q.collect_asks),
-                    q.final_stars, per(q.final_asks, q.final_stars), pct(q.held_final, q.final_stars),
-                    pct(q.held_final_asks, q.final_asks));
-        std::printf("%-8s %7zu   left searches: %zu in all, %zu (%.1f%%) in collects and final walks a held star "
-                    "answers; %.1f%% of the collects (%.1f%% of their searches) follow a whole walk of their vertex; "
-                    "%.1f%% of the collects' triangles were found by their vertex's previous walk\n",
-                    name.c_str(), n, q.neighbour_asks, q.held_asks + q.held_final_asks,
-                    pct(q.held_asks + q.held_final_asks, q.neighbour_asks), pct(q.kept_collects, q.collects),
-                    pct(q.kept_asks, q.collect_asks), pct(q.repeated_triangles, q.walk_triangles));
-      }
-    }
-    return 0;
-  }
-
-  if (csv)
+  else if (csv)
     std::printf("dist,n,steps,mean_changed,median_changed,max_changed,mean_changed_leaves,"
                 "first,collect,process,final,first_leaves,collect_leaves,process_leaves,final_leaves\n");
   else
@@ -167,6 +157,10 @@ int main(int argc, char** argv) {
     for (const std::size_t n : sizes) {
       const auto pts = generate<2>(*dist, n, seed);
       const Box<2> box = derive_box<2>(pts);
+      if (held) {
+        print_held_stars(name, n, detail::cell_refine(box, pts, angle, detail::CellRefineOptions{.held_stars = true}).questions);
+        continue;
+      }
       const auto base = run(box, pts, angle);
       double twin_s = 0, cell_s = 0;
       if (time) {
