@@ -84,7 +84,8 @@ VersionBase* Engine::visible(const ModBase& m, const Stamp* t) const {
   return v;
 }
 
-const VersionBase* Engine::visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops) {
+const VersionBase* Engine::visible_or_default_slow(const ModBase& m, const Stamp* t,
+                                                  const detail::VersionOps* ops) {
   if (VersionBase* v = visible(m, t)) return v;
   // No version at all: the read will hang on m itself, and sees the type's shared T{}.
   // Most defaults read are never written (a list's end), so they never cost a version.
@@ -362,9 +363,7 @@ void Engine::exec_read(ReadNode* r) {
   ++stats_.events_created;
   ++stats_.live_events;
   const ModBase& m = *r->link.issued_mod;
-  // At the trace's end (every from-scratch read) the newest version is the one visible.
-  const VersionBase* v = r->start.next() == nullptr ? m.newest() : nullptr;
-  if (!v) v = visible_or_default(m, &r->start, r->ops()->value);
+  const VersionBase* v = visible_or_default(m, &r->start, r->ops()->value);
   if (!v) throw UsageError("sac::Engine::read: the modifiable was never written before this read");
   attach_seen(&r->link, m, v);
   push_close(&r->end, TaskKind::CloseRead, r);

@@ -502,7 +502,14 @@ class Engine {
   /// (init_default), the type's shared default if m has no version (the read then hangs on
   /// m: attach_default), or m's default made into its base version; else null. `ops`: m's
   /// version type.
-  const detail::VersionBase* visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops);
+  const detail::VersionBase* visible_or_default(const ModBase& m, const Stamp* t, const detail::VersionOps* ops) {
+    // At the trace's end (every from-scratch read) the newest version is the one visible.
+    if (t->next() == nullptr)
+      if (const detail::VersionBase* v = m.newest()) return v;
+    return visible_or_default_slow(m, t, ops);
+  }
+  const detail::VersionBase* visible_or_default_slow(const ModBase& m, const Stamp* t,
+                                                     const detail::VersionOps* ops);
   /// Hangs r on what it sees, v (from visible_or_default).
   static void attach_seen(detail::ReaderLink* r, const ModBase& m, const detail::VersionBase* v) {
     if (m.default_only()) attach_default(r, m);
