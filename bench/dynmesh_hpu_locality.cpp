@@ -22,10 +22,16 @@
 // --held-stars prints instead what stars held from one walk to the next would save: the
 // collects whose walk repeats the vertex's previous one, and the final walks of a star the
 // vertex's last collect walked whole, with their left searches.
+// --maintained-stars prints instead what stars kept up to date by the insertions would
+// answer (src/hpu/star_ledger.hpp): the collects (other than an inserted vertex's first,
+// which is its insertion's walk) whose triangles within the cap some walk had met while they
+// lived, their share of the collects' left searches and of the triangles they need that no
+// walk had met; the inserted vertices' first collects; the final walks answered likewise;
+// and the share of all left searches that the answered collects and final walks make.
 //
 //   dynmesh_hpu_locality [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
 //                        [--seed 1] [--angle 20.7] [--csv] [--by-class] [--reach] [--time] [--profile]
-//                        [--held-stars]
+//                        [--held-stars] [--maintained-stars]
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -109,6 +115,21 @@ void print_held_stars(const std::string& name, std::size_t n, const detail::Cell
               pct(q.kept_asks, q.collect_asks), pct(q.repeated_triangles, q.walk_triangles));
 }
 
+/// One --maintained-stars row: what stars kept up to date by the walks would answer.
+void print_maintained(const std::string& name, std::size_t n, const detail::CellRefinement& r) {
+  const auto pct = [](std::size_t a, std::size_t b) { return b ? 100.0 * static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+  const auto per = [](std::size_t a, std::size_t b) { return b ? static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+  const detail::MaintainedStarStats& m = r.maintained;
+  const std::size_t all = r.questions.neighbour_asks;
+  std::printf("%-8s %7zu %9zu %8.2f %8.1f%% %8.1f%% %8.1f%% %8.1f%% %8.1f%% %8.1f%% %8.1f%% %8.1f%% %10zu %8.1f%% %8.1f%%\n",
+              name.c_str(), n, m.collects, per(m.collect_asks, m.collects), pct(m.answered_design, m.collects),
+              pct(m.answered_design_asks, m.collect_asks), pct(m.births_design_asks, m.birth_asks),
+              pct(m.answered_asks, m.collect_asks), pct(m.unheld_triangles, m.needed_triangles),
+              pct(m.answered_final_asks, m.final_asks), pct(m.whole_final_asks, m.final_asks),
+              pct(m.collect_asks + m.final_asks, all), all, pct(m.answered_design_asks + m.answered_final_asks, all),
+              pct(m.answered_asks + m.answered_final_asks, all));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -136,10 +157,18 @@ int main(int argc, char** argv) {
                "only print, per (distribution, n), the left searches that stars held from one walk to the next would "
                "save: collects whose walk repeats the vertex's previous one, final walks of a star its last collect "
                "walked whole");
+  bool maintained = false;
+  app.add_flag("--maintained-stars", maintained,
+               "only print, per (distribution, n), what stars kept up to date by the insertions would answer: "
+               "collects whose triangles within the cap some walk had met, final walks likewise");
   CLI11_PARSE(app, argc, argv);
 
 
-  if (held)
+  if (maintained)
+    std::printf("%-8s %7s %9s %8s %9s %9s %9s %9s %9s %9s %9s %9s %10s %9s %9s\n", "dist", "n", "collects",
+                "asks/col", "replayed", "rep asks", "birth rep", "orc asks", "unheld", "fin asks", "fin whole",
+                "walk asks", "all asks", "saved", "saved orc");
+  else if (held)
     std::printf("%-8s %7s %9s %10s %9s %9s %9s %9s %9s %9s\n", "dist", "n", "collects", "asks/coll", "held col",
                 "held ask", "final", "asks/fin", "held fin", "held ask");
   else if (csv)
@@ -157,6 +186,10 @@ int main(int argc, char** argv) {
     for (const std::size_t n : sizes) {
       const auto pts = generate<2>(*dist, n, seed);
       const Box<2> box = derive_box<2>(pts);
+      if (maintained) {
+        print_maintained(name, n, detail::cell_refine(box, pts, angle, detail::CellRefineOptions{.maintained_stars = true}));
+        continue;
+      }
       if (held) {
         print_held_stars(name, n, detail::cell_refine(box, pts, angle, detail::CellRefineOptions{.held_stars = true}).questions);
         continue;

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -51,6 +52,7 @@ class CellRefiner {
       : box_(box), tree_(box), questions_(box, min_angle_deg, tree_, Coords{&pts_}, kNone, out.questions),
         max_vertices_(max_vertices), out_(out), check_tree_(options.check_tree), log_steps_(options.log_steps),
         held_stars_(options.held_stars) {
+    if (options.maintained_stars) ledger_ = std::make_unique<StarLedger>(box);
     const double lo[2] = {box.origin[0], box.origin[1]}, hi[2] = {box.origin[0] + box.side, box.origin[1] + box.side};
     // The corners first (vertices 0-3: the first entries' order puts them ahead).
     for (const Point<2>& c : {Point<2>{lo[0], lo[1]}, Point<2>{hi[0], lo[1]}, Point<2>{hi[0], hi[1]},
@@ -65,6 +67,7 @@ class CellRefiner {
     }
     for (const Point<2>& p : points)
       if (!questions_.find(p)) add(p);
+    first_inserted_ = static_cast<Vid>(pts_.size());  // the refinement's vertices from here
   }
 
   void refine() {
@@ -88,8 +91,23 @@ class CellRefiner {
       step_begin();
       std::uint64_t answer = 0;
       const std::size_t asks = out_.questions.neighbour_asks;
+      bool all_held = false, whole_held = false;
+      if (ledger_) {
+        std::size_t needed = 0, unheld = 0;
+        all_held = ledger_->all_held(v, 0.0, needed, unheld, true);
+        whole_held = ledger_->all_held(v, std::numeric_limits<double>::infinity(), needed, unheld);
+      }
       questions_.triangles_of(v, 0.0, mine);
       if (held_stars_) final_asks_.push_back(out_.questions.neighbour_asks - asks);
+      if (ledger_) {
+        MaintainedStarStats& m = out_.maintained;
+        const std::size_t walk_asks = out_.questions.neighbour_asks - asks;
+        ++m.finals;
+        m.final_asks += walk_asks;
+        if (all_held) ++m.answered_finals, m.answered_final_asks += walk_asks;
+        else ledger_->walked_triangles(v, mine);
+        if (whole_held) ++m.whole_finals, m.whole_final_asks += walk_asks;
+      }
       for (const auto& [a, b] : mine) {
         out.push_back(canonical_triangle(pts_[v], pts_[a], pts_[b]));
         answer = mix(mix(answer, pts_[a]), pts_[b]);
@@ -99,10 +117,14 @@ class CellRefiner {
     std::sort(out.begin(), out.end());
     out_.questions.leaves_final += out_.questions.leaves_read - before;
     if (held_stars_) count_held_final(out);
+    if (ledger_) ledger_->check_mesh(out);
     return out;
   }
 
-  void check() const { tree_.check_invariants(pts_); }
+  void check() const {
+    tree_.check_invariants(pts_);
+    if (ledger_) ledger_->check_invariants();
+  }
 
  private:
   struct Entry {
@@ -134,10 +156,12 @@ class CellRefiner {
                                   static_cast<std::int16_t>(std::clamp(cls, -30000, 30000)), at});
   }
 
-  Vid add(const Point<2>& p) {
+  /// `near`: a vertex close to p (the ledger's locating hint), or kNone.
+  Vid add(const Point<2>& p, Vid near = kNone) {
     const auto v = static_cast<Vid>(pts_.size());
     pts_.push_back(p);
     tree_.insert(v, p, pts_);
+    if (ledger_) ledger_->add(v, p, near);
     if (pts_.size() > max_vertices_)
       throw InvariantError("dynmesh: hpu refinement did not terminate (over " + std::to_string(max_vertices_) +
                            " vertices)");
@@ -151,8 +175,12 @@ class CellRefiner {
     step_begin();
     const std::size_t before = out_.questions.leaves_read;
     const std::size_t asks = out_.questions.neighbour_asks;
+    bool all_held = false;
+    if (ledger_)
+      all_held = ledger_->all_held(v, collect_reach(j), out_.maintained.needed_triangles, out_.maintained.unheld_triangles);
     const bool go_on = questions_.collect(v, j, birth, local_pairs_);
     if (held_stars_) count_held(v, j, out_.questions.neighbour_asks - asks);
+    if (ledger_) count_maintained(v, j, birth, all_held, out_.questions.neighbour_asks - asks);
     pairs_.insert(pairs_.end(), local_pairs_.begin(), local_pairs_.end());
     if (go_on) queues_[j + 1].push_back({v, false});
     std::uint64_t answer = go_on;
@@ -177,7 +205,7 @@ class CellRefiner {
         }
         continue;
       }
-      const Vid rv = add(d.at);
+      const Vid rv = add(d.at, p);
       answer = mix(answer, d.at);
       ++out_.stats.off_centers;
       if (d.circumcentre) ++out_.stats.circumcentres;
@@ -191,9 +219,32 @@ class CellRefiner {
   void split_side(Vid a, Vid b, int j) {
     const Point<2> mid = side_midpoint(pts_[a], pts_[b]);
     if (questions_.find(mid)) throw InvariantError("dynmesh: a box edge's midpoint is already a vertex");
-    const Vid v = add(mid);
+    const Vid v = add(mid, a);
     ++out_.stats.side_splits;
     queues_[j].push_back({v, true});
+  }
+
+  /// The cap of a collect of class j (CellQuestions::collect's reach).
+  static double collect_reach(int j) { return std::ldexp(1.0 + 0x1p-20, j + 1 + kGoOnReach); }
+
+  // The maintained-stars count (star_ledger.hpp): a collect a held star replays makes no
+  // walk; any other walks, and what it meets becomes held. The first collects of vertices
+  // the refinement inserted are counted apart too.
+  void count_maintained(Vid v, int j, bool birth, bool all_held, std::size_t asks) {
+    MaintainedStarStats& m = out_.maintained;
+    const bool whole = questions_.star_gap_ends() == 0;
+    const bool closed = whole && !questions_.on_boundary(v);
+    const bool replays = ledger_->replays(v, questions_.star(), whole, closed, collect_reach(j));
+    ++m.collects;
+    m.collect_asks += asks;
+    if (all_held) ++m.answered, m.answered_asks += asks;
+    if (replays) ++m.answered_design, m.answered_design_asks += asks;
+    else ledger_->walked(v, questions_.star(), whole, closed, collect_reach(j));
+    if (birth && v >= first_inserted_) {
+      ++m.births;
+      m.birth_asks += asks;
+      if (replays) ++m.births_design, m.births_design_asks += asks;
+    }
   }
 
   // The held-stars count: v's last collected walk, compared with the next one and with v's
@@ -262,6 +313,8 @@ class CellRefiner {
   std::size_t max_vertices_;
   CellRefinement& out_;
   bool check_tree_, log_steps_, held_stars_;
+  std::unique_ptr<StarLedger> ledger_;  // with maintained_stars
+  Vid first_inserted_ = kNone;          // vertices from here on were inserted by the refinement
   std::map<Vid, HeldStar> held_;
   std::vector<std::size_t> final_asks_;  // by vertex
   std::uint64_t seen_ = 0;

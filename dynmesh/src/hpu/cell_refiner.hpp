@@ -45,6 +45,7 @@
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
 #include "hpu/cell_questions.hpp"
+#include "hpu/star_ledger.hpp"
 
 namespace dynmesh::detail {
 
@@ -69,6 +70,7 @@ struct CellRefinement {
   std::vector<Triangle> triangles;  // canonical, sorted
   HpuStats stats;                   // triangles_made and max_cavity stay 0 (no triangulation)
   CellQuestionStats questions;
+  MaintainedStarStats maintained;   // with maintained_stars only
   std::vector<CellStep> steps;      // with log_steps only
 };
 
@@ -76,6 +78,9 @@ struct CellRefineOptions {
   bool check_tree = false;  // BucketTree::check_invariants after every insertion (O(n) each)
   bool log_steps = false;   // fill CellRefinement::steps
   bool held_stars = false;  // count what stars held by the cells would save (CellQuestionStats)
+  /// Count what stars kept up to date by the insertions would answer (star_ledger.hpp;
+  /// CellRefinement::maintained). Keeps a shadow triangulation beside the refiner.
+  bool maintained_stars = false;
 };
 
 /// The hpu mesh of the points (validated as HpuMesh validates them) by cell questions.
