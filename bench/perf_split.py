@@ -10,7 +10,10 @@ counted as:
   - kernel: a leaf frame in the kernel ([kernel.kallsyms]);
   - runtime and glue: the rest (the engine's matching, undo, reads, writes, the order list,
     the view's bookkeeping around the questions, the program's own steps).
-Then the leaf functions of the runtime part, most frequent first.
+It also prints the share of the samples under a left search (CellQuestions::left_search: the
+star walks' steps, most of them), the part that stars held by the cells would cut. Then the
+leaf functions of the runtime part, most frequent first. With --scratch it keeps the samples
+of the first run instead (under sac::Engine::drain and not under propagate).
 
   perf record -g -o u.data build/relg/bin/dynmesh_hpu_steps --dist uniform --n 32000 --updates 3000
   perf script -i u.data -F comm,ip,sym,dso > u.txt && python3 bench/perf_split.py u.txt [--top 15]
@@ -25,6 +28,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("file", nargs="?", help="perf script output (default: standard input)")
     ap.add_argument("--top", type=int, default=15, help="runtime leaf functions to list")
+    ap.add_argument("--scratch", action="store_true", help="the first run's samples instead of the updates'")
     args = ap.parse_args()
     if args.file:
         with open(args.file, encoding="utf-8", errors="replace") as f:
@@ -42,9 +46,12 @@ def main() -> None:
         # "ip symbol (dso)": the symbol without its dso, which names the kernel's frames.
         syms = [re.sub(r" \([^()]*\)$", "", line.split(" ", 1)[1]) if " " in line else "" for line in lines]
         in_kernel = "kernel.kallsyms" in lines[0]
-        if not any("Engine::propagate" in s for s in syms):
+        updating = any("Engine::propagate" in s for s in syms)
+        if args.scratch == updating or (args.scratch and not any("Engine::drain" in s for s in syms)):
             continue
         under += 1
+        if any("CellQuestions" in s and "left_search" in s for s in syms):
+            split["left searches"] += 1
         if any("CellQuestions" in s for s in syms):
             split["questions"] += 1
         elif in_kernel:
@@ -52,11 +59,13 @@ def main() -> None:
         else:
             split["runtime and glue"] += 1
             leaves[re.sub(r"<.*", "", syms[0])[:100]] += 1
+    where = "in the first run" if args.scratch else "under propagate"
     if not under:
-        sys.exit("perf_split: no sample under sac::Engine::propagate (a -g profile of updates?)")
-    print(f"samples {total}, under propagate {under}")
+        sys.exit(f"perf_split: no sample {where} (a -g profile of a frame-pointer build?)")
+    print(f"samples {total}, {where} {under}")
     for k in ("questions", "runtime and glue", "kernel"):
         print(f"{100 * split[k] / under:5.1f}%  {k}")
+    print(f"{100 * split['left searches'] / under:5.1f}%  left searches (part of the questions)")
     rt = split["runtime and glue"]
     if rt:
         print("runtime and glue, by leaf function (share of that part):")

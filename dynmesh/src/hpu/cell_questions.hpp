@@ -81,8 +81,8 @@ struct CellQuestionStats {
   // than the one before, with the same neighbours: its left searches are then repeats.
   std::size_t collects = 0, collect_asks = 0;       // every collect, and its left searches
   std::size_t held_collects = 0, held_asks = 0;     // collects a held star answers
-  // Collects whose vertex had walked its whole star before: what a star kept up to date by
-  // the insertions (the held star with each cavity applied) could answer, at most.
+  // Collects whose vertex had walked its whole star before (what stars kept up to date by
+  // every walk would answer is star_ledger.hpp's count, CellRefineOptions::maintained_stars).
   std::size_t kept_collects = 0, kept_asks = 0;
   // Triangles (consecutive neighbours) of a collect's walk, and those its vertex's previous
   // walk had found already: each is a left search a walk resumed from its last one would
