@@ -4,13 +4,16 @@
 // Same inputs, box and edit semantics as `dynmesh quadtree`, through the same readers and
 // labels (initial_points.hpp, input_labels.hpp): rank 0 reads the files and hands the points
 // and the edits to MpiQuadtree, which routes them to their ranks. OUT is written once, by
-// rank 0, and equals `dynmesh quadtree`'s `.cells` for every P. --stats prints, per rank, on
+// rank 0 as the ranks' sorted leaves arrive (no rank holds them all), and equals `dynmesh
+// quadtree`'s `.cells` for every P. --stats prints, per rank, on
 // stderr (gathered to rank 0, in rank order): points owned, ghost points, trace bytes, mean
-// time per propagation.
+// time per propagation, peak resident memory.
 // Errors: one line `dynmesh-mpi: <message>` from rank 0 and exit status 1 on every rank (2 for
 // a malformed command line); every failure is agreed by all ranks before the next
 // collective, so none waits forever. Hidden test options: --partition-level L (l0),
-// --ghost-ring W (a narrower ring must break exactness), --rebalance F.
+// --ghost-ring W (a narrower ring must break exactness), --rebalance F, --measure-writing
+// (with --stats: the writing's own peak memory, by restarting the process's peak counter
+// when the writing begins; docs/DISTRIBUTED.md, "Writing the output").
 // No memory guard: the memory is spread over the ranks, which one process cannot see.
 #include <algorithm>
 #include <cstddef>
@@ -28,11 +31,13 @@
 
 #include "atomic_file.hpp"
 #include "distinct_paths.hpp"
+#include "dynmesh/detail/merge_on_root.hpp"
 #include "dynmesh/io.hpp"
 #include "dynmesh/mpi_quadtree.hpp"
 #include "initial_points.hpp"
 #include "input_labels.hpp"
 #include "number_options.hpp"
+#include "peak_memory.hpp"
 #include "verify.hpp"
 
 namespace {
@@ -53,6 +58,7 @@ struct Options {
   int partition_level = -1;
   int ghost_ring = 1;
   double rebalance = 1.5;
+  bool measure_writing = false;
 };
 
 int rank_of(MPI_Comm comm) {
@@ -75,24 +81,29 @@ void print_error(const std::string& message) {
   std::fprintf(stderr, "dynmesh-mpi: %s\n", one_line(message).c_str());
 }
 
-/// Per-rank --stats lines, printed by rank 0 in rank order.
-template <std::size_t d>
-void print_stats(MPI_Comm comm, const MpiQuadtree<d>& tree) {
-  const MpiRankStats st = tree.rank_stats();
+/// Per-rank --stats lines, printed by rank 0 in rank order: the tree's figures, taken before
+/// the tree was freed, and the rank's peak resident memory over the run; with
+/// --measure-writing also the peak over the writing of the output alone and the resident
+/// memory when the writing began (writing_mib < 0: not measured).
+void print_stats(MPI_Comm comm, const MpiRankStats& st, int partition_level, double peak_mib, double writing_mib,
+                 double writing_from_mib) {
   char line[512];
   const double mean = st.propagations ? st.propagate_seconds / static_cast<double>(st.propagations) : 0.0;
-  std::snprintf(line, sizeof line,
-                "[dynmesh-mpi] rank %d: owned %zu points in %zu root cells, ghost %zu points, trace %zu bytes, "
-                "%zu propagations, mean %.6f s, %zu repartitions",
-                rank_of(comm), st.owned_points, st.owned_roots, st.ghost_points, st.trace_bytes, st.propagations, mean,
-                st.repartitions);
+  int n = std::snprintf(line, sizeof line,
+                        "[dynmesh-mpi] rank %d: owned %zu points in %zu root cells, ghost %zu points, trace %zu bytes, "
+                        "%zu propagations, mean %.6f s, %zu repartitions, peak_rss %.0f MiB",
+                        rank_of(comm), st.owned_points, st.owned_roots, st.ghost_points, st.trace_bytes,
+                        st.propagations, mean, st.repartitions, peak_mib);
+  if (writing_mib >= 0 && n > 0 && static_cast<std::size_t>(n) < sizeof line)
+    std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), ", writing peak_rss %.0f MiB (from %.0f MiB)",
+                  writing_mib, writing_from_mib);
   int nranks = 1;
   MPI_Comm_size(comm, &nranks);
   std::vector<char> all(static_cast<std::size_t>(nranks) * sizeof line);
   MPI_Gather(line, sizeof line, MPI_CHAR, all.data(), sizeof line, MPI_CHAR, 0, comm);
   if (rank_of(comm) != 0) return;
   std::fflush(stdout);
-  std::fprintf(stderr, "[dynmesh-mpi] %d ranks, partition level %d\n", nranks, tree.partition_level());
+  std::fprintf(stderr, "[dynmesh-mpi] %d ranks, partition level %d\n", nranks, partition_level);
   for (int r = 0; r < nranks; ++r) std::fprintf(stderr, "%s\n", all.data() + static_cast<std::size_t>(r) * sizeof line);
 }
 
@@ -155,21 +166,51 @@ int run(MPI_Comm comm, const Options& o, Columns columns) {
       return 1;
     }
   }
-  if (o.stats) print_stats<d>(comm, *tree);
+  MpiRankStats rank_stats;
+  int partition_level = 0;
+  if (o.stats) rank_stats = tree->rank_stats(), partition_level = tree->partition_level();
 
-  // Free the trees before the leaves meet on rank 0: the trace is most of the memory.
+  // Free the trees before the leaves meet on rank 0: the trace is most of the memory. Rank 0
+  // then writes OUT as the ranks' sorted leaves arrive, a chunk at a time
+  // (detail/merge_on_root.hpp), so that no rank ever holds every leaf.
   const std::vector<Leaf<d>> local = tree->local_leaves();
   tree.reset();
-  const std::vector<Leaf<d>> leaves = gather_leaves<d>(comm, local, 0);
+  // The writing's own peak (--measure-writing): the peak counter restarts from the resident
+  // set left once the tree is gone, so an outside measure of the peak sees the writing only.
+  const double tree_peak = o.stats ? peak_rss_mib() : -1;
+  const bool writing_measured = o.stats && o.measure_writing && reset_peak_rss();
+  const double writing_from = writing_measured ? rss_mib() : -1;
+  AtomicOutputs out;
+  AtomicOutputs::Stream* file = nullptr;
   if (root) {
     try {
-      AtomicOutputs out;
-      out.add(o.cells, format_cells<d>(box, leaves));
-      out.commit();
-      if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", initial->duplicates_skipped);
+      file = &out.open_stream(o.cells);
+      file->append(format_cells_header<d>(box));
     } catch (const std::exception& e) {
       message = e.what();
+      file = nullptr;  // the merge still runs, so that no rank waits forever
     }
+  }
+  std::string text;
+  try {
+    dynmesh::detail::merge_on_root<Leaf<d>>(
+        comm, std::span<const Leaf<d>>(local), 0, [](const Leaf<d>& a, const Leaf<d>& b) { return a.cell < b.cell; },
+        [&](std::span<const Leaf<d>> part) {
+          if (!file) return;
+          text.clear();
+          append_cells_lines<d>(text, part);
+          file->append(text);
+        });
+    if (file) {
+      out.commit();
+      if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", initial->duplicates_skipped);
+    }
+  } catch (const std::exception& e) {
+    if (root && message.empty()) message = e.what();
+  }
+  if (o.stats) {
+    const double writing_peak = writing_measured ? peak_rss_mib() : -1;
+    print_stats(comm, rank_stats, partition_level, std::max(tree_peak, writing_peak), writing_peak, writing_from);
   }
   if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
   return 0;
@@ -198,11 +239,13 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
   q->add_option("--batch", o.batch, "propagate K consecutive edits together on all ranks (default: each alone)")
       ->check(whole_number(1, std::numeric_limits<std::size_t>::max()));
   q->add_option("--cells", o.cells, "output: the final leaves as .cells (written by rank 0)")->required();
-  q->add_flag("--stats", o.stats, "per rank on stderr: points owned, ghost points, trace bytes, mean propagation time");
+  q->add_flag("--stats", o.stats, "per rank on stderr: points owned, ghost points, trace bytes, mean propagation time, peak "
+              "resident memory");
   // Test and experiment knobs, not part of the contract: hidden from --help.
   q->add_option("--partition-level", o.partition_level)->check(CLI::Range(0, 10))->group("");
   q->add_option("--ghost-ring", o.ghost_ring)->check(CLI::Range(0, 3))->group("");
   q->add_option("--rebalance", o.rebalance)->check(CLI::Range(0.0, 1e9))->group("");
+  q->add_flag("--measure-writing", o.measure_writing)->group("");
   q->parse_complete_callback([&o] {
     const std::string clash = output_overwrites_input({{"POINTS", o.points}, {"--edits", o.edits}}, {{"--cells", o.cells}});
     if (!clash.empty()) throw CLI::ValidationError(clash);

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# tests/mpi/mpi_test.sh CASE MPIEXEC DYNMESH DYNMESH_MPI MPI_GEN WORK_DIR [MPI_QUADTREE_TEST] —
+# tests/mpi/mpi_test.sh CASE MPIEXEC DYNMESH DYNMESH_MPI MPI_GEN WORK_DIR [UNIT] —
 # end-to-end tests of `dynmesh-mpi quadtree` (docs/FORMATS.md, docs/DISTRIBUTED.md): its
 # `.cells` must equal `dynmesh quadtree`'s byte for byte for every number of ranks; bad input
 # gives one line of ours from rank 0 and a non-zero status on every rank, within a timeout.
-# The cases differential2 and differential3 run MPI_QUADTREE_TEST on 2 and 3 ranks. One ctest
+# The cases differential2 and differential3 run UNIT (mpi_quadtree_test) on 2 and 3 ranks, merge1
+# and merge3 run the merge's own test (passed in its place) on 1 and 3 ranks. One ctest
 # per CASE (tests/mpi/CMakeLists.txt). Exit 0 pass, 1 fail.
 #
 # Every launch is isolated and judged apart from the launcher:
@@ -153,6 +154,13 @@ errors_case() {
   expect_error "NaN or infinite" s.xyz --edits inf.edits
   expect_error "exceeds the resolution" s.xyz --edits res.edits --batch 2
   expect_error "cannot open" missing.xyz
+  # An output that cannot be written: rank 0 finds it before the leaves merge, which still
+  # runs to its end, so no rank waits forever; one line of ours, every rank non-zero.
+  mpi 3 quadtree s.xyz --cells nodir/x.cells && fail "writing into a missing directory succeeded"
+  grep -qx 0 <<<"$statuses" && fail "a rank exited 0 on an output it cannot write"
+  our_lines noise.txt err.txt >ours.txt
+  [[ $(wc -l <ours.txt) -eq 1 ]] && grep -qF "nodir/x.cells" ours.txt ||
+    { cat err.txt >&2; fail "an unwritable output: not one line of ours naming the file: $(cat ours.txt)"; }
 }
 
 case $case_name in
@@ -219,8 +227,13 @@ case $case_name in
     grep -q hwloc noise.txt || fail "hwloc printed no warning: the case no longer shows the launcher's notices"
     ;;
   differential2 | differential3) # MpiQuadtree against StaticQuadtree after every batch
-    [[ -x $unit ]] || fail "no MPI_QUADTREE_TEST given"
+    [[ -x $unit ]] || fail "no mpi_quadtree_test given"
     launch "${case_name#differential}" "$unit" || { cat out.txt err.txt >&2; fail "mpi_quadtree_test failed"; }
+    cat out.txt
+    ;;
+  merge1 | merge3) # the ranks' sorted parts merged on rank 0 as a stream (UNIT: merge_on_root_test)
+    [[ -x $unit ]] || fail "no merge_on_root_test given"
+    launch "${case_name#merge}" "$unit" || { cat out.txt err.txt >&2; fail "merge_on_root_test failed"; }
     cat out.txt
     ;;
   real_world) # data the project did not write: gnuplot's world coastline (gnuplot-doc, dev.sh deps)

@@ -171,6 +171,12 @@ void write_cells(std::ostream& out, const Box<d>& box, std::span<const Leaf<d>> 
 /// The `.cells` text as a string (what write_cells writes).
 template <std::size_t d>
 std::string format_cells(const Box<d>& box, std::span<const Leaf<d>> leaves);
+/// The same text in pieces, for a writer that streams the leaves (dynmesh-mpi): the three
+/// header lines, then a line per leaf of `sorted` (already in (level, i, j, k) order).
+template <std::size_t d>
+std::string format_cells_header(const Box<d>& box);
+template <std::size_t d>
+void append_cells_lines(std::string& out, std::span<const Leaf<d>> sorted);
 /// Writes to `path`; InputError(Io) when the file cannot be written.
 template <std::size_t d>
 void write_cells_file(const std::string& path, const Box<d>& box, std::span<const Leaf<d>> leaves);

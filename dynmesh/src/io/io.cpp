@@ -853,9 +853,7 @@ EditScript<d> read_edits_file(const std::string& path) {
 // .cells
 
 template <std::size_t d>
-std::string format_cells(const Box<d>& box, std::span<const Leaf<d>> leaves) {
-  std::vector<Leaf<d>> sorted(leaves.begin(), leaves.end());
-  std::sort(sorted.begin(), sorted.end(), [](const Leaf<d>& a, const Leaf<d>& b) { return a.cell < b.cell; });
+std::string format_cells_header(const Box<d>& box) {
   std::string s = "# dynmesh cells v1\n# dim ";
   detail::append_number(s, d);
   s += "\n# box";
@@ -866,6 +864,11 @@ std::string format_cells(const Box<d>& box, std::span<const Leaf<d>> leaves) {
   s += ' ';
   s += format_exact(box.side);
   s += '\n';
+  return s;
+}
+
+template <std::size_t d>
+void append_cells_lines(std::string& s, std::span<const Leaf<d>> sorted) {
   s.reserve(s.size() + sorted.size() * (8 + 14 * d));
   for (const Leaf<d>& leaf : sorted) {
     detail::append_number(s, static_cast<std::size_t>(leaf.cell.level));
@@ -877,6 +880,14 @@ std::string format_cells(const Box<d>& box, std::span<const Leaf<d>> leaves) {
     detail::append_number(s, leaf.npoints);
     s += '\n';
   }
+}
+
+template <std::size_t d>
+std::string format_cells(const Box<d>& box, std::span<const Leaf<d>> leaves) {
+  std::vector<Leaf<d>> sorted(leaves.begin(), leaves.end());
+  std::sort(sorted.begin(), sorted.end(), [](const Leaf<d>& a, const Leaf<d>& b) { return a.cell < b.cell; });
+  std::string s = format_cells_header<d>(box);
+  append_cells_lines<d>(s, sorted);
   return s;
 }
 
@@ -961,6 +972,8 @@ CellsFile<d> read_cells_file(const std::string& path) {
   template EditScript<D> read_edits<D>(std::istream&, const std::string&);                           \
   template EditScript<D> read_edits_file<D>(const std::string&);                                     \
   template std::string format_cells<D>(const Box<D>&, std::span<const Leaf<D>>);                     \
+  template std::string format_cells_header<D>(const Box<D>&);                                          \
+  template void append_cells_lines<D>(std::string&, std::span<const Leaf<D>>);                        \
   template void write_cells<D>(std::ostream&, const Box<D>&, std::span<const Leaf<D>>);              \
   template void write_cells_file<D>(const std::string&, const Box<D>&, std::span<const Leaf<D>>);    \
   template CellsFile<D> read_cells<D>(std::istream&, const std::string&);                            \
