@@ -177,7 +177,7 @@ int run(MPI_Comm comm, const Options& o, Columns columns) {
   tree.reset();
   // The writing's own peak (--measure-writing): the peak counter restarts from the resident
   // set left once the tree is gone, so an outside measure of the peak sees the writing only.
-  const double tree_peak = o.stats ? peak_rss_mib() : -1;
+  const double tree_peak = o.stats && o.measure_writing ? peak_rss_mib() : -1;
   const bool writing_measured = o.stats && o.measure_writing && reset_peak_rss();
   const double writing_from = writing_measured ? rss_mib() : -1;
   AtomicOutputs out;
@@ -209,8 +209,11 @@ int run(MPI_Comm comm, const Options& o, Columns columns) {
     if (root && message.empty()) message = e.what();
   }
   if (o.stats) {
+    // Without the restart the counter has seen the whole run; with it, the run's peak is the
+    // larger of the two phases'.
     const double writing_peak = writing_measured ? peak_rss_mib() : -1;
-    print_stats(comm, rank_stats, partition_level, std::max(tree_peak, writing_peak), writing_peak, writing_from);
+    const double run_peak = writing_measured ? std::max(tree_peak, writing_peak) : peak_rss_mib();
+    print_stats(comm, rank_stats, partition_level, run_peak, writing_peak, writing_from);
   }
   if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
   return 0;

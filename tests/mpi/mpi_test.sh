@@ -214,7 +214,13 @@ case $case_name in
     for p in 2 3 4; do
       same "$p" u.xyz --box 0 0 1 --edits move.edits --batch 50 --stats
       grep -q ' [1-9][0-9]* repartitions' err.txt || { cat err.txt >&2; fail "-np $p: no repartition happened"; }
+      [[ $(grep -c '^\[dynmesh-mpi\] rank [0-9]*: .*, peak_rss [0-9]* MiB$' err.txt) -eq $p ]] ||
+        { cat err.txt >&2; fail "-np $p --stats: not a line with peak_rss for every rank"; }
     done
+    # The writing's own peak (hidden --measure-writing), on every rank's line.
+    same 3 u.xyz --box 0 0 1 --edits move.edits --batch 50 --stats --measure-writing
+    [[ $(grep -c ', peak_rss [0-9]* MiB, writing peak_rss [0-9]* MiB (from [0-9]* MiB)$' err.txt) -eq 3 ]] ||
+      { cat err.txt >&2; fail "--measure-writing: not a writing peak on every rank's line"; }
     same 2 u.xyz --box 0 0 1 --edits move.edits --batch 50 --rebalance 0
     ;;
   errors) # bad input: one line of ours from rank 0, every rank non-zero, nothing written
