@@ -3,9 +3,10 @@
 // sorted part of a random set (sizes uneven, some parts empty, the root's too) and merges
 // with chunks of 1, 3 and the default, so that every rank's part arrives in many messages:
 // the root must see the sorted union, in chunks of at most the chunk size, and the other
-// ranks nothing. Then the failures: parts that overlap give InvariantError on the root; a
-// sink that throws stops being called, the root still takes every chunk (no rank is left
-// sending) and rethrows; the other ranks return normally.
+// ranks nothing. Then the failures: a chunk of 0 elements is refused on every rank; parts
+// that overlap give InvariantError on the root; a sink that throws stops being called, the
+// root still takes every chunk (no rank is left sending) and rethrows; the other ranks
+// return normally.
 // Exit status 0 when every check passed on every rank, 1 otherwise.
 #include <algorithm>
 #include <cstdint>
@@ -126,6 +127,13 @@ int main(int argc, char** argv) {
       if (g_ranks > 2) merges(5, 300, 2, chunk);
     }
     overlapping_parts_fail();
+    bool refused = false;
+    try {
+      dynmesh::detail::merge_on_root<Item>(MPI_COMM_WORLD, std::span<const Item>(), 0, less, [](std::span<const Item>) {}, 0);
+    } catch (const std::invalid_argument&) {
+      refused = true;
+    }
+    check(refused, "a chunk of 0 elements was not refused");
     throwing_sink_drains();
   } catch (const std::exception& e) {
     check(false, std::string("exception: ") + e.what());

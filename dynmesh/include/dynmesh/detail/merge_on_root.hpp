@@ -12,18 +12,22 @@
 // order of arrival can deadlock.
 // Invariants (checked on the root): each part is sorted by `less` and the parts are
 // disjoint, i.e. the merged sequence is strictly increasing; InvariantError otherwise.
-// Errors: a sink that throws stops being called, but the root still receives every chunk
-// (no rank is left in MPI_Send), then rethrows; other ranks return normally, so a caller
-// agrees on the failure afterwards (the tool's shared_failure).
+// Errors: a chunk of 0 elements, or of more bytes than an MPI count holds, throws
+// std::invalid_argument on every rank before any message. A sink that throws stops being
+// called, but the root still receives every chunk (no rank is left in MPI_Send), then
+// rethrows; other ranks return normally, so a caller agrees on the failure afterwards (the
+// tool's shared_failure).
 // Complexity: O(N lg P) comparisons on the root for N elements in all; O(N/chunk) messages.
 // Paper: none (a k-way merge; the ranks' parts are runs of the global order).
 #pragma once
 
 #include <algorithm>
+#include <climits>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
 #include <span>
+#include <stdexcept>
 #include <type_traits>
 #include <vector>
 
@@ -41,6 +45,9 @@ void merge_on_root(MPI_Comm comm, std::span<const T> local, int root, Less less,
                    std::size_t chunk = std::size_t{1} << 16) {
   static_assert(std::is_trivially_copyable_v<T>, "the parts travel as bytes");
   constexpr int kTag = 0x6d65;  // 'me': the merge's messages, apart from any other traffic
+  // Every rank is given the same chunk, so every rank refuses it alike, before any message.
+  if (chunk == 0 || chunk > static_cast<std::size_t>(INT_MAX) / sizeof(T))
+    throw std::invalid_argument("dynmesh: merge on root: a chunk must hold 1 to INT_MAX bytes' worth of elements");
   int rank = 0, nranks = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &nranks);
