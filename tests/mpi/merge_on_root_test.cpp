@@ -20,18 +20,16 @@
 
 #include <mpi.h>
 
+#include "mpi_checks.hpp"
+
 #include "dynmesh/detail/merge_on_root.hpp"
 #include "dynmesh/errors.hpp"
 
 namespace {
 
-int g_rank = 0, g_ranks = 1, g_failures = 0;
-
-void check(bool ok, const std::string& what) {
-  if (ok) return;
-  ++g_failures;
-  std::fprintf(stderr, "FAIL (rank %d): %s\n", g_rank, what.c_str());
-}
+using mpi_checks::check;
+using mpi_checks::g_rank;
+using mpi_checks::g_ranks;
 
 struct Item {
   std::uint64_t key;
@@ -115,9 +113,7 @@ void throwing_sink_drains() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &g_ranks);
+  mpi_checks::start(&argc, &argv);
   try {
     for (const std::size_t chunk : {std::size_t{1}, std::size_t{3}, std::size_t{1} << 16}) {
       merges(1, 2000, -1, chunk);
@@ -138,9 +134,5 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     check(false, std::string("exception: ") + e.what());
   }
-  int mine = g_failures, total = 0;
-  MPI_Allreduce(&mine, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  if (g_rank == 0) std::printf("merge_on_root_test on %d ranks: %s\n", g_ranks, total ? "FAILED" : "passed");
-  MPI_Finalize();
-  return total ? 1 : 0;
+  return mpi_checks::finish("merge_on_root_test");
 }

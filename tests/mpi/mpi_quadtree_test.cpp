@@ -17,6 +17,8 @@
 
 #include <mpi.h>
 
+#include "mpi_checks.hpp"
+
 #include "dynmesh/box.hpp"
 #include "dynmesh/distributions.hpp"
 #include "dynmesh/errors.hpp"
@@ -27,13 +29,9 @@ namespace {
 
 using namespace dynmesh;
 
-int g_rank = 0, g_ranks = 1, g_failures = 0;
-
-void check(bool ok, const std::string& what) {
-  if (ok) return;
-  ++g_failures;
-  std::fprintf(stderr, "FAIL (rank %d): %s\n", g_rank, what.c_str());
-}
+using mpi_checks::check;
+using mpi_checks::g_rank;
+using mpi_checks::g_ranks;
 
 /// Rank r's contiguous share of v.
 template <class T>
@@ -166,9 +164,7 @@ void repartition() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &g_ranks);
+  mpi_checks::start(&argc, &argv);
   try {
     for (const Distribution dist : {Distribution::Uniform, Distribution::Clusters, Distribution::Shrinking}) {
       differential<2>(dist, 1, {});
@@ -183,9 +179,5 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     check(false, std::string("exception: ") + e.what());
   }
-  int mine = g_failures, total = 0;
-  MPI_Allreduce(&mine, &total, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
-  if (g_rank == 0) std::printf("mpi_quadtree_test on %d ranks: %s\n", g_ranks, total ? "FAILED" : "passed");
-  MPI_Finalize();
-  return total ? 1 : 0;
+  return mpi_checks::finish("mpi_quadtree_test");
 }
