@@ -22,12 +22,14 @@
 // --held-stars prints instead what stars held from one walk to the next would save: the
 // collects whose walk repeats the vertex's previous one, and the final walks of a star the
 // vertex's last collect walked whole, with their left searches.
-// --maintained-stars prints instead what stars kept up to date by the insertions would
-// answer (src/hpu/star_ledger.hpp): the collects (other than an inserted vertex's first,
-// which is its insertion's walk) whose triangles within the cap some walk had met while they
-// lived, their share of the collects' left searches and of the triangles they need that no
-// walk had met; the inserted vertices' first collects; the final walks answered likewise;
-// and the share of all left searches that the answered collects and final walks make.
+// --maintained-stars prints instead what stars kept up to date by the walks would answer
+// (src/hpu/star_ledger.hpp): the collects a held star replays and their share of the
+// collects' left searches; the share of the new vertices' first collects' searches
+// replayed; the collects' searches the oracle answers (every triangle within the cap held)
+// and the share of the triangles within the caps that no walk had met; the final walks'
+// searches whose emitted triangles, and whose whole star, were held; and the share of all
+// left searches that the replayed collects and the answered final walks make (and with the
+// oracle's collects).
 //
 //   dynmesh_hpu_locality [--dist spiral,curves,uniform] [--n 1000,4000,16000] [--updates 20]
 //                        [--seed 1] [--angle 20.7] [--csv] [--by-class] [--reach] [--time] [--profile]
@@ -159,8 +161,8 @@ int main(int argc, char** argv) {
                "walked whole");
   bool maintained = false;
   app.add_flag("--maintained-stars", maintained,
-               "only print, per (distribution, n), what stars kept up to date by the insertions would answer: "
-               "collects whose triangles within the cap some walk had met, final walks likewise");
+               "only print, per (distribution, n), what stars kept up to date by the walks would answer: collects "
+               "a held star replays, final walks whose triangles some walk had met");
   CLI11_PARSE(app, argc, argv);
 
 

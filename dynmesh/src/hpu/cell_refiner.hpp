@@ -78,7 +78,7 @@ struct CellRefineOptions {
   bool check_tree = false;  // BucketTree::check_invariants after every insertion (O(n) each)
   bool log_steps = false;   // fill CellRefinement::steps
   bool held_stars = false;  // count what stars held by the cells would save (CellQuestionStats)
-  /// Count what stars kept up to date by the insertions would answer (star_ledger.hpp;
+  /// Count what stars kept up to date by the walks would answer (star_ledger.hpp;
   /// CellRefinement::maintained). Keeps a shadow triangulation beside the refiner.
   bool maintained_stars = false;
 };

@@ -1,12 +1,11 @@
-// star_ledger.hpp (private) — what stars kept up to date by the insertions would answer: a
+// star_ledger.hpp (private) — what stars kept up to date by the walks would answer: a
 // measurement of the cell refiner (cell_refiner.hpp, CellRefineOptions::maintained_stars).
 //
 // Purpose: the design of stars held by the cells (docs/HPU_ON_CELLS.md, "Open") stores, for
-// each vertex, the triangles at it that some walk has found, and keeps them up to date as
-// vertices arrive: an insertion removes the triangles whose circles hold the new vertex, and
-// the new vertex's own walk, capped as its birth collect would be, writes the triangles it
-// meets into the stars of their corners. A collect of class j is then answered without a
-// left search when every triangle at its vertex of circumradius up to its cap is held. The
+// each vertex, the triangles at it that some walk has met, and keeps them up to date as
+// vertices arrive: every walk writes the triangles it meets into the stars of their three
+// corners, and an insertion removes the triangles whose circles hold the new vertex. A
+// collect then needs no left search when its walk can be replayed from what is held. The
 // ledger follows that design beside the refiner, without changing a question:
 //   - a shadow Delaunay triangulation (geometry/delaunay.hpp) of the same vertices, inserted
 //     in the refiner's order, tells which triangles are alive;
@@ -23,8 +22,9 @@
 // Invariants (check_invariants()): the shadow triangulation's, each refiner vertex is the
 // shadow vertex at its point, and every triangle slot has a held flag and certificates;
 // check_mesh() compares the shadow's triangles with the refiner's mesh.
-// Complexity: each insertion the shadow triangulation's (O(1) expected near its hint) plus a
-// star walk; each collect a star walk. A measurement: off unless asked for.
+// Complexity: each insertion the shadow triangulation's (O(1) expected near its hint); each
+// collect and final walk a star of the shadow triangulation. A measurement: off unless asked
+// for.
 // Paper: Acar & Hudson, Figure 5 (the collects); docs/HPU_ON_CELLS.md, "A vertex's star".
 #pragma once
 
