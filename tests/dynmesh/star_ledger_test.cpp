@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cstddef>
-#include <limits>
 #include <set>
 #include <vector>
 
@@ -20,7 +19,7 @@ namespace {
 using namespace dynmesh;
 using detail::StarLedger;
 using dynmesh_test::kSanitized;
-constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kNoCap = StarLedger::kNoCap;  // every triangle
 
 /// The unit box's corners as vertices 0-3 (counter-clockwise from the origin) and its
 /// centre as vertex 4, whose star is the four corners.
@@ -36,38 +35,39 @@ StarLedger centre_of_the_box() {
 TEST(StarLedger, AWalkHoldsItsTrianglesUntilAnInsertionInTheirCirclesDropsThem) {
   StarLedger ledger = centre_of_the_box();
   std::size_t needed = 0, unheld = 0;
-  EXPECT_FALSE(ledger.all_held(4, kInf, needed, unheld));
+  EXPECT_FALSE(ledger.all_held(4, kNoCap, needed, unheld));
   EXPECT_EQ(needed, 4u);
   EXPECT_EQ(unheld, 4u);
   const std::vector<StarLedger::Vid> star{0, 1, 2, 3};
-  EXPECT_FALSE(ledger.replays(4, star, true, true, kInf));
-  ledger.walked(4, star, true, true, kInf);
-  EXPECT_TRUE(ledger.replays(4, star, true, true, kInf));
+  EXPECT_FALSE(ledger.replays(4, star, true, true, kNoCap));
+  ledger.walked(4, star, true, true, kNoCap);
+  EXPECT_TRUE(ledger.replays(4, star, true, true, kNoCap));
   needed = unheld = 0;
-  EXPECT_TRUE(ledger.all_held(4, kInf, needed, unheld));
+  EXPECT_TRUE(ledger.all_held(4, kNoCap, needed, unheld));
   EXPECT_EQ(unheld, 0u);
   // A vertex near the bottom side lies in the circle of (4, 0, 1) only: the centre's other
   // three triangles stay held, and the two new ones at it are not.
   ledger.add(5, {0.5, 0.1}, 4);
   ledger.check_invariants();
   needed = unheld = 0;
-  EXPECT_FALSE(ledger.all_held(4, kInf, needed, unheld));
+  EXPECT_FALSE(ledger.all_held(4, kNoCap, needed, unheld));
   EXPECT_EQ(needed, 5u);
   EXPECT_EQ(unheld, 2u);
 }
 
 TEST(StarLedger, AGapsCertificateAnswersCapsUpToItsOwn) {
-  // The centre's four triangles have circumradius 1/2. A walk capped below that meets none
-  // of them: a run of one vertex, with both ends at the same gap.
+  // The centre's four triangles have circumradius 1/2 = 2^(−2+1), within cap −2. A walk
+  // capped at −3 (circumradius up to 1/4) meets none of them: a run of one vertex, with both
+  // ends at the same gap.
   StarLedger ledger = centre_of_the_box();
   const std::vector<StarLedger::Vid> run{0};
-  ledger.walked(4, run, false, false, 0.4);
-  EXPECT_TRUE(ledger.replays(4, run, false, false, 0.4));
-  EXPECT_TRUE(ledger.replays(4, run, false, false, 0.2));
-  EXPECT_FALSE(ledger.replays(4, run, false, false, 0.45));  // beyond what the walk certified
+  ledger.walked(4, run, false, false, -3);
+  EXPECT_TRUE(ledger.replays(4, run, false, false, -3));
+  EXPECT_TRUE(ledger.replays(4, run, false, false, -4));
+  EXPECT_FALSE(ledger.replays(4, run, false, false, -2));  // beyond what the walk certified
   // A vertex inside the gap's triangles makes new ones, which carry no certificate.
   ledger.add(5, {0.5, 0.2}, 4);
-  EXPECT_FALSE(ledger.replays(4, run, false, false, 0.25));
+  EXPECT_FALSE(ledger.replays(4, run, false, false, -4));
 }
 
 TEST(StarLedger, TheMaintainedStarsCountLeavesTheMeshAloneAndCountsPartsOfWholes) {

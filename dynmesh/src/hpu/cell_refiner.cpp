@@ -94,8 +94,8 @@ class CellRefiner {
       bool all_held = false, whole_held = false;
       if (ledger_) {
         std::size_t needed = 0, unheld = 0;
-        all_held = ledger_->all_held(v, 0.0, needed, unheld, true);
-        whole_held = ledger_->all_held(v, std::numeric_limits<double>::infinity(), needed, unheld);
+        all_held = ledger_->all_held(v, StarLedger::kNoCap, needed, unheld, true);
+        whole_held = ledger_->all_held(v, StarLedger::kNoCap, needed, unheld);
       }
       questions_.triangles_of(v, 0.0, mine);
       if (held_stars_) final_asks_.push_back(out_.questions.neighbour_asks - asks);
@@ -177,7 +177,7 @@ class CellRefiner {
     const std::size_t asks = out_.questions.neighbour_asks;
     bool all_held = false;
     if (ledger_)
-      all_held = ledger_->all_held(v, collect_reach(j), out_.maintained.needed_triangles, out_.maintained.unheld_triangles);
+      all_held = ledger_->all_held(v, j + kGoOnReach, out_.maintained.needed_triangles, out_.maintained.unheld_triangles);
     const bool go_on = questions_.collect(v, j, birth, local_pairs_);
     if (held_stars_) count_held(v, j, out_.questions.neighbour_asks - asks);
     if (ledger_) count_maintained(v, j, birth, all_held, out_.questions.neighbour_asks - asks);
@@ -224,9 +224,6 @@ class CellRefiner {
     queues_[j].push_back({v, true});
   }
 
-  /// The cap of a collect of class j (CellQuestions::collect's reach).
-  static double collect_reach(int j) { return std::ldexp(1.0 + 0x1p-20, j + 1 + kGoOnReach); }
-
   // The maintained-stars count (star_ledger.hpp): a collect a held star replays makes no
   // walk; any other walks, and what it meets becomes held. The first collects of vertices
   // the refinement inserted are counted apart too.
@@ -234,12 +231,12 @@ class CellRefiner {
     MaintainedStarStats& m = out_.maintained;
     const bool whole = questions_.star_gap_ends() == 0;
     const bool closed = whole && !questions_.on_boundary(v);
-    const bool replays = ledger_->replays(v, questions_.star(), whole, closed, collect_reach(j));
+    const bool replays = ledger_->replays(v, questions_.star(), whole, closed, j + kGoOnReach);
     ++m.collects;
     m.collect_asks += asks;
     if (all_held) ++m.answered, m.answered_asks += asks;
     if (replays) ++m.answered_design, m.answered_design_asks += asks;
-    else ledger_->walked(v, questions_.star(), whole, closed, collect_reach(j));
+    else ledger_->walked(v, questions_.star(), whole, closed, j + kGoOnReach);
     if (birth && v >= first_inserted_) {
       ++m.births;
       m.birth_asks += asks;

@@ -13,7 +13,8 @@
 //     final walk's actual runs): the walk writes it into the stars of its three corners,
 //     and the insertion of a vertex inside its circle removes it;
 //   - a walk that stops at its cap leaves a *certificate* on the triangle there: its
-//     circumradius exceeds that cap (a triangle's certificates die with it);
+//     circumradius exceeds that cap (a triangle's certificates die with it). Caps are the
+//     continuation rule's classes, sized by its own test (circumradius_above);
 //   - a collect is answered *by the design* when its walk's runs are held and each run
 //     ends at a box side or at a triangle that is held (its circle is known) or certified
 //     for at least the collect's cap: a held star then replays the walk. It is answered
@@ -30,7 +31,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -41,6 +41,7 @@
 #include "dynmesh/mesh.hpp"
 #include "dynmesh/point.hpp"
 #include "geometry/delaunay.hpp"
+#include "hpu/hpu_geometry.hpp"  // circumradius_above, kGoOnReach
 
 namespace dynmesh::detail {
 
@@ -65,7 +66,7 @@ class StarLedger {
   using Vid = std::uint32_t;
 
   explicit StarLedger(const Box<2>& box)
-      : dt_(box), held_(dt_.num_slots(), 0), certs_(dt_.num_slots(), {0, 0, 0}) {}
+      : dt_(box), held_(dt_.num_slots(), 0), certs_(dt_.num_slots(), kNoCerts) {}
 
   static constexpr Vid kNone = Delaunay::kNone;
 
@@ -87,19 +88,24 @@ class StarLedger {
       to_dt_.push_back(found);
     }
     held_.resize(dt_.num_slots(), 0);
-    certs_.resize(dt_.num_slots());
-    for (const Tid t : created_) held_[t] = 0, certs_[t] = {0, 0, 0};  // new triangles in reused slots
+    certs_.resize(dt_.num_slots(), kNoCerts);
+    for (const Tid t : created_) held_[t] = 0, certs_[t] = kNoCerts;  // new triangles in reused slots
   }
 
-  /// Are all triangles at v of circumradius up to R held? Counts them into `needed` and
-  /// the unheld ones into `unheld`. `emitted`: only those v emits in the final mesh (v is
-  /// their (x, y)-smallest corner), whatever their size.
-  bool all_held(Vid v, double R, std::size_t& needed, std::size_t& unheld, bool emitted = false) {
+  /// Caps are classes, as the continuation rule's: cap c means circumradius up to 2^(c+1)
+  /// (circumradius_above, hpu_geometry.hpp); a collect of class j walks with cap
+  /// j + kGoOnReach. kNoCap: every triangle.
+  static constexpr int kNoCap = 4000;
+  static constexpr int kNoCert = -4000;
+
+  /// Are all triangles at v within cap c held? Counts them into `needed` and the unheld
+  /// ones into `unheld`. `emitted`: only those v emits in the final mesh (v is their (x,
+  /// y)-smallest corner), whatever their size.
+  bool all_held(Vid v, int c, std::size_t& needed, std::size_t& unheld, bool emitted = false) {
     const Vid dv = to_dt_[v];
     dt_.star(dv, nb_, left_);
     bool all = true;
-    for (std::size_t i = 0; i < left_.size(); ++i) {
-      const Tid t = left_[i];
+    for (const Tid t : left_) {
       if (t == kNone) continue;
       if (emitted) {
         const Point<2>& p = dt_.point(dv);
@@ -108,7 +114,7 @@ class StarLedger {
         for (const Vid w : T.v)
           if (w != dv && !xy_less(p, dt_.point(w))) smallest = false;
         if (!smallest) continue;
-      } else if (radius(t) > R) {
+      } else if (beyond(t, c)) {
         continue;
       }
       ++needed;
@@ -117,35 +123,26 @@ class StarLedger {
     return all;
   }
 
-  /// Could a held star replay the walk of v with cap R whose runs are `star` (as
+  /// Could a held star replay the walk of v with cap c whose runs are `star` (as
   /// CellQuestions::star() leaves them; `whole`: no gap; `closed`: an interior vertex's
   /// whole cycle)? Its triangles must be held, and each end at a gap held or certified.
-  bool replays(Vid v, const std::vector<Vid>& star, bool whole, bool closed, double R) const {
-    const Vid dv = to_dt_[v];
-    const std::size_t d = star.size();
-    for (std::size_t i = 0; i + 1 < d || (closed && d > 2 && i < d); ++i)
-      if (!held_[triangle(dv, to_dt_[star[i]], to_dt_[star[(i + 1) % d]])]) return false;
-    if (whole || d == 0) return true;
-    for (const auto& e : {dt_.left_of(dv, to_dt_[star.back()]), dt_.left_of(to_dt_[star.front()], dv)})
-      if (e && !held_[e->first] && cert(e->first, dv) < R) return false;
-    return true;
+  bool replays(Vid v, const std::vector<Vid>& star, bool whole, bool closed, int c) const {
+    bool all = true;
+    for_each_walked(v, star, whole, closed, [&](Tid t) { all = all && held_[t]; },
+                    [&](Tid t, int k) { all = all && (held_[t] || certs_[t][k] >= c); });
+    return all;
   }
 
-  /// The walk of v with cap R whose runs are `star` (see replays()): its triangles become
+  /// The walk of v with cap c whose runs are `star` (see replays()): its triangles become
   /// held, and the triangles at its gap ends certified.
-  void walked(Vid v, const std::vector<Vid>& star, bool whole, bool closed, double R) {
-    const Vid dv = to_dt_[v];
-    const std::size_t d = star.size();
-    for (std::size_t i = 0; i + 1 < d || (closed && d > 2 && i < d); ++i)
-      mark(triangle(dv, to_dt_[star[i]], to_dt_[star[(i + 1) % d]]));
-    if (whole || d == 0) return;
-    for (const auto& e : {dt_.left_of(dv, to_dt_[star.back()]), dt_.left_of(to_dt_[star.front()], dv)})
-      if (e) certify(e->first, dv, R);
+  void walked(Vid v, const std::vector<Vid>& star, bool whole, bool closed, int c) {
+    for_each_walked(v, star, whole, closed, [&](Tid t) { held_[t] = 1; },
+                    [&](Tid t, int k) { certs_[t][k] = std::max(certs_[t][k], c); });
   }
 
   /// The final walk of v met the triangles (v, a, b) of `tris`: they become held.
   void walked_triangles(Vid v, const std::vector<std::array<Vid, 2>>& tris) {
-    for (const auto& [a, b] : tris) mark(triangle(to_dt_[v], to_dt_[a], to_dt_[b]));
+    for (const auto& [a, b] : tris) held_[triangle(to_dt_[v], to_dt_[a], to_dt_[b])] = 1;
   }
 
   /// The shadow triangulation's invariants, and a held flag and certificates for each of
@@ -164,22 +161,15 @@ class StarLedger {
     if (dt_.triangles() != mesh) throw InvariantError("dynmesh: star ledger: the shadow triangulation differs from the mesh");
   }
 
-
  private:
   using Tid = Delaunay::Tid;
+  static constexpr std::array<int, 3> kNoCerts{kNoCert, kNoCert, kNoCert};
 
-  double dist2(Vid a, Vid b) const {
-    const Point<2>&p = dt_.point(a), &q = dt_.point(b);
-    return (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]);
-  }
-  /// Circumradius in doubles: a measurement's cap, not a decision of the mesh.
-  double radius(Tid t) const {
+  /// Is t's circumradius above cap c? The continuation rule's own test, so that the ledger
+  /// sizes triangles as the refinement does.
+  bool beyond(Tid t, int c) const {
     const auto& T = dt_.tri(t);
-    const Point<2>&a = dt_.point(T.v[0]), &b = dt_.point(T.v[1]), &c = dt_.point(T.v[2]);
-    const double ab = std::hypot(b[0] - a[0], b[1] - a[1]), bc = std::hypot(c[0] - b[0], c[1] - b[1]),
-                 ca = std::hypot(a[0] - c[0], a[1] - c[1]);
-    const double twice_area = std::abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
-    return ab * bc * ca / (2 * twice_area);
+    return circumradius_above(dt_.point(T.v[0]), dt_.point(T.v[1]), dt_.point(T.v[2]), c);
   }
   /// The live triangle (v, a, b), counter-clockwise.
   Tid triangle(Vid v, Vid a, Vid b) const {
@@ -188,27 +178,30 @@ class StarLedger {
       throw InvariantError("dynmesh: star ledger: a walked triangle the shadow triangulation lacks");
     return e->first;
   }
-  /// The certificate v holds on t: t's circumradius exceeds it (0: none).
-  double cert(Tid t, Vid dv) const {
-    const auto& T = dt_.tri(t);
-    for (std::size_t k = 0; k < 3; ++k)
-      if (T.v[k] == dv) return certs_[t][k];
-    return 0;
-  }
-  void certify(Tid t, Vid dv, double R) {
-    const auto& T = dt_.tri(t);
-    for (std::size_t k = 0; k < 3; ++k)
-      if (T.v[k] == dv) certs_[t][k] = std::max(certs_[t][k], R);
-  }
-  void mark(Tid t) {
-    held_[t] = 1;
+  /// Calls on_run(t) for each triangle t of the walk's runs, and on_end(t, k) for the
+  /// triangle t at each gap end, k the walk's vertex's corner number in t.
+  template <class Run, class End>
+  void for_each_walked(Vid v, const std::vector<Vid>& star, bool whole, bool closed, Run on_run, End on_end) const {
+    const Vid dv = to_dt_[v];
+    const std::size_t d = star.size();
+    for (std::size_t i = 0; i + 1 < d || (closed && d > 2 && i < d); ++i)
+      on_run(triangle(dv, to_dt_[star[i]], to_dt_[star[(i + 1) % d]]));
+    if (whole || d == 0) return;
+    for (const auto& e : {dt_.left_of(dv, to_dt_[star.back()]), dt_.left_of(to_dt_[star.front()], dv)}) {
+      if (!e) continue;
+      const auto& T = dt_.tri(e->first);
+      for (int k = 0; k < 3; ++k)
+        if (T.v[static_cast<std::size_t>(k)] == dv) on_end(e->first, k);
+    }
   }
 
   Delaunay dt_;
   std::vector<Vid> to_dt_;          // the refiner's vertex → the shadow triangulation's
   std::vector<Point<2>> point_;     // the refiner's vertex → where it was added
   std::vector<std::uint8_t> held_;  // by triangle slot: met by a walk since it was made
-  std::vector<std::array<double, 3>> certs_;  // by triangle slot and corner: that corner's certificate
+  // By triangle slot and corner: the largest cap that corner's walks certified the triangle
+  // beyond (kNoCert: none).
+  std::vector<std::array<int, 3>> certs_;
   std::vector<Tid> created_, left_;
   std::vector<Vid> nb_;
 };
