@@ -1522,3 +1522,112 @@ TYPED_TEST(DynamicQuadtreeApi, IsSplitAndLeavesInAgreeWithTheOracle) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------
+// split_below: every cell coarser than a level split as well (the distributed meshes' local
+// trees). Oracle: T*'s leaves of that level or finer, and each coarser leaf of T* cut into
+// its descendants of that level (holding its point, if any).
+
+namespace {
+
+template <std::size_t d>
+std::vector<Leaf<d>> cut_to(const std::vector<Leaf<d>>& tree, int level, std::span<const Position<d>> pts) {
+  std::vector<Leaf<d>> out;
+  for (const Leaf<d>& leaf : tree) {
+    if (leaf.cell.level >= level) {
+      out.push_back(leaf);
+      continue;
+    }
+    const int shift = level - leaf.cell.level;
+    const std::uint64_t side = std::uint64_t{1} << shift;
+    std::uint64_t count = 1;
+    for (std::size_t a = 0; a < d; ++a) count *= side;
+    for (std::uint64_t code = 0; code < count; ++code) {
+      CellId<d> c;
+      c.level = level;
+      std::uint64_t rest = code;
+      for (std::size_t a = 0; a < d; ++a, rest >>= shift) c.index[a] = (leaf.cell.index[a] << shift) + (rest & (side - 1));
+      std::uint32_t k = 0;
+      for (const Position<d>& q : pts) k += contains(c, q) ? 1 : 0;
+      out.push_back(Leaf<d>{c, leaf.npoints == 0 ? 0 : k});
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+template <std::size_t d>
+void run_split_below(Distribution dist, std::uint64_t seed, int level, std::size_t updates) {
+  SCOPED_TRACE("seed " + std::to_string(seed) + ", split_below " + std::to_string(level));
+  const std::vector<Point<d>> pool = generate<d>(dist, scaled<std::size_t>(300), seed, 0x1p20);
+  const Box<d> box = derive_box<d>(pool);
+  Rng rng(seed + 99);
+  std::vector<Point<d>> present, absent;
+  for (const Point<d>& p : pool) (rng.below(2) ? present : absent).push_back(p);
+  DynamicQuadtree<d> tree(box, present, DynamicQuadtreeOptions{level});
+  for (std::size_t u = 0;; ++u) {
+    const std::vector<Point<d>> now = list_of(tree);
+    std::vector<Position<d>> qs;
+    for (const Point<d>& p : now) qs.push_back(locate(box, p));
+    const std::vector<Leaf<d>> want = cut_to<d>(oracle_leaves<d>(box, now), level, qs);
+    ASSERT_TRUE(same_leaves<d>(tree.leaves(), want)) << "after " << u << " updates";
+    ASSERT_NO_THROW(tree.check_invariants());
+    // From scratch on the same points: the same leaves.
+    ASSERT_EQ(DynamicQuadtree<d>(box, now, DynamicQuadtreeOptions{level}).leaves(), tree.leaves());
+    if (u == updates) break;
+    if (!absent.empty() && (rng.below(2) || tree.size() == 0)) {
+      const std::size_t i = rng.below(absent.size());
+      tree.insert(absent[i]);
+      absent.erase(absent.begin() + static_cast<std::ptrdiff_t>(i));
+    } else {
+      const std::vector<Point<d>> in = list_of(tree);
+      const Point<d> gone = in[rng.below(in.size())];
+      tree.erase(gone);
+      absent.push_back(gone);
+    }
+  }
+}
+
+}  // namespace
+
+TEST(DynamicQuadtreeSplitBelow, EqualsTStarCutToTheLevel2D) {
+  for (int level : {1, 2, 3, 4})
+    for (Distribution dist : {Distribution::Uniform, Distribution::Clusters, Distribution::Shrinking})
+      run_split_below<2>(dist, 11 + static_cast<std::uint64_t>(level), level, scaled<std::size_t>(60));
+}
+
+TEST(DynamicQuadtreeSplitBelow, EqualsTStarCutToTheLevel3D) {
+  for (int level : {1, 2})
+    for (Distribution dist : {Distribution::Uniform, Distribution::Clusters})
+      run_split_below<3>(dist, 21 + static_cast<std::uint64_t>(level), level, scaled<std::size_t>(30));
+}
+
+TEST(DynamicQuadtreeSplitBelow, EmptyAndSinglePointSetsAreCutToo) {
+  const Box<2> box{{0, 0}, 1};
+  DynamicQuadtree<2> empty(box, {}, DynamicQuadtreeOptions{2});
+  EXPECT_EQ(empty.leaves().size(), 16u);
+  EXPECT_NO_THROW(empty.check_invariants());
+  const PointId id = empty.insert({0.3, 0.3});
+  EXPECT_EQ(empty.leaves().size(), 16u);
+  empty.erase(id);
+  EXPECT_EQ(empty.leaves().size(), 16u);
+  EXPECT_NO_THROW(empty.check_invariants());
+}
+
+TEST(DynamicQuadtreeSplitBelow, LevelOutOfRangeIsRefused) {
+  const Box<2> box{{0, 0}, 1};
+  EXPECT_THROW(DynamicQuadtree<2>(box, {}, DynamicQuadtreeOptions{-1}), std::invalid_argument);
+  EXPECT_THROW(DynamicQuadtree<2>(box, {}, DynamicQuadtreeOptions{kMaxSplitBelow + 1}), std::invalid_argument);
+}
+
+TEST(DynamicQuadtreeSplitBelow, TheCheckerRefusesALeafAboveTheLevel) {
+  const Box<2> box{{0, 0}, 1};
+  const std::vector<Point<2>> pts{{0.1, 0.1}, {0.9, 0.9}};
+  std::vector<Position<2>> qs;
+  for (const auto& p : pts) qs.push_back(locate(box, p));
+  const auto t = oracle_leaves<2>(box, pts);  // leaves of level 1 and finer
+  EXPECT_TRUE(check_tree<2>(qs, t).ok());
+  EXPECT_FALSE(check_tree<2>(qs, t, 64, 3).ok());
+  EXPECT_TRUE(check_tree<2>(qs, cut_to<2>(t, 3, qs), 64, 3).ok());
+  EXPECT_FALSE(check_tree<2>(qs, cut_to<2>(t, 3, qs)).ok()) << "unforced, the cut tree has unjustified splits";
+}

@@ -3,8 +3,9 @@
 # end-to-end tests of `dynmesh-mpi quadtree` (docs/FORMATS.md, docs/DISTRIBUTED.md): its
 # `.cells` must equal `dynmesh quadtree`'s byte for byte for every number of ranks; bad input
 # gives one line of ours from rank 0 and a non-zero status on every rank, within a timeout.
-# The cases differential2 and differential3 run UNIT (mpi_quadtree_test) on 2 and 3 ranks, merge1
-# and merge3 run the merge's own test (passed in its place) on 1 and 3 ranks. One ctest
+# The cases differential2 and differential3 run UNIT (mpi_quadtree_test) on 2 and 3 ranks;
+# merge1/merge3 and number1/number3 run the writers' own tests (merge_on_root_test,
+# number_on_root_test, passed in its place) on 1 and 3 ranks. One ctest
 # per CASE (tests/mpi/CMakeLists.txt). Exit 0 pass, 1 fail.
 #
 # Every launch is isolated and judged apart from the launcher:
@@ -237,9 +238,9 @@ case $case_name in
     launch "${case_name#differential}" "$unit" || { cat out.txt err.txt >&2; fail "mpi_quadtree_test failed"; }
     cat out.txt
     ;;
-  merge1 | merge3) # the ranks' sorted parts merged on rank 0 as a stream (UNIT: merge_on_root_test)
-    [[ -x $unit ]] || fail "no merge_on_root_test given"
-    launch "${case_name#merge}" "$unit" || { cat out.txt err.txt >&2; fail "merge_on_root_test failed"; }
+  merge1 | merge3 | number1 | number3) # the writers' streamed merges on rank 0 (UNIT: their test)
+    [[ -x $unit ]] || fail "no unit test given"
+    launch "${case_name: -1}" "$unit" || { cat out.txt err.txt >&2; fail "$(basename "$unit") failed"; }
     cat out.txt
     ;;
   real_world) # data the project did not write: gnuplot's world coastline (gnuplot-doc, dev.sh deps)

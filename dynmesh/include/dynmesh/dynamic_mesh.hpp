@@ -59,6 +59,10 @@ struct MeshOptions {
   /// The hpu mesh's angle bound in degrees, 1 to 30 (InputError(Malformed) otherwise).
   /// Ignored by the quadtree mesh, whose bound is fixed.
   double min_angle = kHpuDefaultMinAngle;
+  /// The quadtree mesh's tree (DynamicQuadtreeOptions: a distributed mesh's ranks split
+  /// every cell coarser than their partition level). The hpu mesh takes the defaults only
+  /// (std::invalid_argument otherwise).
+  DynamicQuadtreeOptions tree{};
 };
 
 namespace detail {

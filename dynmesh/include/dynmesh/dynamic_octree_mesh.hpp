@@ -50,7 +50,10 @@ class DynamicOctreeMesh {
   /// Meshes `points` in `box` from scratch; ids are 0..n−1 in input order. InputError as
   /// DynamicQuadtree<3> reports it, plus Resolution for points the mesh cannot resolve in
   /// double precision.
-  explicit DynamicOctreeMesh(const Box<3>& box, std::span<const Point<3>> points = {});
+  /// `tree`: the octree's options (DynamicQuadtreeOptions; a distributed mesh's ranks split
+  /// every cell coarser than their partition level).
+  explicit DynamicOctreeMesh(const Box<3>& box, std::span<const Point<3>> points = {},
+                             const DynamicQuadtreeOptions& tree = {});
   ~DynamicOctreeMesh();
   DynamicOctreeMesh(DynamicOctreeMesh&&) noexcept;
   DynamicOctreeMesh& operator=(DynamicOctreeMesh&&) noexcept;

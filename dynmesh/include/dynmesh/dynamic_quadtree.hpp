@@ -87,6 +87,18 @@ struct QuadtreeMemory {
   }
 };
 
+/// The deepest level split_below may name: a distributed mesh's partition level is at most 10.
+inline constexpr int kMaxSplitBelow = 16;
+
+struct DynamicQuadtreeOptions {
+  /// Split every cell coarser than this level as well, whatever its points (0: T* itself).
+  /// A rank of a distributed mesh runs its program on some of the points with this set to
+  /// the partition level, so that its tree has the one-process shape there
+  /// (docs/DISTRIBUTED.md); the leaves are then T*'s leaves of that level or finer, and T*'s
+  /// coarser leaves cut down to it. std::invalid_argument outside 0..kMaxSplitBelow.
+  int split_below = 0;
+};
+
 namespace detail {
 template <std::size_t d>
 struct DynamicState;
@@ -98,7 +110,8 @@ class DynamicQuadtree {
  public:
   /// Builds T* of `points` in `box` from scratch. Throws InputError (NotFinite, OutsideBox,
   /// Duplicate, Resolution) naming the point index; ids are 0..n−1 in input order.
-  explicit DynamicQuadtree(const Box<d>& box, std::span<const Point<d>> points = {});
+  explicit DynamicQuadtree(const Box<d>& box, std::span<const Point<d>> points = {},
+                           const DynamicQuadtreeOptions& options = {});
   ~DynamicQuadtree();
   DynamicQuadtree(DynamicQuadtree&&) noexcept;
   DynamicQuadtree& operator=(DynamicQuadtree&&) noexcept;

@@ -122,14 +122,15 @@ struct CheckReport {
 /// Checks that `leaves` are exactly the leaves of T* for `points` (see the header comment),
 /// reporting each broken rule. Structural (tiling) violations stop the check early, since
 /// the later rules presuppose a tree. Positions must be distinct to pass (equal positions
-/// show up as an overfull leaf).
+/// show up as an overfull leaf). `split_below` > 0 checks T* with every cell coarser than
+/// that level split as well (the distributed meshes' local trees, DynamicQuadtreeOptions).
 template <std::size_t d>
 CheckReport<d> check_tree(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves,
-                          std::size_t max_violations = 64);
+                          std::size_t max_violations = 64, int split_below = 0);
 
 /// check_tree, throwing InvariantError with the summary when it fails.
 template <std::size_t d>
-void require_valid_tree(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves);
+void require_valid_tree(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves, int split_below = 0);
 
 template <std::size_t d>
   requires SupportedDim<d>

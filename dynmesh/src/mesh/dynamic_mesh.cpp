@@ -21,6 +21,7 @@
 #include <chrono>
 #include <iterator>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -49,6 +50,9 @@ const Box<2>& validated(const Box<2>& box) {
 /// The options, validated before anything is built.
 MeshOptions validated(MeshOptions o) {
   if (o.postprocess == Postprocess::Hpu) validate_min_angle(o.min_angle);
+  checked_split_below(o.tree.split_below);
+  if (o.postprocess == Postprocess::Hpu && o.tree.split_below != 0)
+    throw std::invalid_argument("dynmesh: the hpu mesh refines no quadtree: tree options apply to the quadtree mesh");
   return o;
 }
 
@@ -123,6 +127,7 @@ class QuadtreeMeshState final : public MeshState {
     program.dir = &core.dir;
     program.input = &core.head;
     program.log = &log;
+    core.program.split_below = o.tree.split_below;
   }
   ~QuadtreeMeshState() override { log.closing = true; }  // before core (and its engine) goes
 
@@ -191,7 +196,7 @@ class QuadtreeMeshState final : public MeshState {
                             tree.push_back(Leaf<2>{c, k});
                           });
     std::sort(tree.begin(), tree.end());
-    require_valid_tree<2>(qs, tree);
+    require_valid_tree<2>(qs, tree, core.program.split_below);
     // T': every point leaf has its block of same-size leaves.
     require_refined_tree(refined_leaves(), core.by_id.size());
   }

@@ -75,7 +75,7 @@ void check_trees_of(const DynamicOctreeMesh& mesh, const OctreeMeshState& s) {
                             tree.push_back(Leaf<3>{c, k});
                           });
   std::sort(tree.begin(), tree.end());
-  require_valid_tree<3>(qs, tree);
+  require_valid_tree<3>(qs, tree, s.core.program.split_below);
   require_refined_tree(mesh.refined_leaves(), qs);
 }
 
@@ -96,8 +96,10 @@ std::vector<PointId> checked_update(const DynamicOctreeMesh& mesh, OctreeMeshSta
 
 }  // namespace detail
 
-DynamicOctreeMesh::DynamicOctreeMesh(const Box<3>& box, std::span<const Point<3>> points)
+DynamicOctreeMesh::DynamicOctreeMesh(const Box<3>& box, std::span<const Point<3>> points,
+                                     const DynamicQuadtreeOptions& tree)
     : s_(std::make_unique<detail::OctreeMeshState>(box)) {
+  s_->core.program.split_below = detail::checked_split_below(tree.split_below);
   const std::vector<Edit<3>> edits = detail::inserts_of<3>(points);
   s_->validate(edits, "point");
   validate_mesh_box(box);

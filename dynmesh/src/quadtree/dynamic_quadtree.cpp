@@ -30,7 +30,7 @@ void check_tree_of(const DynamicQuadtree<d>& tree, const DynamicState<d>& s) {
       if (!dynmesh::contains(c, p->q) || !s.by_pos.contains(p->q))
         throw InvariantError("dynmesh: leaf " + to_string(c) + " lists a point it does not hold");
   });
-  require_valid_tree<d>(tree.positions(), tree.leaves());
+  require_valid_tree<d>(tree.positions(), tree.leaves(), s.program.split_below);
 }
 
 /// Applies validated edits with one propagation. Built with the CMake option
@@ -53,8 +53,10 @@ std::vector<PointId> checked_update(const DynamicQuadtree<d>& tree, DynamicState
 
 template <std::size_t d>
   requires SupportedDim<d>
-DynamicQuadtree<d>::DynamicQuadtree(const Box<d>& box, std::span<const Point<d>> points)
+DynamicQuadtree<d>::DynamicQuadtree(const Box<d>& box, std::span<const Point<d>> points,
+                                    const DynamicQuadtreeOptions& options)
     : s_(std::make_unique<detail::DynamicState<d>>(box)) {
+  s_->program.split_below = detail::checked_split_below(options.split_below);
   s_->validate(detail::inserts_of<d>(points), "point");
   s_->build(points, [](sac::Engine&) {});
 }

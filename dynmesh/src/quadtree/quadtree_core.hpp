@@ -28,6 +28,7 @@
 #include <deque>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <unordered_map>
@@ -454,6 +455,13 @@ class InputPoints {
     by_id.erase(n->id);
   }
 };
+
+/// DynamicQuadtreeOptions::split_below, checked.
+inline int checked_split_below(int level) {
+  if (level < 0 || level > kMaxSplitBelow)
+    throw std::invalid_argument("dynmesh: split_below must be 0 to " + std::to_string(kMaxSplitBelow));
+  return level;
+}
 
 template <std::size_t d>
 class QuadtreeCore : public InputPoints<d> {

@@ -120,13 +120,17 @@ struct Slot {
   [[no_unique_address]] std::conditional_t<d == 3, sac::Mod<std::uint64_t>, SlotNoKids> kids;
 };
 
-/// A crowded-queue entry's key: its cell, packed, and `two` in a bit the packing leaves free
-/// (bit 52 of the first word, below the level's byte). 8·d bytes, not 8·d + 16.
+/// A crowded-queue entry's key: its cell, packed, and `two` and `forced` in bits the packing
+/// leaves free (bits 52 and 53 of the first word, below the level's byte). 8·d bytes, not
+/// 8·d + 16.
 template <std::size_t d>
 struct QKey {
   static constexpr std::uint64_t kTwo = std::uint64_t{1} << 52;
+  static constexpr std::uint64_t kForced = std::uint64_t{1} << 53;
   PackedCell<d> k;
-  QKey(const CellId<d>& c, bool two) : k(pack_cell<d>(c)) { k[0] |= two ? kTwo : 0; }
+  QKey(const CellId<d>& c, bool two, bool forced = false) : k(pack_cell<d>(c)) {
+    k[0] |= (two ? kTwo : 0) | (forced ? kForced : 0);
+  }
   bool operator==(const QKey&) const = default;
   std::size_t hash() const noexcept {
     std::uint64_t h = k[0];
@@ -143,11 +147,13 @@ struct QNode {
   sac::Mod<QNode*> next;
   CellId<d> cell() const noexcept {
     PackedCell<d> k = key.k;
-    k[0] &= ~QKey<d>::kTwo;
+    k[0] &= ~(QKey<d>::kTwo | QKey<d>::kForced);
     return unpack_cell<d>(k);
   }
   /// The cell holds two or more points; else one, and N(cell) holds another.
   bool two() const noexcept { return (key.k[0] & QKey<d>::kTwo) != 0; }
+  /// The cell is split because it is coarser than Refine::split_below, whatever its points.
+  bool forced() const noexcept { return (key.k[0] & QKey<d>::kForced) != 0; }
 };
 
 /// What the program needs from its owner: the cell directory and the root's point list.
@@ -162,6 +168,11 @@ struct Refine {
 
   Dir* dir;
   List* input;  // the root's list: the input points
+  /// Every cell coarser than this level is split, whatever its points (0: T* itself). The
+  /// distributed meshes' local programs set it to the partition level, so that a rank's tree,
+  /// built from some of the points, has the one-process tree's shape at and below that level
+  /// (docs/DISTRIBUTED.md). Fixed before the first run.
+  int split_below = 0;
 
   Slot<d>& slot(sac::Engine& rt, const CellId<d>& c) { return dir->get(rt, c); }
 
@@ -192,6 +203,13 @@ struct Refine {
     Refine* program = ctx(rt);
     // The root is crowded when it holds two points (its neighbourhood is itself).
     Crowded* c0 = rt.alloc<Crowded>(0);
+    if (program->split_below > 0) {
+      const QKey<d> key(CellId<d>::root(), false, true);
+      QNode<d>* root = rt.alloc<QNode<d>>(key, key);
+      rt.write(root->next, nullptr);
+      rt.write(*c0, root);
+      return rt.memo(sac::fn<&refine>(0, c0));
+    }
     rt.read(*program->input, [c0](sac::Engine& rt2, Node* a) {
       if (!a) return rt2.write(*c0, nullptr);
       rt2.read(a->next, [c0](sac::Engine& rt3, Node* b) {
@@ -316,10 +334,29 @@ struct Refine {
   ///   * c holds one point: only the child holding it can be crowded, and its siblings are
   ///     empty, so only the rest of N(k) is scanned.
   /// So no test scans a neighbourhood to learn what its parent's entry already says.
+  ///   * c is forced (coarser than split_below): its children one level above split_below
+  ///     are forced too, with no read; the others are tested in full, siblings included.
   static void classify(sac::Engine& rt, QNode<d>* e, Crowded* out) {
     if (!e) return rt.write(*out, nullptr);
-    if (e->two()) test_child(rt, ctx(rt), e, 0, out);
+    if (e->forced() && e->cell().level + 1 < ctx(rt)->split_below) return queue_forced(rt, e, out);
+    if (e->two() || e->forced()) test_child(rt, ctx(rt), e, 0, out);
     else test_lone(rt, ctx(rt), e, out);
+  }
+  /// Queues every child of a forced entry whose children are forced as well.
+  static void queue_forced(sac::Engine& rt, QNode<d>* e, Crowded* out) {
+    for (unsigned w = 0; w < static_cast<unsigned>(kChildren<d>); ++w) {
+      const QKey<d> key(child(e->cell(), w), false, true);
+      QNode<d>* q = rt.alloc<QNode<d>>(key, key);
+      rt.write(*out, q);
+      out = &q->next;
+    }
+    next_entry(rt, e, out);
+  }
+  /// What follows the test of child w: the next child, or (a lone point's entry, which has
+  /// one child to test) the next entry.
+  static void after_child(sac::Engine& rt, QNode<d>* e, unsigned w, Crowded* out) {
+    if (e->two() || e->forced()) test_child(rt, ctx(rt), e, w + 1, out);
+    else next_entry(rt, e, out);
   }
   /// The walk's next step, once e's children are tested.
   static void next_entry(sac::Engine& rt, QNode<d>* e, Crowded* out) {
@@ -349,7 +386,9 @@ struct Refine {
     rt.read(program->slot(rt, child(e->cell(), w)).pts, [at = At(e, w), out](sac::Engine& rt2, Node* a) {
       if (!a) return test_child(rt2, ctx(rt2), at.e(), at.w() + 1, out);  // empty: not crowded
       rt2.read(a->next, [at, out](sac::Engine& rt3, Node* b) {
-        queue_crowded(rt3, ctx(rt3), at.e(), at.w(), b != nullptr, out);
+        // A forced entry's child holding one point is crowded only if N(k) holds another.
+        if (!b && at.e()->forced()) return scan_neighbourhood(rt3, ctx(rt3), at.e(), at.w(), 0, out);
+        queue_crowded(rt3, at.e(), at.w(), b != nullptr, out);
       });
     });
   }
@@ -411,22 +450,21 @@ struct Refine {
     const CellId<d> k = child(e->cell(), w);
     CellId<d> nb;
     while (i < kAround && !offset_cell(k, kScanOrder[w][static_cast<std::size_t>(i)], nb)) ++i;
-    if (i >= kAround) return next_entry(rt, e, out);
+    if (i >= kAround) return after_child(rt, e, w, out);
     rt.read(program->slot(rt, nb).pts, [at = At(e, w, i), out](sac::Engine& rt2, Node* p) {
-      if (p) return queue_crowded(rt2, ctx(rt2), at.e(), at.w(), false, out);
+      if (p) return queue_crowded(rt2, at.e(), at.w(), false, out);
       scan_neighbourhood(rt2, ctx(rt2), at.e(), at.w(), at.i() + 1, out);
     });
   }
 
   /// Queues child w of e's cell, holding two or more points (`two`) or one; then the rest
   /// of e's children (none after a lone point's child).
-  static void queue_crowded(sac::Engine& rt, Refine* program, QNode<d>* e, unsigned w, bool two, Crowded* out) {
+  static void queue_crowded(sac::Engine& rt, QNode<d>* e, unsigned w, bool two, Crowded* out) {
     const CellId<d> k = child(e->cell(), w);
     const QKey<d> key(k, two);
     QNode<d>* q = rt.alloc<QNode<d>>(key, key);
     rt.write(*out, q);
-    if (e->two()) test_child(rt, program, e, w + 1, &q->next);
-    else next_entry(rt, e, &q->next);
+    after_child(rt, e, w, &q->next);
   }
 };
 

@@ -449,8 +449,10 @@ namespace {
 template <std::size_t d>
 class TreeCheck {
  public:
-  TreeCheck(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves, std::size_t max_violations)
-      : points_(points), leaves_(leaves), max_violations_(max_violations), nl_(leaves.size()) {}
+  TreeCheck(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves, std::size_t max_violations,
+            int split_below)
+      : points_(points), leaves_(leaves), max_violations_(max_violations), split_below_(split_below),
+        nl_(leaves.size()) {}
 
   CheckReport<d> report;
 
@@ -643,11 +645,17 @@ class TreeCheck {
     }
   }
 
-  /// Minimality: every split is crowded or forced by a deeper split.
+  /// Minimality: every split is crowded, forced by a deeper split, or coarser than
+  /// split_below (which also makes every leaf coarser than it wrong).
   void check_minimality() {
+    for (const Leaf<d>& leaf : leaves_)
+      if (leaf.cell.level < split_below_)
+        add(ViolationKind::CrowdedLeaf, leaf.cell, leaf.cell,
+            "leaf " + to_string<d>(leaf.cell) + " is coarser than level " + std::to_string(split_below_) +
+                ", where every cell is split");
     for (const auto& level : split_by_level_)
       for (const CellId<d>& s : level) {
-        if (*split_.find(s) & kForced) continue;
+        if (*split_.find(s) & kForced || s.level < split_below_) continue;
         const std::size_t k = index_->count(s);
         if (k >= 2 || (k == 1 && neighbours_hold_points(s))) continue;
         add(ViolationKind::UnjustifiedSplit, s, s,
@@ -718,6 +726,7 @@ class TreeCheck {
   std::span<const Position<d>> points_;
   std::span<const Leaf<d>> leaves_;
   std::size_t max_violations_;
+  int split_below_ = 0;
   std::size_t nl_;
   std::vector<std::uint32_t> order_;
   CellTable<d, std::uint16_t> split_;
@@ -733,8 +742,8 @@ class TreeCheck {
 
 template <std::size_t d>
 CheckReport<d> check_tree(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves,
-                          std::size_t max_violations) {
-  TreeCheck<d> check(points, leaves, max_violations);
+                          std::size_t max_violations, int split_below) {
+  TreeCheck<d> check(points, leaves, max_violations, split_below);
   if (leaves.empty()) {
     check.add(ViolationKind::Gap, CellId<d>::root(), CellId<d>::root(), "no leaves: the box is not covered");
     return std::move(check.report);
@@ -752,8 +761,8 @@ CheckReport<d> check_tree(std::span<const Position<d>> points, std::span<const L
 }
 
 template <std::size_t d>
-void require_valid_tree(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves) {
-  const CheckReport<d> rep = check_tree<d>(points, leaves);
+void require_valid_tree(std::span<const Position<d>> points, std::span<const Leaf<d>> leaves, int split_below) {
+  const CheckReport<d> rep = check_tree<d>(points, leaves, 64, split_below);
   if (!rep.ok()) throw InvariantError("quadtree contract violated:\n" + rep.summary());
 }
 
@@ -761,9 +770,9 @@ template class StaticQuadtree<2>;
 template class StaticQuadtree<3>;
 template struct CheckReport<2>;
 template struct CheckReport<3>;
-template CheckReport<2> check_tree<2>(std::span<const Position<2>>, std::span<const Leaf<2>>, std::size_t);
-template CheckReport<3> check_tree<3>(std::span<const Position<3>>, std::span<const Leaf<3>>, std::size_t);
-template void require_valid_tree<2>(std::span<const Position<2>>, std::span<const Leaf<2>>);
-template void require_valid_tree<3>(std::span<const Position<3>>, std::span<const Leaf<3>>);
+template CheckReport<2> check_tree<2>(std::span<const Position<2>>, std::span<const Leaf<2>>, std::size_t, int);
+template CheckReport<3> check_tree<3>(std::span<const Position<3>>, std::span<const Leaf<3>>, std::size_t, int);
+template void require_valid_tree<2>(std::span<const Position<2>>, std::span<const Leaf<2>>, int);
+template void require_valid_tree<3>(std::span<const Position<3>>, std::span<const Leaf<3>>, int);
 
 }  // namespace dynmesh
