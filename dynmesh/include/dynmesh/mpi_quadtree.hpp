@@ -50,6 +50,7 @@
 
 #include "dynmesh/box.hpp"
 #include "dynmesh/cell.hpp"
+#include "dynmesh/dynamic_quadtree.hpp"
 #include "dynmesh/edit.hpp"
 #include "dynmesh/point.hpp"
 #include "dynmesh/static_quadtree.hpp"
@@ -81,7 +82,7 @@ struct MpiRankStats {
 };
 
 namespace detail {
-template <std::size_t d>
+template <std::size_t d, class Local>
 struct MpiState;
 }
 
@@ -122,7 +123,7 @@ class MpiQuadtree {
   void check_invariants() const;
 
  private:
-  std::unique_ptr<detail::MpiState<d>> s_;
+  std::unique_ptr<detail::MpiState<d, DynamicQuadtree<d>>> s_;
 };
 
 /// Collective: the leaves of every rank's `local`, sorted, on rank `root`; empty on the
