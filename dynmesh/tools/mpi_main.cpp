@@ -32,12 +32,18 @@
 #include "atomic_file.hpp"
 #include "distinct_paths.hpp"
 #include "dynmesh/detail/merge_on_root.hpp"
+#include "dynmesh/detail/mesh_grid.hpp"
+#include "dynmesh/detail/number_on_root.hpp"
 #include "dynmesh/io.hpp"
+#include "dynmesh/mesh_io.hpp"
+#include "dynmesh/mesh_text_parts.hpp"
+#include "dynmesh/mpi_mesh.hpp"
 #include "dynmesh/mpi_quadtree.hpp"
 #include "initial_points.hpp"
 #include "input_labels.hpp"
 #include "number_options.hpp"
 #include "peak_memory.hpp"
+#include "postprocess_option.hpp"
 #include "verify.hpp"
 
 namespace {
@@ -56,9 +62,15 @@ struct Options {
   std::string cells;
   bool stats = false;
   int partition_level = -1;
-  int ghost_ring = 1;
+  int ghost_ring = -1;  // -1: the command's own (1 for the tree, kMeshGhostRing for the meshes)
   double rebalance = 1.5;
   bool measure_writing = false;
+  // mesh
+  std::string postprocess;
+  double min_angle = 0;
+  bool min_angle_given = false;
+  std::string outbase;
+  std::string feed;
 };
 
 int rank_of(MPI_Comm comm) {
@@ -85,14 +97,17 @@ void print_error(const std::string& message) {
 /// the tree was freed, and the rank's peak resident memory over the run; with
 /// --measure-writing also the peak over the writing of the output alone and the resident
 /// memory when the writing began (writing_mib < 0: not measured).
+/// `simplices` (the mesh: those the rank owns; negative: the tree, none) follows the ghosts.
 void print_stats(MPI_Comm comm, const MpiRankStats& st, int partition_level, double peak_mib, double writing_mib,
-                 double writing_from_mib) {
+                 double writing_from_mib, long long simplices = -1) {
   char line[512];
+  char owned[64] = "";
+  if (simplices >= 0) std::snprintf(owned, sizeof owned, ", %lld simplices owned", simplices);
   const double mean = st.propagations ? st.propagate_seconds / static_cast<double>(st.propagations) : 0.0;
   int n = std::snprintf(line, sizeof line,
-                        "[dynmesh-mpi] rank %d: owned %zu points in %zu root cells, ghost %zu points, trace %zu bytes, "
+                        "[dynmesh-mpi] rank %d: owned %zu points in %zu root cells, ghost %zu points%s, trace %zu bytes, "
                         "%zu propagations, mean %.6f s, %zu repartitions, peak_rss %.0f MiB",
-                        rank_of(comm), st.owned_points, st.owned_roots, st.ghost_points, st.trace_bytes,
+                        rank_of(comm), st.owned_points, st.owned_roots, st.ghost_points, owned, st.trace_bytes,
                         st.propagations, mean, st.repartitions, peak_mib);
   if (writing_mib >= 0 && n > 0 && static_cast<std::size_t>(n) < sizeof line)
     std::snprintf(line + n, sizeof line - static_cast<std::size_t>(n), ", writing peak_rss %.0f MiB (from %.0f MiB)",
@@ -136,7 +151,7 @@ int run(MPI_Comm comm, const Options& o, Columns columns) {
 
   MpiQuadtreeOptions options;
   options.partition_level = o.partition_level;
-  options.ghost_ring = o.ghost_ring;
+  options.ghost_ring = o.ghost_ring >= 0 ? o.ghost_ring : 1;
   options.rebalance_factor = o.rebalance;
   std::optional<MpiQuadtree<d>> tree;
   try {
@@ -219,6 +234,206 @@ int run(MPI_Comm comm, const Options& o, Columns columns) {
   return 0;
 }
 
+/// Rank 0's end of a merge: text appended to an output stream, or nothing once the stream
+/// failed (the merges go on, so that no rank waits; the first error is kept for the
+/// agreement at the end).
+struct RootText {
+  AtomicOutputs::Stream* file = nullptr;
+  std::string* message = nullptr;
+  std::string text;
+
+  template <class Format>
+  void put(Format&& format) {
+    if (!file) return;
+    text.clear();
+    format(text);
+    try {
+      file->append(text);
+    } catch (const std::exception& e) {
+      if (message->empty()) *message = e.what();
+      file = nullptr;
+    }
+  }
+  /// Runs a collective merge whose sink calls put(); a sink that threw is recorded.
+  template <class Merge>
+  void merge(Merge&& run) {
+    try {
+      run();
+    } catch (const std::exception& e) {
+      if (message->empty()) *message = e.what();
+      file = nullptr;
+    }
+  }
+};
+
+/// Opens OUT on rank 0 for a streamed output; a failure is kept in `message`.
+AtomicOutputs::Stream* open_on_root(bool root, AtomicOutputs& out, const std::string& path, std::string& message) {
+  if (!root || path.empty()) return nullptr;
+  try {
+    return &out.open_stream(path);
+  } catch (const std::exception& e) {
+    if (message.empty()) message = e.what();
+    return nullptr;
+  }
+}
+
+/// `dynmesh-mpi mesh`: MpiMesh on the ranks; rank 0 writes the feed as each propagation's
+/// owned changes merge (counts first, then the '-' lines, then the '+' lines, each group
+/// sorted as the ranks' sorted parts merge), then .node and .ele by numbering the ranks'
+/// vertices on rank 0 (detail/number_on_root.hpp: once to count them for the header, once
+/// to write them and send each rank its numbers) and merging the renumbered simplices.
+template <std::size_t d>
+int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
+  using Simplex = MeshSimplex<d>;
+  const bool root = rank_of(comm) == 0;
+  std::optional<InitialPoints<d>> initial;
+  EditScript<d> script;
+  std::string message;
+  if (root) {
+    try {
+      initial.emplace(read_initial_points<d>(o.points, o.box, o.skip_duplicates, columns));
+      if (!o.edits.empty()) script = read_edits_file<d>(o.edits);
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
+  }
+  if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
+
+  Box<d> box;
+  if (root) box = initial->box;
+  double words[d + 1];
+  for (std::size_t a = 0; a < d; ++a) words[a] = box.origin[a];
+  words[d] = box.side;
+  MPI_Bcast(words, d + 1, MPI_DOUBLE, 0, comm);
+  for (std::size_t a = 0; a < d; ++a) box.origin[a] = words[a];
+  box.side = words[d];
+  std::uint64_t nedits = script.edits.size();
+  MPI_Bcast(&nedits, 1, MPI_UINT64_T, 0, comm);
+
+  MpiQuadtreeOptions options = mpi_mesh_defaults();
+  options.partition_level = o.partition_level;
+  if (o.ghost_ring >= 0) options.ghost_ring = o.ghost_ring;
+  options.rebalance_factor = o.rebalance;
+  std::optional<MpiMesh<d>> mesh;
+  try {
+    mesh.emplace(comm, box, root ? std::span<const Point<d>>(initial->file.points) : std::span<const Point<d>>{},
+                 options);
+  } catch (const InputError& e) {
+    if (!root) return 1;
+    try {
+      const int level = dynmesh::detail::BasicMeshGrid<d>::resolution_level(box);
+      rethrow_construction_error<d>(e, *initial, level >= 2 ? level : -1);
+    } catch (const std::exception& labelled) {
+      print_error(labelled.what());
+    }
+    return 1;
+  }
+
+  // The feed streams to its file aside as the edits propagate.
+  AtomicOutputs out;
+  RootText feed{open_on_root(root, out, o.feed, message), &message, {}};
+  feed.put([](std::string& t) { t += "# dynmesh feed v1\n"; });
+  const auto less = [](const Simplex& a, const Simplex& b) { return a < b; };
+  std::size_t propagations = 0;
+  auto write_update = [&] {
+    ++propagations;
+    if (o.feed.empty()) return;
+    const OwnedChange<d>& change = mesh->local_change();
+    std::uint64_t mine[2] = {change.removed.size(), change.added.size()}, sums[2] = {0, 0};
+    MPI_Reduce(mine, sums, 2, MPI_UINT64_T, MPI_SUM, 0, comm);
+    feed.put([&](std::string& t) { append_feed_head(t, propagations, sums[0], sums[1]); });
+    for (const auto& [sign, part] : {std::pair{'-', &change.removed}, std::pair{'+', &change.added}})
+      feed.merge([&, sign = sign, part = part] {
+        dynmesh::detail::merge_on_root<Simplex>(comm, std::span<const Simplex>(*part), 0, less,
+                                                [&](std::span<const Simplex> run) {
+                                                  feed.put([&](std::string& t) { append_feed_lines(t, sign, run); });
+                                                });
+      });
+  };
+  const std::size_t step = o.batch == 0 ? 1 : o.batch;
+  const std::span<const Edit<d>> all(script.edits);
+  for (std::uint64_t i = 0; i < nedits; i += step) {
+    const std::size_t k = static_cast<std::size_t>(std::min<std::uint64_t>(step, nedits - i));
+    try {
+      mesh->apply(root ? all.subspan(static_cast<std::size_t>(i), k) : std::span<const Edit<d>>{});
+    } catch (const InputError& err) {
+      if (!root) return 1;
+      const std::size_t at = err.point_indices().empty() ? 0 : err.point_indices().back();
+      print_error(edit_error<d>(script, static_cast<std::size_t>(i) + at, err).what());
+      return 1;
+    }
+    write_update();
+  }
+
+  MpiRankStats rank_stats;
+  int partition_level = 0;
+  if (o.stats) rank_stats = mesh->rank_stats(), partition_level = mesh->partition_level();
+  // The simplices this rank owns, then the mesh goes: the trace is most of the memory.
+  const std::vector<Simplex> mine = mesh->local_simplices();
+  mesh.reset();
+
+  std::vector<Point<d>> vertices;
+  vertices.reserve(mine.size() * (d + 1));
+  for (const Simplex& s : mine)
+    for (const Point<d>& v : s.v) vertices.push_back(v);
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  const auto point_less = [](const Point<d>& a, const Point<d>& b) { return a < b; };
+  std::uint64_t nvertices = 0;
+  (void)dynmesh::detail::number_on_root<Point<d>>(comm, std::span<const Point<d>>(vertices), 0, point_less,
+                                                  [](std::span<const Point<d>>) {}, nvertices);
+  RootText node{open_on_root(root, out, o.outbase + ".node", message), &message, {}};
+  node.put([&](std::string& t) { append_node_header(t, nvertices, d); });
+  std::size_t written = 0;
+  std::vector<std::uint64_t> numbers;
+  node.merge([&] {
+    numbers = dynmesh::detail::number_on_root<Point<d>>(
+        comm, std::span<const Point<d>>(vertices), 0, point_less,
+        [&](std::span<const Point<d>> run) {
+          node.put([&](std::string& t) { append_node_lines(t, written, run, box); });
+          written += run.size();
+        },
+        nvertices);
+  });
+
+  // Vertex numbers follow coordinate order, so a canonical simplex's corners, numbered, are
+  // its canonical index form, and sorting either form sorts the other.
+  using Cell = std::array<std::uint64_t, d + 1>;
+  std::vector<Cell> cells;
+  cells.reserve(mine.size());
+  for (const Simplex& s : mine) {
+    Cell c{};
+    for (std::size_t k = 0; k <= d; ++k)
+      c[k] = numbers[static_cast<std::size_t>(std::lower_bound(vertices.begin(), vertices.end(), s.v[k]) -
+                                              vertices.begin())];
+    cells.push_back(c);
+  }
+  std::sort(cells.begin(), cells.end());
+  std::uint64_t ncells_mine = cells.size(), ncells = 0;
+  MPI_Reduce(&ncells_mine, &ncells, 1, MPI_UINT64_T, MPI_SUM, 0, comm);
+  RootText ele{open_on_root(root, out, o.outbase + ".ele", message), &message, {}};
+  ele.put([&](std::string& t) { append_ele_header(t, ncells, d + 1); });
+  std::size_t written_cells = 0;
+  ele.merge([&] {
+    dynmesh::detail::merge_on_root<Cell>(comm, std::span<const Cell>(cells), 0, std::less<Cell>{},
+                                         [&](std::span<const Cell> run) {
+                                           ele.put([&](std::string& t) { append_ele_lines(t, written_cells, run); });
+                                           written_cells += run.size();
+                                         });
+  });
+  if (root && message.empty()) {
+    try {
+      out.commit();
+      if (o.skip_duplicates) std::printf("duplicates: skipped %zu later copies\n", initial->duplicates_skipped);
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
+  }
+  if (o.stats) print_stats(comm, rank_stats, partition_level, peak_rss_mib(), -1, -1, static_cast<long long>(mine.size()));
+  if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
+  return 0;
+}
+
 int parse_and_run(MPI_Comm comm, int argc, char** argv) {
   const bool root = rank_of(comm) == 0;
   CLI::App app{"dynmesh-mpi: the dynamic quadtree T* on MPI ranks, equal to `dynmesh quadtree` "
@@ -253,6 +468,39 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
     const std::string clash = output_overwrites_input({{"POINTS", o.points}, {"--edits", o.edits}}, {{"--cells", o.cells}});
     if (!clash.empty()) throw CLI::ValidationError(clash);
   });
+
+  CLI::App* m = app.add_subcommand(
+      "mesh", "Mesh the box of a point file on the ranks (the quadtree mesh in 2D, the octree's tetrahedra in 3D), "
+              "apply an edit script, write the final mesh");
+  m->add_option("POINTS", o.points, "point file: .node, the vertices of a .poly, or plain text; read by rank 0")->required();
+  CLI::Option* mesh_dim = m->add_option("--dim", o.dim, "dimension (default: as `dynmesh mesh`)")->check(CLI::IsMember({2, 3}));
+  m->add_option("--box", o.box, "domain box: origin and side length (default: derived from the initial points)")
+      ->expected(3, 4)
+      ->type_name("o1 o2 [o3] L");
+  m->add_option("--postprocess", o.postprocess,
+                "quadtree: the quadtree mesh (2D) or the octree's tetrahedral mesh (3D); hpu does not run on ranks yet");
+  CLI::Option* min_angle = m->add_option("--min-angle", o.min_angle, "2D: at most the quadtree mesh's bound");
+  m->add_option_function<std::string>(
+       "--duplicates", [&o](const std::string& v) { o.skip_duplicates = v == "skip"; },
+       "error (the default) or skip: drop later copies of a point")
+      ->check(CLI::IsMember({"error", "skip"}));
+  m->add_option("--edits", o.edits, "edit script: '+ x y [z]' inserts, '- x y [z]' deletes");
+  m->add_option("--batch", o.batch, "propagate K consecutive edits together on all ranks (default: each alone)")
+      ->check(whole_number(1, std::numeric_limits<std::size_t>::max()));
+  m->add_option("-o", o.outbase, "output: OUTBASE.node and OUTBASE.ele (written by rank 0)")->required();
+  m->add_option("--feed", o.feed, "output: the change feed of every propagation");
+  m->add_flag("--stats", o.stats, "per rank on stderr: points owned, ghost points, simplices owned, trace bytes, mean "
+              "propagation time, peak resident memory");
+  m->add_option("--partition-level", o.partition_level)->check(CLI::Range(0, 10))->group("");
+  m->add_option("--ghost-ring", o.ghost_ring)->check(CLI::Range(0, 3))->group("");
+  m->add_option("--rebalance", o.rebalance)->check(CLI::Range(0.0, 1e9))->group("");
+  m->parse_complete_callback([&o] {
+    if (o.outbase.empty()) throw CLI::ValidationError("-o needs a non-empty OUTBASE");
+    const std::string clash = output_overwrites_input(
+        {{"POINTS", o.points}, {"--edits", o.edits}},
+        {{"-o", o.outbase + ".node"}, {"-o", o.outbase + ".ele"}, {"--feed", o.feed}});
+    if (!clash.empty()) throw CLI::ValidationError(clash);
+  });
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -264,7 +512,9 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
     if (root) print_error(std::string(e.what()) + " (see dynmesh-mpi --help)");
     return 2;
   }
-  o.dim_given = dim->count() > 0;
+  const bool meshing = m->parsed();
+  o.dim_given = (meshing ? mesh_dim : dim)->count() > 0;
+  o.min_angle_given = min_angle->count() > 0;
   // As `dynmesh quadtree`: --dim, else a .node header's, else the count of numbers on the
   // first line of plain text (io.hpp point_file_shape). Rank 0 looks; its error is everyone's.
   int shape[2] = {o.dim, 0};  // the dimension, and 1 for Columns::Exactly
@@ -282,7 +532,29 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
   MPI_Bcast(shape, 2, MPI_INT, 0, comm);
   const int d = shape[0];
   const Columns columns = shape[1] != 0 ? Columns::Exactly : Columns::AtLeast;
+  if (meshing) {
+    // As `dynmesh mesh`: the 2D mesh's own options are a malformed command line in 3D; in
+    // 2D, --postprocess and --min-angle as it takes them. DynHPU does not run on ranks yet.
+    std::string why;
+    try {
+      if (d == 3) {
+        why = mesh_options_2d_only(o.postprocess, o.min_angle_given, false);
+        if (why.empty() && !o.postprocess.empty() && o.postprocess != "quadtree")
+          why = "unknown --postprocess '" + o.postprocess + "' (quadtree, the 3D default)";
+      } else if (check_postprocess(o.postprocess, false, o.min_angle_given ? std::optional<double>(o.min_angle)
+                                                                            : std::nullopt) == PostprocessChoice::Hpu) {
+        why = "the hpu mesh (the 2D default) does not run on ranks yet: pass --postprocess quadtree";
+      }
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+    if (!why.empty()) {
+      if (root) print_error(why);
+      return 2;
+    }
+  }
   try {
+    if (meshing) return d == 3 ? run_mesh<3>(comm, o, columns) : run_mesh<2>(comm, o, columns);
     return d == 3 ? run<3>(comm, o, columns) : run<2>(comm, o, columns);
   } catch (const std::exception& e) {
     // Only agreed failures reach here (MpiQuadtree throws on every rank alike).

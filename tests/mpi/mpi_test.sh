@@ -121,6 +121,51 @@ expect_error() {
     fail "message differs from dynmesh quadtree's: $(cat ours.txt) / $(cat err1.txt)"
 }
 
+# same_mesh P POINTS ARGS...: dynmesh-mpi mesh on P ranks writes the ref.node, ref.ele and
+# ref.feed that dynmesh mesh wrote.
+same_mesh() {
+  local p=$1
+  shift
+  mpi "$p" mesh "$@" -o mpi --feed mpi.feed || { cat err.txt >&2; fail "a rank failed ($(tr '\n' ' ' <<<"$statuses")): -np $p mesh $*"; }
+  for f in node ele; do cmp -s ref.$f mpi.$f || fail "-np $p mesh $*: .$f differs from dynmesh mesh's"; done
+  cmp -s ref.feed mpi.feed || fail "-np $p mesh $*: the feed differs from dynmesh mesh's"
+}
+
+# exact_mesh DIM DIST N SPREAD NEDITS [ARGS...]: generated input and edits; 1 to 4 ranks with
+# batches, 2 ranks with single edits, against dynmesh mesh (the quadtree mesh in 2D). The
+# array `mpi_only` holds options for dynmesh-mpi alone (--partition-level).
+exact_mesh() {
+  local dim=$1 dist=$2 n=$3 spread=$4 nedits=$5
+  shift 5
+  "$gen" "$dist" "$dim" "$n" 7 "$spread" in.xyz in.edits "$nedits" || fail "mpi_gen $dist"
+  "$dynmesh" mesh in.xyz --dim "$dim" --postprocess quadtree --edits in.edits --batch 9 -o ref --feed ref.feed "$@" \
+    2>/dev/null || fail "dynmesh mesh $dist"
+  for p in 1 2 3 4; do
+    same_mesh "$p" in.xyz --dim "$dim" --postprocess quadtree --edits in.edits --batch 9 "$@" "${mpi_only[@]}"
+  done
+  "$dynmesh" mesh in.xyz --dim "$dim" --postprocess quadtree --edits in.edits -o ref --feed ref.feed "$@" \
+    2>/dev/null || fail "dynmesh mesh $dist"
+  same_mesh 2 in.xyz --dim "$dim" --postprocess quadtree --edits in.edits "$@" "${mpi_only[@]}"
+}
+mpi_only=()
+
+# expect_mesh_error WANT_TEXT ARGS...: as expect_error, for dynmesh-mpi mesh against dynmesh
+# mesh --postprocess quadtree: one line of ours, every rank non-zero, no output written.
+expect_mesh_error() {
+  local want=$1
+  shift
+  rm -f err.node err.ele err.feed
+  mpi 3 mesh "$@" --postprocess quadtree -o err --feed err.feed && fail "every rank exited 0: mesh $*"
+  grep -qx 0 <<<"$statuses" && fail "a rank exited 0: mesh $*"
+  our_lines noise.txt err.txt >ours.txt
+  [[ $(wc -l <ours.txt) -eq 1 ]] || { cat err.txt >&2; fail "our stderr is not exactly one line: mesh $*"; }
+  grep -qF -- "$want" ours.txt || fail "stderr lacks '$want': $(cat ours.txt)"
+  [[ ! -e err.node && ! -e err.ele && ! -e err.feed ]] || fail "a failed run wrote its output: mesh $*"
+  "$dynmesh" mesh "$@" --postprocess quadtree -o err1 >/dev/null 2>err1.txt && fail "dynmesh mesh accepted $*"
+  [[ "$(sed 's/^dynmesh-mpi: //' ours.txt)" == "$(sed 's/^dynmesh: //' err1.txt | grep -v '^\[dynmesh\]')" ]] ||
+    fail "message differs from dynmesh mesh's: $(cat ours.txt) / $(cat err1.txt)"
+}
+
 # errors_case: malformed, NaN, duplicate, outside the box, absent deletion, spread beyond the
 # resolution; first the launcher's notices of a clean run, and our_lines's own check.
 errors_case() {
@@ -255,6 +300,74 @@ case $case_name in
       END { for (i = 1; i <= k; i++) print "+ " keep[i] }' >w.edits
     "$dynmesh" quadtree w.xyz --duplicates skip --edits w.edits --cells ref.cells 2>/dev/null || fail "dynmesh on world.dat"
     for p in 1 2 3 4; do same "$p" w.xyz --duplicates skip --edits w.edits --batch 10; done
+    ;;
+  mesh_exact2d) # the quadtree mesh: uniform in the unit box (root cells finer than the default
+    # box allows), clusters, shrinking (spread 2^30), spiral, boundary; the feed too
+    mpi_only=(--partition-level 6)
+    exact_mesh 2 uniform 3000 2 200 --box 0 0 1
+    mpi_only=()
+    exact_mesh 2 clusters 1200 2 150
+    exact_mesh 2 shrinking 1200 1073741824 150
+    exact_mesh 2 spiral 1200 2 150
+    mpi_only=(--partition-level 5)
+    exact_mesh 2 boundary 800 2 100
+    ;;
+  mesh_exact3d) # the octree's tetrahedral mesh
+    mpi_only=(--partition-level 4)
+    exact_mesh 3 uniform 400 2 60 --box 0 0 0 1
+    mpi_only=()
+    exact_mesh 3 clusters 300 2 60
+    exact_mesh 3 spiral 300 2 60
+    ;;
+  mesh_ghost_ring) # the meshes' ring (docs/DISTRIBUTED.md): one narrower breaks exactness here
+    "$gen" uniform 3 800 3 2 t.xyz t.edits 100 || fail "mpi_gen"
+    "$dynmesh" mesh t.xyz --box 0 0 0 1 --edits t.edits --batch 3 -o ref --feed ref.feed 2>/dev/null || fail "dynmesh mesh"
+    same_mesh 3 t.xyz --box 0 0 0 1 --edits t.edits --batch 3 --partition-level 4
+    mpi 3 mesh t.xyz --box 0 0 0 1 --edits t.edits --batch 3 --partition-level 4 --ghost-ring 2 -o narrow \
+      --feed narrow.feed || fail "ring 2 failed to run"
+    cmp -s ref.ele narrow.ele && cmp -s ref.feed narrow.feed &&
+      fail "a ghost ring of width 2 gave the exact mesh: the test input no longer shows the need"
+    ;;
+  mesh_real_world) # gnuplot's world coastline, meshed on 1 to 4 ranks
+    world=/usr/share/doc/gnuplot/examples/world.dat
+    [[ -r $world ]] || fail "$world is missing (bash dev.sh deps installs gnuplot-doc)"
+    grep -v '^#' "$world" | awk 'NF >= 2 { print $1, $2 }' >w.xyz
+    awk '!seen[$0]++' w.xyz | awk 'NR % 7 == 1 { print "- " $0 } NR % 14 == 1 { keep[++k] = $0 }
+      END { for (i = 1; i <= k; i++) print "+ " keep[i] }' >w.edits
+    "$dynmesh" mesh w.xyz --postprocess quadtree --duplicates skip --edits w.edits --batch 10 -o ref --feed ref.feed \
+      >/dev/null 2>&1 || fail "dynmesh mesh on world.dat"
+    for p in 1 2 3 4; do same_mesh "$p" w.xyz --postprocess quadtree --duplicates skip --edits w.edits --batch 10; done
+    ;;
+  mesh_errors) # bad input to dynmesh-mpi mesh: one line of ours, every rank non-zero, nothing written
+    "$gen" uniform 2 300 3 2 s.xyz s.edits 20 || fail "mpi_gen"
+    mpi 3 mesh s.xyz --postprocess quadtree --edits s.edits -o ok || { cat err.txt >&2; fail "a clean run failed"; }
+    grep '^dynmesh-mpi' err.txt && fail "a clean run printed a line of ours on stderr"
+    cp err.txt noise.txt
+    printf '0.5 0.5\n0.5 abc\n' >bad.xyz
+    printf '0.5 0.5\n0.1 0.2\n0.5 0.5\n' >dup.xyz
+    echo "- 0.123 0.456" >absent.edits
+    echo "+ 5 5" >outside.edits
+    { head -4 s.edits; echo "- 0.123 0.456"; } >late.edits
+    expect_mesh_error "malformed number" bad.xyz
+    expect_mesh_error "duplicate point" dup.xyz
+    expect_mesh_error "not in the set" s.xyz --edits absent.edits
+    expect_mesh_error "late.edits:5:" s.xyz --edits late.edits --batch 3
+    expect_mesh_error "outside the domain box" s.xyz --edits outside.edits
+    # The hpu mesh (the 2D default) does not run on ranks yet: refused, status 2.
+    mpi 3 mesh s.xyz -o hpu && fail "the hpu mesh ran on ranks"
+    our_lines noise.txt err.txt | grep -q "does not run on ranks yet" || { cat err.txt >&2; fail "hpu: no clear refusal"; }
+    [[ ! -e hpu.node ]] || fail "the refused hpu run wrote its output"
+    # An output that cannot be written: one line naming it, every rank non-zero.
+    mpi 3 mesh s.xyz --postprocess quadtree -o nodir/x && fail "writing into a missing directory succeeded"
+    grep -qx 0 <<<"$statuses" && fail "a rank exited 0 on an output it cannot write"
+    our_lines noise.txt err.txt >ours.txt
+    [[ $(wc -l <ours.txt) -eq 1 ]] && grep -qF "nodir/x" ours.txt ||
+      { cat err.txt >&2; fail "an unwritable output: not one line of ours naming the file: $(cat ours.txt)"; }
+    ;;
+  mesh_differential2 | mesh_differential3) # MpiMesh against the static twins after every batch
+    [[ -x $unit ]] || fail "no mpi_mesh_test given"
+    launch "${case_name#mesh_differential}" "$unit" || { cat out.txt err.txt >&2; fail "mpi_mesh_test failed"; }
+    cat out.txt
     ;;
   *) fail "unknown case" ;;
 esac

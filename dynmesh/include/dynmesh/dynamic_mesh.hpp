@@ -104,6 +104,8 @@ class DynamicMesh {
   /// The leaves of the refined tree T', sorted (quadtree; empty with hpu, which refines
   /// no tree).
   std::vector<Leaf<2>> refined_leaves() const;
+  /// Is c split in the quadtree T* (with the tree options' splits)? Always false with hpu.
+  bool is_split(const CellId<2>& c) const noexcept;
 
   /// The last update's trace distance and time (seconds: relinking, the propagation and
   /// the change feed; not the input's validation).

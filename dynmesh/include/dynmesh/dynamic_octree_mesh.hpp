@@ -81,6 +81,8 @@ class DynamicOctreeMesh {
   const TetMeshChange& last_change() const noexcept;
   /// The leaves of the refined tree T', sorted.
   std::vector<Leaf<3>> refined_leaves() const;
+  /// Is c split in the octree T* (with the tree options' splits)?
+  bool is_split(const CellId<3>& c) const noexcept;
 
   /// The last update's trace distance and time (seconds: relinking, the propagation and the
   /// change feed; not the input's validation).

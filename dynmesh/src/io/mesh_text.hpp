@@ -54,49 +54,72 @@ void append_coordinates(std::string& out, const Point<d>& p, bool pad_to_3d) {
 
 // ---- Triangle's and TetGen's .node / .ele ---------------------------------------------------
 
-/// `<#vertices> d 0 1`, then `<i> <coordinates> <marker>` for i from 1; the marker is 1 on a
-/// side of the closed box (a coordinate equal to o or fl(o + L)), else 0.
+/// `<#vertices> d 0 1`.
 template <std::size_t d>
-std::string node_text(std::span<const Point<d>> vertices, const Box<d>& box) {
-  std::string out;
-  out.reserve(32 + vertices.size() * (8 + 24 * d));
-  append_number(out, vertices.size());
+void append_node_header(std::string& out, std::size_t vertices) {
+  append_number(out, vertices);
   out += ' ';
   out += digit<d>();
   out += " 0 1";
   append_line_end(out);
+}
+
+/// `<i> <coordinates> <marker>` for each vertex, i from first + 1; the marker is 1 on a side
+/// of the closed box (a coordinate equal to o or fl(o + L)), else 0.
+template <std::size_t d>
+void append_node_lines(std::string& out, std::size_t first, std::span<const Point<d>> vertices, const Box<d>& box) {
   for (std::size_t i = 0; i < vertices.size(); ++i) {
     const Point<d>& p = vertices[i];
     bool boundary = false;
     for (std::size_t a = 0; a < d; ++a)
       boundary = boundary || p[a] == box.origin[a] || p[a] == box.origin[a] + box.side;
-    append_number(out, i + 1);
+    append_number(out, first + i + 1);
     out += ' ';
     append_coordinates(out, p, false);
     out += boundary ? " 1" : " 0";
     append_line_end(out);
   }
+}
+
+template <std::size_t d>
+std::string node_text(std::span<const Point<d>> vertices, const Box<d>& box) {
+  std::string out;
+  out.reserve(32 + vertices.size() * (8 + 24 * d));
+  append_node_header<d>(out, vertices.size());
+  append_node_lines<d>(out, 0, vertices, box);
   return out;
 }
 
-/// `<#cells> k 0`, then `<i> <v1> ... <vk>` with 1-based vertex numbers.
+/// `<#cells> k 0`.
 template <std::size_t k>
-std::string ele_text(std::span<const std::array<std::uint32_t, k>> cells) {
-  std::string out;
-  out.reserve(32 + cells.size() * 8 * (k + 1));
-  append_number(out, cells.size());
+void append_ele_header(std::string& out, std::size_t cells) {
+  append_number(out, cells);
   out += ' ';
   out += digit<k>();
   out += " 0";
   append_line_end(out);
+}
+
+/// `<i> <v1> ... <vk>` for each cell, i from first + 1, of 0-based vertex numbers written
+/// from 1.
+template <std::size_t k, class Index>
+void append_ele_lines(std::string& out, std::size_t first, std::span<const std::array<Index, k>> cells) {
   for (std::size_t t = 0; t < cells.size(); ++t) {
-    append_number(out, t + 1);
-    for (std::uint32_t v : cells[t]) {
+    append_number(out, first + t + 1);
+    for (const Index v : cells[t]) {
       out += ' ';
-      append_number(out, std::size_t{v} + 1);
+      append_number(out, static_cast<std::size_t>(v) + 1);
     }
     append_line_end(out);
   }
+}
+
+template <std::size_t k>
+std::string ele_text(std::span<const std::array<std::uint32_t, k>> cells) {
+  std::string out;
+  out.reserve(32 + cells.size() * 8 * (k + 1));
+  append_ele_header<k>(out, cells.size());
+  append_ele_lines<k, std::uint32_t>(out, 0, cells);
   return out;
 }
 
@@ -307,29 +330,38 @@ void read_node_ele_text(const std::string& node_text, const std::string& ele_tex
 
 // ---- the change feed ------------------------------------------------------------------------
 
-/// `update <k> removed <r> added <a>`, then a `- ...` line per removed simplex and a `+ ...`
-/// line per added one, each its corners' coordinates in the simplex's (canonical) order.
-/// Appended to `out`, so that a caller streaming the feed can reuse one string.
-template <class Simplex>
-void append_feed_update_text(std::string& out, std::size_t k, std::span<const Simplex> removed,
-                             std::span<const Simplex> added) {
+/// `update <k> removed <r> added <a>`.
+inline void append_feed_head(std::string& out, std::size_t k, std::size_t removed, std::size_t added) {
   out += "update ";
   append_number(out, k);
   out += " removed ";
-  append_number(out, removed.size());
+  append_number(out, removed);
   out += " added ";
-  append_number(out, added.size());
+  append_number(out, added);
   append_line_end(out);
-  auto simplex_line = [&](char sign, const Simplex& s) {
+}
+
+/// A `sign ...` line per simplex: its corners' coordinates in its (canonical) order.
+template <class Simplex>
+void append_simplex_lines(std::string& out, char sign, std::span<const Simplex> simplices) {
+  for (const Simplex& s : simplices) {
     out += sign;
     for (const auto& p : s.v) {
       out += ' ';
       append_coordinates(out, p, false);
     }
     append_line_end(out);
-  };
-  for (const Simplex& s : removed) simplex_line('-', s);
-  for (const Simplex& s : added) simplex_line('+', s);
+  }
+}
+
+/// The head, then a `- ...` line per removed simplex and a `+ ...` line per added one.
+/// Appended to `out`, so that a caller streaming the feed can reuse one string.
+template <class Simplex>
+void append_feed_update_text(std::string& out, std::size_t k, std::span<const Simplex> removed,
+                             std::span<const Simplex> added) {
+  append_feed_head(out, k, removed.size(), added.size());
+  append_simplex_lines<Simplex>(out, '-', removed);
+  append_simplex_lines<Simplex>(out, '+', added);
 }
 
 // ---- the statistics report ------------------------------------------------------------------

@@ -111,6 +111,7 @@ class MeshState {
   virtual Mesh mesh() const { return make_mesh(triangles()); }
   virtual std::size_t num_triangles() const noexcept = 0;
   virtual std::vector<Leaf<2>> refined_leaves() const = 0;
+  virtual bool is_split(const CellId<2>&) const noexcept { return false; }
   virtual std::size_t trace_bytes() const = 0;
   virtual void compact() = 0;
   virtual void check_invariants() const = 0;
@@ -162,6 +163,7 @@ class QuadtreeMeshState final : public MeshState {
   std::vector<Triangle> triangles() const override { return log.simplices(); }
   std::size_t num_triangles() const noexcept override { return log.num_simplices(); }
 
+  bool is_split(const CellId<2>& c) const noexcept override { return core.is_split(c); }
   std::vector<Leaf<2>> refined_leaves() const override {
     std::vector<Leaf<2>> out;
     for (const LeafBlock* b = log.live; b; b = b->next) {
@@ -355,6 +357,7 @@ std::size_t DynamicMesh::num_triangles() const noexcept { return s_->num_triangl
 Mesh DynamicMesh::mesh() const { return s_->mesh(); }
 const MeshChange& DynamicMesh::last_change() const noexcept { return s_->change; }
 std::vector<Leaf<2>> DynamicMesh::refined_leaves() const { return s_->refined_leaves(); }
+bool DynamicMesh::is_split(const CellId<2>& c) const noexcept { return s_->is_split(c); }
 
 const UpdateStats& DynamicMesh::last_update() const noexcept { return s_->last_update(); }
 const sac::Stats& DynamicMesh::engine_stats() const noexcept { return s_->engine().stats(); }

@@ -150,48 +150,7 @@ void MpiQuadtree<d>::check_invariants() const {
   using namespace detail;
   const auto& s = *s_;
   std::optional<Failure> failure;
-  auto fail = [&](const std::string& text) {
-    if (failure) return;
-    failure = Failure{};
-    failure->invariant = true;
-    failure->key = 0;
-    failure->text = "dynmesh: rank " + std::to_string(s.rank) + ": " + text;
-  };
-  try {
-    s.tree->check_invariants();
-  } catch (const std::exception& e) {
-    fail(e.what());
-  }
-  if (s.starts.size() != static_cast<std::size_t>(s.nranks) + 1 || s.starts.front() != 0 || s.starts.back() != s.nroots ||
-      !std::is_sorted(s.starts.begin(), s.starts.end()))
-    fail("the partition does not cover the root cells in order");
-  // The tree holds exactly the points of the owned and ghost root cells, as many as counted.
-  std::vector<std::uint32_t> mine(s.nroots, 0);
-  for (const Position<d>& q : s.tree->positions()) {
-    const std::uint64_t m = s.root_of(q);
-    if (s.role[m] == 0) fail("its tree holds a point of root cell " + std::to_string(m) + ", neither owned nor ghost");
-    ++mine[m];
-  }
-  for (std::uint64_t m = 0; m < s.nroots; ++m) {
-    if (s.role[m] != 0 && mine[m] != s.counts[m])
-      fail("root cell " + std::to_string(m) + " holds " + std::to_string(mine[m]) + " points, counted " +
-           std::to_string(s.counts[m]));
-    if (s.role[m] == 1 && (s.tree->is_split(from_morton<d>(m, s.l0)) ? 1 : 0) != s.root_split[m])
-      fail("the split bit of root cell " + std::to_string(m) + " is stale");
-  }
-  // The shared tables are alike on every rank (an FNV-1a digest compared by min and max).
-  std::uint64_t h = 1469598103934665603ULL;
-  auto mix = [&](const void* p, std::size_t n) {
-    for (std::size_t i = 0; i < n; ++i) h = (h ^ static_cast<const unsigned char*>(p)[i]) * 1099511628211ULL;
-  };
-  mix(s.starts.data(), s.starts.size() * sizeof(std::uint64_t));
-  mix(s.counts.data(), s.counts.size() * sizeof(std::uint32_t));
-  mix(s.root_split.data(), s.root_split.size());
-  for (const auto& level : s.coarse) mix(level.data(), level.size());
-  std::uint64_t lo = 0, hi = 0;
-  MPI_Allreduce(&h, &lo, 1, MPI_UINT64_T, MPI_MIN, s.comm);
-  MPI_Allreduce(&h, &hi, 1, MPI_UINT64_T, MPI_MAX, s.comm);
-  if (lo != hi) fail("the partition, counts or coarse levels differ between ranks");
+  s.check_partition(failure);
   agree_or_throw(s.comm, failure);
 
   // The union of the leaves is T* of the union of the owned points (check_tree on rank 0).
@@ -202,7 +161,7 @@ void MpiQuadtree<d>::check_invariants() const {
   const std::vector<Position<d>> points = gather_all(s.comm, owned);
   if (s.rank == 0) {
     const CheckReport<d> report = check_tree<d>(points, leaves);
-    if (!report.ok()) fail("the gathered leaves are not T*: " + report.summary());
+    if (!report.ok()) s.fail(failure, "the gathered leaves are not T*: " + report.summary());
   }
   agree_or_throw(s.comm, failure);
 }

@@ -346,7 +346,66 @@ struct MpiState {
   /// Moves whole root cells so that the runs are balanced again, and rebuilds the trees.
   /// T* is a function of the point set, so the counts, split bits and coarse levels stay.
   void repartition() {
-    std::vector<Routed<d>> mine = owned_routed();
+    redistribute(owned_routed());
+    ++stats.repartitions;
+  }
+
+  /// The first failure found, as an invariant failure naming this rank.
+  void fail(std::optional<Failure>& failure, const std::string& text) const {
+    if (failure) return;
+    failure = Failure{};
+    failure->invariant = true;
+    failure->key = 0;
+    failure->text = "dynmesh: rank " + std::to_string(rank) + ": " + text;
+  }
+
+  /// Collective: the local structure's own checks, the partition, the points held against
+  /// the counts, the owned split bits, and the shared tables alike on every rank. Records the
+  /// first fault in `failure` (the caller agrees on it).
+  void check_partition(std::optional<Failure>& failure) const {
+    const MpiState& s = *this;
+    auto fail = [&](const std::string& text) { s.fail(failure, text); };
+    try {
+      s.tree->check_invariants();
+    } catch (const std::exception& e) {
+      fail(e.what());
+    }
+    if (s.starts.size() != static_cast<std::size_t>(s.nranks) + 1 || s.starts.front() != 0 || s.starts.back() != s.nroots ||
+        !std::is_sorted(s.starts.begin(), s.starts.end()))
+      fail("the partition does not cover the root cells in order");
+    // The tree holds exactly the points of the owned and ghost root cells, as many as counted.
+    std::vector<std::uint32_t> mine(s.nroots, 0);
+    for (const auto& entry : s.tree->points()) {
+      const Position<d> q = dynmesh::locate(s.box, entry.second);
+      const std::uint64_t m = s.root_of(q);
+      if (s.role[m] == 0) fail("its tree holds a point of root cell " + std::to_string(m) + ", neither owned nor ghost");
+      ++mine[m];
+    }
+    for (std::uint64_t m = 0; m < s.nroots; ++m) {
+      if (s.role[m] != 0 && mine[m] != s.counts[m])
+        fail("root cell " + std::to_string(m) + " holds " + std::to_string(mine[m]) + " points, counted " +
+             std::to_string(s.counts[m]));
+      if (s.role[m] == 1 && (s.tree->is_split(from_morton<d>(m, s.l0)) ? 1 : 0) != s.root_split[m])
+        fail("the split bit of root cell " + std::to_string(m) + " is stale");
+    }
+    // The shared tables are alike on every rank (an FNV-1a digest compared by min and max).
+    std::uint64_t h = 1469598103934665603ULL;
+    auto mix = [&](const void* p, std::size_t n) {
+      for (std::size_t i = 0; i < n; ++i) h = (h ^ static_cast<const unsigned char*>(p)[i]) * 1099511628211ULL;
+    };
+    mix(s.starts.data(), s.starts.size() * sizeof(std::uint64_t));
+    mix(s.counts.data(), s.counts.size() * sizeof(std::uint32_t));
+    mix(s.root_split.data(), s.root_split.size());
+    for (const auto& level : s.coarse) mix(level.data(), level.size());
+    std::uint64_t lo = 0, hi = 0;
+    MPI_Allreduce(&h, &lo, 1, MPI_UINT64_T, MPI_MIN, s.comm);
+    MPI_Allreduce(&h, &hi, 1, MPI_UINT64_T, MPI_MAX, s.comm);
+    if (lo != hi) fail("the partition, counts or coarse levels differ between ranks");
+  }
+
+  /// Collective: the partition recomputed from the counts, `mine` (each rank's owned points)
+  /// sent to their owners and ghost holders, and the local structures rebuilt.
+  void redistribute(const std::vector<Routed<d>>& mine) {
     partition();
     std::vector<std::vector<Routed<d>>> out(static_cast<std::size_t>(nranks));
     std::vector<int> to;
@@ -355,13 +414,12 @@ struct MpiState {
       for (const int r : to) out[static_cast<std::size_t>(r)].push_back(p);
     }
     std::vector<Routed<d>> in = detail::alltoall(comm, out);
-    // Order by position: the tree does not depend on it, the ids do.
+    // Order by position: the structure does not depend on it, the ids do.
     std::sort(in.begin(), in.end(), [&](const Routed<d>& a, const Routed<d>& b) {
       return dynmesh::locate(box, a.point) < dynmesh::locate(box, b.point);
     });
     for (std::size_t i = 0; i < in.size(); ++i) in[i].index = i;
     build_tree(std::move(in));
-    ++stats.repartitions;
   }
 
   /// Collective: builds the partition and this rank's structure on `points` (any part of the

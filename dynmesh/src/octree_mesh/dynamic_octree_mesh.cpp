@@ -167,6 +167,8 @@ TetMesh DynamicOctreeMesh::mesh() const {
 }
 const TetMeshChange& DynamicOctreeMesh::last_change() const noexcept { return s_->change; }
 
+bool DynamicOctreeMesh::is_split(const CellId<3>& c) const noexcept { return s_->core.is_split(c); }
+
 std::vector<Leaf<3>> DynamicOctreeMesh::refined_leaves() const {
   std::vector<Leaf<3>> out;
   for (const detail::OctreeBlock* b = s_->log.live; b; b = b->next) {
