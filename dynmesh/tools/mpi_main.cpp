@@ -71,6 +71,8 @@ struct Options {
   bool min_angle_given = false;
   std::string outbase;
   std::string feed;
+  std::string vtk;
+  std::string msh;
 };
 
 int rank_of(MPI_Comm comm) {
@@ -254,17 +256,18 @@ struct RootText {
       file = nullptr;
     }
   }
-  /// Runs a collective merge whose sink calls put(); a sink that threw is recorded.
-  template <class Merge>
-  void merge(Merge&& run) {
-    try {
-      run();
-    } catch (const std::exception& e) {
-      if (message->empty()) *message = e.what();
-      file = nullptr;
-    }
-  }
 };
+
+/// Runs a collective merge; what it throws (on rank 0: a part out of order) is kept in
+/// `message` for the agreement at the end, and the run goes on, so that no rank waits.
+template <class Merge>
+void guarded(std::string& message, Merge&& run) {
+  try {
+    run();
+  } catch (const std::exception& e) {
+    if (message.empty()) message = e.what();
+  }
+}
 
 /// Opens OUT on rank 0 for a streamed output; a failure is kept in `message`.
 AtomicOutputs::Stream* open_on_root(bool root, AtomicOutputs& out, const std::string& path, std::string& message) {
@@ -343,7 +346,7 @@ int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
     MPI_Reduce(mine, sums, 2, MPI_UINT64_T, MPI_SUM, 0, comm);
     feed.put([&](std::string& t) { append_feed_head(t, propagations, sums[0], sums[1]); });
     for (const auto& [sign, part] : {std::pair{'-', &change.removed}, std::pair{'+', &change.added}})
-      feed.merge([&, sign = sign, part = part] {
+      guarded(message, [&, sign = sign, part = part] {
         dynmesh::detail::merge_on_root<Simplex>(comm, std::span<const Simplex>(*part), 0, less,
                                                 [&](std::span<const Simplex> run) {
                                                   feed.put([&](std::string& t) { append_feed_lines(t, sign, run); });
@@ -382,15 +385,25 @@ int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
   std::uint64_t nvertices = 0;
   (void)dynmesh::detail::number_on_root<Point<d>>(comm, std::span<const Point<d>>(vertices), 0, point_less,
                                                   [](std::span<const Point<d>>) {}, nvertices);
-  RootText node{open_on_root(root, out, o.outbase + ".node", message), &message, {}};
-  node.put([&](std::string& t) { append_node_header(t, nvertices, d); });
+  // Every file of the mesh in its five parts (mesh_text_parts.hpp), fed by the same merges.
+  struct File {
+    MeshFile kind;
+    RootText text;
+  };
+  std::vector<File> files;
+  files.push_back({MeshFile::Node, {open_on_root(root, out, o.outbase + ".node", message), &message, {}}});
+  files.push_back({MeshFile::Ele, {open_on_root(root, out, o.outbase + ".ele", message), &message, {}}});
+  if (!o.vtk.empty()) files.push_back({MeshFile::Vtk, {open_on_root(root, out, o.vtk, message), &message, {}}});
+  if (!o.msh.empty()) files.push_back({MeshFile::Msh, {open_on_root(root, out, o.msh, message), &message, {}}});
+  for (File& f : files) f.text.put([&](std::string& t) { append_vertices_head(t, f.kind, nvertices, d); });
   std::size_t written = 0;
   std::vector<std::uint64_t> numbers;
-  node.merge([&] {
+  guarded(message, [&] {
     numbers = dynmesh::detail::number_on_root<Point<d>>(
         comm, std::span<const Point<d>>(vertices), 0, point_less,
         [&](std::span<const Point<d>> run) {
-          node.put([&](std::string& t) { append_node_lines(t, written, run, box); });
+          for (File& f : files)
+            f.text.put([&](std::string& t) { append_vertex_lines(t, f.kind, written, run, box); });
           written += run.size();
         },
         nvertices);
@@ -411,16 +424,19 @@ int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
   std::sort(cells.begin(), cells.end());
   std::uint64_t ncells_mine = cells.size(), ncells = 0;
   MPI_Reduce(&ncells_mine, &ncells, 1, MPI_UINT64_T, MPI_SUM, 0, comm);
-  RootText ele{open_on_root(root, out, o.outbase + ".ele", message), &message, {}};
-  ele.put([&](std::string& t) { append_ele_header(t, ncells, d + 1); });
+  for (File& f : files) f.text.put([&](std::string& t) { append_cells_head(t, f.kind, ncells, d + 1); });
   std::size_t written_cells = 0;
-  ele.merge([&] {
+  guarded(message, [&] {
     dynmesh::detail::merge_on_root<Cell>(comm, std::span<const Cell>(cells), 0, std::less<Cell>{},
                                          [&](std::span<const Cell> run) {
-                                           ele.put([&](std::string& t) { append_ele_lines(t, written_cells, run); });
+                                           for (File& f : files)
+                                             f.text.put([&](std::string& t) {
+                                               append_cell_lines(t, f.kind, written_cells, run);
+                                             });
                                            written_cells += run.size();
                                          });
   });
+  for (File& f : files) f.text.put([&](std::string& t) { append_file_tail(t, f.kind, ncells, d + 1); });
   if (root && message.empty()) {
     try {
       out.commit();
@@ -489,6 +505,8 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
       ->check(whole_number(1, std::numeric_limits<std::size_t>::max()));
   m->add_option("-o", o.outbase, "output: OUTBASE.node and OUTBASE.ele (written by rank 0)")->required();
   m->add_option("--feed", o.feed, "output: the change feed of every propagation");
+  m->add_option("--vtk", o.vtk, "also write the mesh as legacy VTK");
+  m->add_option("--msh", o.msh, "also write the mesh as Gmsh 2.2 ASCII");
   m->add_flag("--stats", o.stats, "per rank on stderr: points owned, ghost points, simplices owned, trace bytes, mean "
               "propagation time, peak resident memory");
   m->add_option("--partition-level", o.partition_level)->check(CLI::Range(0, 10))->group("");
@@ -498,7 +516,8 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
     if (o.outbase.empty()) throw CLI::ValidationError("-o needs a non-empty OUTBASE");
     const std::string clash = output_overwrites_input(
         {{"POINTS", o.points}, {"--edits", o.edits}},
-        {{"-o", o.outbase + ".node"}, {"-o", o.outbase + ".ele"}, {"--feed", o.feed}});
+        {{"-o", o.outbase + ".node"}, {"-o", o.outbase + ".ele"}, {"--feed", o.feed}, {"--vtk", o.vtk},
+         {"--msh", o.msh}});
     if (!clash.empty()) throw CLI::ValidationError(clash);
   });
   try {

@@ -121,13 +121,14 @@ expect_error() {
     fail "message differs from dynmesh quadtree's: $(cat ours.txt) / $(cat err1.txt)"
 }
 
-# same_mesh P POINTS ARGS...: dynmesh-mpi mesh on P ranks writes the ref.node, ref.ele and
-# ref.feed that dynmesh mesh wrote.
+# same_mesh P POINTS ARGS...: dynmesh-mpi mesh on P ranks writes the ref.node, ref.ele,
+# ref.feed, ref.vtk and ref.msh that dynmesh mesh wrote.
 same_mesh() {
   local p=$1
   shift
-  mpi "$p" mesh "$@" -o mpi --feed mpi.feed || { cat err.txt >&2; fail "a rank failed ($(tr '\n' ' ' <<<"$statuses")): -np $p mesh $*"; }
-  for f in node ele; do cmp -s ref.$f mpi.$f || fail "-np $p mesh $*: .$f differs from dynmesh mesh's"; done
+  mpi "$p" mesh "$@" -o mpi --feed mpi.feed --vtk mpi.vtk --msh mpi.msh ||
+    { cat err.txt >&2; fail "a rank failed ($(tr '\n' ' ' <<<"$statuses")): -np $p mesh $*"; }
+  for f in node ele vtk msh; do cmp -s ref.$f mpi.$f || fail "-np $p mesh $*: .$f differs from dynmesh mesh's"; done
   cmp -s ref.feed mpi.feed || fail "-np $p mesh $*: the feed differs from dynmesh mesh's"
 }
 
@@ -138,12 +139,12 @@ exact_mesh() {
   local dim=$1 dist=$2 n=$3 spread=$4 nedits=$5
   shift 5
   "$gen" "$dist" "$dim" "$n" 7 "$spread" in.xyz in.edits "$nedits" || fail "mpi_gen $dist"
-  "$dynmesh" mesh in.xyz --dim "$dim" --postprocess quadtree --edits in.edits --batch 9 -o ref --feed ref.feed "$@" \
+  "$dynmesh" mesh in.xyz --dim "$dim" --postprocess quadtree --edits in.edits --batch 9 -o ref --feed ref.feed --vtk ref.vtk --msh ref.msh "$@" \
     2>/dev/null || fail "dynmesh mesh $dist"
   for p in 1 2 3 4; do
     same_mesh "$p" in.xyz --dim "$dim" --postprocess quadtree --edits in.edits --batch 9 "$@" "${mpi_only[@]}"
   done
-  "$dynmesh" mesh in.xyz --dim "$dim" --postprocess quadtree --edits in.edits -o ref --feed ref.feed "$@" \
+  "$dynmesh" mesh in.xyz --dim "$dim" --postprocess quadtree --edits in.edits -o ref --feed ref.feed --vtk ref.vtk --msh ref.msh "$@" \
     2>/dev/null || fail "dynmesh mesh $dist"
   same_mesh 2 in.xyz --dim "$dim" --postprocess quadtree --edits in.edits "$@" "${mpi_only[@]}"
 }
@@ -321,7 +322,7 @@ case $case_name in
     ;;
   mesh_ghost_ring) # the meshes' ring (docs/DISTRIBUTED.md): one narrower breaks exactness here
     "$gen" uniform 3 800 3 2 t.xyz t.edits 100 || fail "mpi_gen"
-    "$dynmesh" mesh t.xyz --box 0 0 0 1 --edits t.edits --batch 3 -o ref --feed ref.feed 2>/dev/null || fail "dynmesh mesh"
+    "$dynmesh" mesh t.xyz --box 0 0 0 1 --edits t.edits --batch 3 -o ref --feed ref.feed --vtk ref.vtk --msh ref.msh 2>/dev/null || fail "dynmesh mesh"
     same_mesh 3 t.xyz --box 0 0 0 1 --edits t.edits --batch 3 --partition-level 4
     mpi 3 mesh t.xyz --box 0 0 0 1 --edits t.edits --batch 3 --partition-level 4 --ghost-ring 2 -o narrow \
       --feed narrow.feed || fail "ring 2 failed to run"
@@ -335,6 +336,7 @@ case $case_name in
     awk '!seen[$0]++' w.xyz | awk 'NR % 7 == 1 { print "- " $0 } NR % 14 == 1 { keep[++k] = $0 }
       END { for (i = 1; i <= k; i++) print "+ " keep[i] }' >w.edits
     "$dynmesh" mesh w.xyz --postprocess quadtree --duplicates skip --edits w.edits --batch 10 -o ref --feed ref.feed \
+      --vtk ref.vtk --msh ref.msh \
       >/dev/null 2>&1 || fail "dynmesh mesh on world.dat"
     for p in 1 2 3 4; do same_mesh "$p" w.xyz --postprocess quadtree --duplicates skip --edits w.edits --batch 10; done
     ;;

@@ -126,73 +126,112 @@ std::string ele_text(std::span<const std::array<std::uint32_t, k>> cells) {
 // ---- VTK and Gmsh ---------------------------------------------------------------------------
 
 /// Legacy VTK (version 3.0) ASCII unstructured grid: 3D points (z = 0 in 2D), 0-based cells,
-/// one VTK cell type for all.
+/// one VTK cell type for all. In parts: the header and `POINTS`, the point lines, `CELLS`,
+/// the cell lines, then `CELL_TYPES` and its lines.
+inline void append_vtk_points_head(std::string& out, std::size_t nv) {
+  out += "# vtk DataFile Version 3.0\ndynmesh mesh\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS ";
+  append_number(out, nv);
+  out += " double\n";
+}
+template <std::size_t d>
+void append_vtk_point_lines(std::string& out, std::span<const Point<d>> vertices) {
+  for (const Point<d>& p : vertices) {
+    append_coordinates(out, p, true);
+    append_line_end(out);
+  }
+}
+template <std::size_t k>
+void append_vtk_cells_head(std::string& out, std::size_t nt) {
+  out += "CELLS ";
+  append_number(out, nt);
+  out += ' ';
+  append_number(out, (k + 1) * nt);  // each cell: its point count, then its 0-based point ids
+  append_line_end(out);
+}
+template <std::size_t k, class Index>
+void append_vtk_cell_lines(std::string& out, std::span<const std::array<Index, k>> cells) {
+  for (const auto& cell : cells) {
+    out += digit<k>();
+    for (const Index v : cell) {
+      out += ' ';
+      append_number(out, static_cast<std::size_t>(v));
+    }
+    append_line_end(out);
+  }
+}
+inline void append_vtk_cell_types(std::string& out, std::size_t nt, int cell_type) {
+  out += "CELL_TYPES ";
+  append_number(out, nt);
+  append_line_end(out);
+  const std::string type_line = std::to_string(cell_type) + '\n';
+  for (std::size_t t = 0; t < nt; ++t) out += type_line;
+}
+
 template <std::size_t d, std::size_t k>
 std::string vtk_text(std::span<const Point<d>> vertices, std::span<const std::array<std::uint32_t, k>> cells,
                      int cell_type) {
   const std::size_t nv = vertices.size(), nt = cells.size();
   std::string out;
   out.reserve(160 + nv * 66 + nt * 8 * (k + 1));
-  out += "# vtk DataFile Version 3.0\ndynmesh mesh\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS ";
-  append_number(out, nv);
-  out += " double\n";
-  for (const Point<d>& p : vertices) {
-    append_coordinates(out, p, true);
-    append_line_end(out);
-  }
-  out += "CELLS ";
-  append_number(out, nt);
-  out += ' ';
-  append_number(out, (k + 1) * nt);  // each cell: its point count, then its 0-based point ids
-  append_line_end(out);
-  for (const auto& cell : cells) {
-    out += digit<k>();
-    for (std::uint32_t v : cell) {
-      out += ' ';
-      append_number(out, v);
-    }
-    append_line_end(out);
-  }
-  out += "CELL_TYPES ";
-  append_number(out, nt);
-  append_line_end(out);
-  const std::string type_line = std::to_string(cell_type) + '\n';
-  for (std::size_t t = 0; t < nt; ++t) out += type_line;
+  append_vtk_points_head(out, nv);
+  append_vtk_point_lines<d>(out, vertices);
+  append_vtk_cells_head<k>(out, nt);
+  append_vtk_cell_lines<k, std::uint32_t>(out, cells);
+  append_vtk_cell_types(out, nt, cell_type);
   return out;
 }
 
-/// Gmsh MSH 2.2 ASCII: 3D nodes (z = 0 in 2D) and 1-based elements of one type.
+/// Gmsh MSH 2.2 ASCII: 3D nodes (z = 0 in 2D) and 1-based elements of one type. In parts:
+/// the head with the node count, the node lines, the element head (`$EndNodes` and the
+/// element count), the element lines, `$EndElements`.
+inline void append_msh_nodes_head(std::string& out, std::size_t nv) {
+  out += "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n";
+  append_number(out, nv);
+  append_line_end(out);
+}
+template <std::size_t d>
+void append_msh_node_lines(std::string& out, std::size_t first, std::span<const Point<d>> vertices) {
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    append_number(out, first + i + 1);
+    out += ' ';
+    append_coordinates(out, vertices[i], true);
+    append_line_end(out);
+  }
+}
+inline void append_msh_elements_head(std::string& out, std::size_t nt) {
+  out += "$EndNodes\n$Elements\n";
+  append_number(out, nt);
+  append_line_end(out);
+}
+template <std::size_t k, class Index>
+void append_msh_element_lines(std::string& out, std::size_t first, std::span<const std::array<Index, k>> cells,
+                              int element_type) {
+  // Two tags per element: physical group 1 and elementary entity 1. Readers that keep only
+  // physical groups (dolfin-convert, some meshio paths) then keep them all.
+  const std::string type_and_tags = ' ' + std::to_string(element_type) + " 2 1 1";
+  for (std::size_t t = 0; t < cells.size(); ++t) {
+    append_number(out, first + t + 1);
+    out += type_and_tags;
+    for (const Index v : cells[t]) {
+      out += ' ';
+      append_number(out, static_cast<std::size_t>(v) + 1);
+    }
+    append_line_end(out);
+  }
+}
+inline void append_msh_end(std::string& out) { out += "$EndElements\n"; }
+
 template <std::size_t d, std::size_t k>
 std::string msh_text(std::span<const Point<d>> vertices, std::span<const std::array<std::uint32_t, k>> cells,
                      int element_type) {
   const std::size_t nv = vertices.size(), nt = cells.size();
   std::string out;
   out.reserve(160 + nv * 72 + nt * 8 * (k + 5));
-  out += "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n";
-  append_number(out, nv);
-  append_line_end(out);
-  for (std::size_t i = 0; i < nv; ++i) {
-    append_number(out, i + 1);
-    out += ' ';
-    append_coordinates(out, vertices[i], true);
-    append_line_end(out);
-  }
-  out += "$EndNodes\n$Elements\n";
-  append_number(out, nt);
-  append_line_end(out);
-  // Two tags per element: physical group 1 and elementary entity 1. Readers that keep only
-  // physical groups (dolfin-convert, some meshio paths) then keep them all.
-  const std::string type_and_tags = ' ' + std::to_string(element_type) + " 2 1 1";
-  for (std::size_t t = 0; t < nt; ++t) {
-    append_number(out, t + 1);
-    out += type_and_tags;
-    for (std::uint32_t v : cells[t]) {
-      out += ' ';
-      append_number(out, std::size_t{v} + 1);
-    }
-    append_line_end(out);
-  }
-  out += "$EndElements\n";
+  append_msh_nodes_head(out, nv);
+  append_msh_node_lines<d>(out, 0, vertices);
+  append_msh_elements_head(out, nt);
+  append_msh_element_lines<k, std::uint32_t>(out, 0, cells, element_type);
+  append_msh_end(out);
   return out;
 }
 
