@@ -371,16 +371,15 @@ int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
   MpiRankStats rank_stats;
   int partition_level = 0;
   if (o.stats) rank_stats = mesh->rank_stats(), partition_level = mesh->partition_level();
-  // The simplices this rank owns, then the mesh goes: the trace is most of the memory.
-  const std::vector<Simplex> mine = mesh->local_simplices();
+  // The simplices this rank owns, in index form, then the mesh goes: the trace is most of
+  // the memory.
+  const CanonicalMesh<d> mine = mesh->owned_mesh();
   mesh.reset();
-
-  std::vector<Point<d>> vertices;
-  vertices.reserve(mine.size() * (d + 1));
-  for (const Simplex& s : mine)
-    for (const Point<d>& v : s.v) vertices.push_back(v);
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  const std::vector<Point<d>>& vertices = mine.vertices;
+  const auto& owned_cells = [&]() -> const auto& {
+    if constexpr (d == 2) return mine.triangles;
+    else return mine.tetrahedra;
+  }();
   const auto point_less = [](const Point<d>& a, const Point<d>& b) { return a < b; };
   std::uint64_t nvertices = 0;
   (void)dynmesh::detail::number_on_root<Point<d>>(comm, std::span<const Point<d>>(vertices), 0, point_less,
@@ -409,19 +408,16 @@ int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
         nvertices);
   });
 
-  // Vertex numbers follow coordinate order, so a canonical simplex's corners, numbered, are
-  // its canonical index form, and sorting either form sorts the other.
+  // Global numbers follow the local ones' order (both are coordinate order), so the
+  // renumbered tuples stay canonical and sorted.
   using Cell = std::array<std::uint64_t, d + 1>;
   std::vector<Cell> cells;
-  cells.reserve(mine.size());
-  for (const Simplex& s : mine) {
+  cells.reserve(owned_cells.size());
+  for (const auto& local : owned_cells) {
     Cell c{};
-    for (std::size_t k = 0; k <= d; ++k)
-      c[k] = numbers[static_cast<std::size_t>(std::lower_bound(vertices.begin(), vertices.end(), s.v[k]) -
-                                              vertices.begin())];
+    for (std::size_t k = 0; k <= d; ++k) c[k] = numbers[local[k]];
     cells.push_back(c);
   }
-  std::sort(cells.begin(), cells.end());
   std::uint64_t ncells_mine = cells.size(), ncells = 0;
   MPI_Reduce(&ncells_mine, &ncells, 1, MPI_UINT64_T, MPI_SUM, 0, comm);
   for (File& f : files) f.text.put([&](std::string& t) { append_cells_head(t, f.kind, ncells, d + 1); });
@@ -445,7 +441,7 @@ int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
       message = e.what();
     }
   }
-  if (o.stats) print_stats(comm, rank_stats, partition_level, peak_rss_mib(), -1, -1, static_cast<long long>(mine.size()));
+  if (o.stats) print_stats(comm, rank_stats, partition_level, peak_rss_mib(), -1, -1, static_cast<long long>(owned_cells.size()));
   if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
   return 0;
 }

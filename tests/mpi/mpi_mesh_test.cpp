@@ -49,11 +49,16 @@ std::vector<Tetrahedron> twin(const Box<3>& box, const std::vector<Point<3>>& po
   return OctreeMesh(box, points).tetrahedra();
 }
 
-/// The ranks' owned simplices, merged on rank 0, equal the static twin's on `points` (agreed).
+Mesh canonical(const std::vector<Triangle>& t) { return make_mesh(t); }
+TetMesh canonical(const std::vector<Tetrahedron>& t) { return make_tet_mesh(t); }
+
+/// The ranks' owned simplices, merged on rank 0, equal the static twin's on `points`, and
+/// each rank's index form is its simplices' (agreed).
 template <std::size_t d>
 bool exact(const MpiMesh<d>& mesh, const std::vector<Point<d>>& points) {
   using Simplex = MeshSimplex<d>;
   const std::vector<Simplex> mine = mesh.local_simplices();
+  check(canonical(mine) == mesh.owned_mesh(), "owned_mesh() is not the owned simplices' index form");
   std::vector<Simplex> all;
   int ok = 1;
   try {

@@ -62,6 +62,9 @@ inline MpiQuadtreeOptions mpi_mesh_defaults() {
 
 template <std::size_t d>
 using MeshSimplex = std::conditional_t<d == 2, Triangle, Tetrahedron>;
+/// The canonical index form: Mesh (2D) or TetMesh (3D).
+template <std::size_t d>
+using CanonicalMesh = std::conditional_t<d == 2, Mesh, TetMesh>;
 
 /// An update's change restricted to one rank's simplices: both sorted, canonical.
 template <std::size_t d>
@@ -100,6 +103,9 @@ class MpiMesh {
 
   /// The simplices this rank owns, canonical and sorted.
   std::vector<Simplex> local_simplices() const;
+  /// The same in index form: the vertices they use, sorted, and the simplices as canonical
+  /// index tuples, sorted (a sixth of the coordinates' memory in 3D: what the writer uses).
+  CanonicalMesh<d> owned_mesh() const;
   /// The last apply()'s change to the simplices this rank owns (empty after construction).
   const OwnedChange<d>& local_change() const noexcept;
 

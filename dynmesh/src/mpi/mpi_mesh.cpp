@@ -87,16 +87,20 @@ struct MpiMeshState : MpiState<d, LocalMesh<d>> {
     this->compute_coarse();
   }
 
-  /// The root cell holding the simplex's centroid, in doubles: the same on every rank, so
-  /// every simplex has one owner.
-  std::uint64_t owner_root(const Simplex& s) const {
+  /// The root cell holding the centroid of the corners `at(0..d)` (canonical order), in
+  /// doubles: the same on every rank, so every simplex has one owner.
+  template <class Corner>
+  std::uint64_t owner_root(Corner&& at) const {
     Point<d> c{};
     for (std::size_t a = 0; a < d; ++a) {
       double sum = 0;
-      for (const auto& v : s.v) sum += v[a];
-      c[a] = sum / static_cast<double>(s.v.size());
+      for (std::size_t k = 0; k <= d; ++k) sum += at(k)[a];
+      c[a] = sum / static_cast<double>(d + 1);
     }
     return this->root_of(dynmesh::locate(box, c));
+  }
+  std::uint64_t owner_root(const Simplex& s) const {
+    return owner_root([&s](std::size_t k) -> const Point<d>& { return s.v[k]; });
   }
 
   std::vector<Simplex> owned(const std::vector<Simplex>& all) const {
@@ -185,6 +189,40 @@ template <std::size_t d>
   requires SupportedDim<d>
 std::vector<typename MpiMesh<d>::Simplex> MpiMesh<d>::local_simplices() const {
   return s_->owned(detail::LocalTraits<detail::LocalMesh<d>>::simplices(*s_->tree));
+}
+
+template <std::size_t d>
+  requires SupportedDim<d>
+CanonicalMesh<d> MpiMesh<d>::owned_mesh() const {
+  const auto& s = *s_;
+  const CanonicalMesh<d> all = s.tree->mesh();
+  const auto& cells = [&]() -> const auto& {
+    if constexpr (d == 2) return all.triangles;
+    else return all.tetrahedra;
+  }();
+  CanonicalMesh<d> out;
+  auto& kept = [&]() -> auto& {
+    if constexpr (d == 2) return out.triangles;
+    else return out.tetrahedra;
+  }();
+  constexpr std::uint32_t kUnused = ~std::uint32_t{0};
+  std::vector<std::uint32_t> renumber(all.vertices.size(), kUnused);
+  for (const auto& c : cells) {
+    const std::uint64_t m = s.owner_root([&](std::size_t k) -> const Point<d>& { return all.vertices[c[k]]; });
+    if (s.role[m] != 1) continue;
+    kept.push_back(c);
+    for (const std::uint32_t v : c) renumber[v] = 0;
+  }
+  // The kept vertices in their order: a monotone renumbering keeps every tuple canonical and
+  // the tuples sorted.
+  for (std::size_t v = 0; v < all.vertices.size(); ++v)
+    if (renumber[v] != kUnused) {
+      renumber[v] = static_cast<std::uint32_t>(out.vertices.size());
+      out.vertices.push_back(all.vertices[v]);
+    }
+  for (auto& c : kept)
+    for (std::uint32_t& v : c) v = renumber[v];
+  return out;
 }
 
 template <std::size_t d>
