@@ -1,19 +1,28 @@
-// dynmesh-mpi — `dynmesh quadtree` on MPI ranks (docs/FORMATS.md, docs/DISTRIBUTED.md):
+// dynmesh-mpi — `dynmesh quadtree` and `dynmesh mesh --postprocess quadtree` on MPI ranks
+// (docs/FORMATS.md, docs/DISTRIBUTED.md):
 //   mpirun -np P dynmesh-mpi quadtree POINTS [--dim 2|3] [--box o1 o2 [o3] L]
 //                [--duplicates error|skip] [--edits FILE] [--batch K] --cells OUT [--stats]
-// Same inputs, box and edit semantics as `dynmesh quadtree`, through the same readers and
-// labels (initial_points.hpp, input_labels.hpp): rank 0 reads the files and hands the points
-// and the edits to MpiQuadtree, which routes them to their ranks. OUT is written once, by
-// rank 0 as the ranks' sorted leaves arrive (no rank holds them all), and equals `dynmesh
-// quadtree`'s `.cells` for every P. --stats prints, per rank, on
-// stderr (gathered to rank 0, in rank order): points owned, ghost points, trace bytes, mean
-// time per propagation, peak resident memory.
+//   mpirun -np P dynmesh-mpi mesh POINTS [--dim 2|3] [--box ...] [--postprocess quadtree]
+//                [--min-angle DEG] [--duplicates error|skip] [--edits FILE] [--batch K]
+//                -o OUTBASE [--feed F] [--vtk F] [--msh F] [--stats]
+// Same inputs, box and edit semantics as the one-process commands, through the same readers
+// and labels (initial_points.hpp, input_labels.hpp): rank 0 reads the files and hands the
+// points and the edits to MpiQuadtree or MpiMesh, which route them to their ranks. Every
+// output is written once, by rank 0, as the ranks' sorted parts arrive (no rank holds them
+// all), and equals the one-process command's for every P: the leaves merged
+// (detail/merge_on_root.hpp); the feed merged per propagation; the mesh's vertices numbered
+// as they merge, each rank told its numbers (detail/number_on_root.hpp), then its simplices
+// renumbered and merged; every file in the parts of mesh_text_parts.hpp. --stats prints, per
+// rank, on stderr (gathered to rank 0, in rank order): points owned, ghost points, simplices
+// owned (mesh), trace bytes, mean time per propagation, peak resident memory. DynHPU does not
+// run on ranks: `mesh` refuses --postprocess hpu, the 2D default.
 // Errors: one line `dynmesh-mpi: <message>` from rank 0 and exit status 1 on every rank (2 for
 // a malformed command line); every failure is agreed by all ranks before the next
-// collective, so none waits forever. Hidden test options: --partition-level L (l0),
-// --ghost-ring W (a narrower ring must break exactness), --rebalance F, --measure-writing
-// (with --stats: the writing's own peak memory, by restarting the process's peak counter
-// when the writing begins; docs/DISTRIBUTED.md, "Writing the output").
+// collective, so none waits forever. Hidden test options: --partition-level L (l0; the mesh
+// lowers it to T*'s coarsest leaf), --ghost-ring W (a narrower ring must break exactness),
+// --rebalance F, --measure-writing (quadtree, with --stats: the writing's own peak memory, by
+// restarting the process's peak counter when the writing begins; docs/DISTRIBUTED.md,
+// "Writing the output").
 // No memory guard: the memory is spread over the ranks, which one process cannot see.
 #include <algorithm>
 #include <cstddef>
@@ -335,7 +344,7 @@ int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
   // The feed streams to its file aside as the edits propagate.
   AtomicOutputs out;
   RootText feed{open_on_root(root, out, o.feed, message), &message, {}};
-  feed.put([](std::string& t) { t += "# dynmesh feed v1\n"; });
+  feed.put([](std::string& t) { t += feed_header(); });
   const auto less = [](const Simplex& a, const Simplex& b) { return a < b; };
   std::size_t propagations = 0;
   auto write_update = [&] {

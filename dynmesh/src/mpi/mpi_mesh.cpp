@@ -152,8 +152,25 @@ template <std::size_t d>
 MpiMesh<d>::MpiMesh(MPI_Comm comm, const Box<d>& box, std::span<const Point<d>> points,
                     const MpiQuadtreeOptions& options)
     : s_(std::make_unique<detail::MpiMeshState<d>>()) {
+  MpiQuadtreeOptions chosen = options;
+  if (chosen.partition_level < 0) {
+    // The finest partition the meshes allow is T*'s coarsest leaf (capped at the finest level
+    // counted): the finer the root cells, the thinner the ring of 3 around a rank's run. T*
+    // alone finds it, at a fraction of a mesh's cost, and is freed before the meshes are built.
+    MpiQuadtreeOptions probe;
+    probe.partition_level = detail::kMaxPartitionLevel<d>;
+    probe.rebalance_factor = 0;
+    int coarsest = detail::kMaxPartitionLevel<d>;
+    {
+      const MpiQuadtree<d> tree(comm, box, points, probe);
+      for (const Leaf<d>& leaf : tree.local_leaves()) coarsest = std::min(coarsest, leaf.cell.level);
+    }
+    int least = coarsest;
+    MPI_Allreduce(&coarsest, &least, 1, MPI_INT, MPI_MIN, comm);
+    chosen.partition_level = least;
+  }
   s_->split_to_l0 = true;
-  s_->construct(comm, box, points, options);
+  s_->construct(comm, box, points, chosen);
   if (!s_->top_split()) s_->rebuild_at(s_->coarsest_leaf());
 }
 
