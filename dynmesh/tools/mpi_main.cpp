@@ -133,65 +133,108 @@ void print_stats(MPI_Comm comm, const MpiRankStats& st, int partition_level, dou
   for (int r = 0; r < nranks; ++r) std::fprintf(stderr, "%s\n", all.data() + static_cast<std::size_t>(r) * sizeof line);
 }
 
+/// What rank 0 read, and what every rank learns of it: the box and the number of edits.
 template <std::size_t d>
-int run(MPI_Comm comm, const Options& o, Columns columns) {
+struct Inputs {
+  std::optional<InitialPoints<d>> initial;  // rank 0
+  EditScript<d> script;                     // rank 0
+  Box<d> box;
+  std::uint64_t nedits = 0;
+  /// The initial points on rank 0, none elsewhere (the structures route them).
+  std::span<const Point<d>> points(bool root) const {
+    return root ? std::span<const Point<d>>(initial->file.points) : std::span<const Point<d>>{};
+  }
+};
+
+/// Rank 0 reads POINTS and the edit script; the box and the edit count go to every rank.
+/// False (rank 0 has printed the error) when reading failed.
+template <std::size_t d>
+bool read_inputs(MPI_Comm comm, const Options& o, Columns columns, Inputs<d>& in) {
   const bool root = rank_of(comm) == 0;
-  std::optional<InitialPoints<d>> initial;
-  EditScript<d> script;
   std::string message;
   if (root) {
     try {
-      initial.emplace(read_initial_points<d>(o.points, o.box, o.skip_duplicates, columns));
-      if (!o.edits.empty()) script = read_edits_file<d>(o.edits);
+      in.initial.emplace(read_initial_points<d>(o.points, o.box, o.skip_duplicates, columns));
+      if (!o.edits.empty()) in.script = read_edits_file<d>(o.edits);
     } catch (const std::exception& e) {
       message = e.what();
     }
   }
-  if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
-
-  Box<d> box;
-  if (root) box = initial->box;
+  if (shared_failure(comm, message)) {
+    if (root) print_error(message);
+    return false;
+  }
+  if (root) in.box = in.initial->box;
   double words[d + 1];
-  for (std::size_t a = 0; a < d; ++a) words[a] = box.origin[a];
-  words[d] = box.side;
+  for (std::size_t a = 0; a < d; ++a) words[a] = in.box.origin[a];
+  words[d] = in.box.side;
   MPI_Bcast(words, d + 1, MPI_DOUBLE, 0, comm);
-  for (std::size_t a = 0; a < d; ++a) box.origin[a] = words[a];
-  box.side = words[d];
-  std::uint64_t nedits = script.edits.size();
-  MPI_Bcast(&nedits, 1, MPI_UINT64_T, 0, comm);
+  for (std::size_t a = 0; a < d; ++a) in.box.origin[a] = words[a];
+  in.box.side = words[d];
+  in.nedits = in.script.edits.size();
+  MPI_Bcast(&in.nedits, 1, MPI_UINT64_T, 0, comm);
+  return true;
+}
+
+/// Builds the structure with make(); an InputError (the same on every rank) is labelled by
+/// rank 0 with the point file's lines. False when it failed.
+template <std::size_t d, class Structure, class Make>
+bool build_or_report(MPI_Comm comm, const Inputs<d>& in, int resolution_level, std::optional<Structure>& out,
+                     Make&& make) {
+  try {
+    make(out);
+    return true;
+  } catch (const InputError& e) {
+    if (rank_of(comm) != 0) return false;
+    try {
+      rethrow_construction_error<d>(e, *in.initial, resolution_level);
+    } catch (const std::exception& labelled) {
+      print_error(labelled.what());
+    }
+    return false;
+  }
+}
+
+/// Applies the script in batches of --batch (1 without it) on every rank, calling after()
+/// after each; false (rank 0 has printed it, named by its line) when an edit is refused.
+template <std::size_t d, class Structure, class After>
+bool apply_script(MPI_Comm comm, const Options& o, const Inputs<d>& in, Structure& structure, After&& after) {
+  const bool root = rank_of(comm) == 0;
+  const std::size_t step = o.batch == 0 ? 1 : o.batch;
+  const std::span<const Edit<d>> all(in.script.edits);
+  for (std::uint64_t i = 0; i < in.nedits; i += step) {
+    const std::size_t k = static_cast<std::size_t>(std::min<std::uint64_t>(step, in.nedits - i));
+    try {
+      structure.apply(root ? all.subspan(static_cast<std::size_t>(i), k) : std::span<const Edit<d>>{});
+    } catch (const InputError& err) {
+      if (!root) return false;
+      const std::size_t at = err.point_indices().empty() ? 0 : err.point_indices().back();
+      print_error(edit_error<d>(in.script, static_cast<std::size_t>(i) + at, err).what());
+      return false;
+    }
+    after();
+  }
+  return true;
+}
+
+template <std::size_t d>
+int run(MPI_Comm comm, const Options& o, Columns columns) {
+  const bool root = rank_of(comm) == 0;
+  Inputs<d> in;
+  if (!read_inputs<d>(comm, o, columns, in)) return 1;
+  const std::optional<InitialPoints<d>>& initial = in.initial;
+  const Box<d>& box = in.box;
+  std::string message;
 
   MpiQuadtreeOptions options;
   options.partition_level = o.partition_level;
   options.ghost_ring = o.ghost_ring >= 0 ? o.ghost_ring : 1;
   options.rebalance_factor = o.rebalance;
   std::optional<MpiQuadtree<d>> tree;
-  try {
-    tree.emplace(comm, box, root ? std::span<const Point<d>>(initial->file.points) : std::span<const Point<d>>{},
-                 options);
-  } catch (const InputError& e) {
-    // Every rank has the same error; rank 0 labels it with the file's lines.
-    if (!root) return 1;
-    try {
-      rethrow_construction_error<d>(e, *initial);
-    } catch (const std::exception& labelled) {
-      print_error(labelled.what());
-    }
+  if (!build_or_report<d>(comm, in, kMaxLevel, tree,
+                          [&](auto& t) { t.emplace(comm, box, in.points(root), options); }))
     return 1;
-  }
-
-  const std::size_t step = o.batch == 0 ? 1 : o.batch;
-  const std::span<const Edit<d>> all(script.edits);
-  for (std::uint64_t i = 0; i < nedits; i += step) {
-    const std::size_t k = static_cast<std::size_t>(std::min<std::uint64_t>(step, nedits - i));
-    try {
-      tree->apply(root ? all.subspan(static_cast<std::size_t>(i), k) : std::span<const Edit<d>>{});
-    } catch (const InputError& err) {
-      if (!root) return 1;
-      const std::size_t at = err.point_indices().empty() ? 0 : err.point_indices().back();
-      print_error(edit_error<d>(script, static_cast<std::size_t>(i) + at, err).what());
-      return 1;
-    }
-  }
+  if (!apply_script<d>(comm, o, in, *tree, [] {})) return 1;
   MpiRankStats rank_stats;
   int partition_level = 0;
   if (o.stats) rank_stats = tree->rank_stats(), partition_level = tree->partition_level();
@@ -298,48 +341,22 @@ template <std::size_t d>
 int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
   using Simplex = MeshSimplex<d>;
   const bool root = rank_of(comm) == 0;
-  std::optional<InitialPoints<d>> initial;
-  EditScript<d> script;
+  Inputs<d> in;
+  if (!read_inputs<d>(comm, o, columns, in)) return 1;
+  const std::optional<InitialPoints<d>>& initial = in.initial;
+  const Box<d>& box = in.box;
   std::string message;
-  if (root) {
-    try {
-      initial.emplace(read_initial_points<d>(o.points, o.box, o.skip_duplicates, columns));
-      if (!o.edits.empty()) script = read_edits_file<d>(o.edits);
-    } catch (const std::exception& e) {
-      message = e.what();
-    }
-  }
-  if (shared_failure(comm, message)) return root ? (print_error(message), 1) : 1;
-
-  Box<d> box;
-  if (root) box = initial->box;
-  double words[d + 1];
-  for (std::size_t a = 0; a < d; ++a) words[a] = box.origin[a];
-  words[d] = box.side;
-  MPI_Bcast(words, d + 1, MPI_DOUBLE, 0, comm);
-  for (std::size_t a = 0; a < d; ++a) box.origin[a] = words[a];
-  box.side = words[d];
-  std::uint64_t nedits = script.edits.size();
-  MPI_Bcast(&nedits, 1, MPI_UINT64_T, 0, comm);
 
   MpiQuadtreeOptions options = mpi_mesh_defaults();
   options.partition_level = o.partition_level;
   if (o.ghost_ring >= 0) options.ghost_ring = o.ghost_ring;
   options.rebalance_factor = o.rebalance;
   std::optional<MpiMesh<d>> mesh;
-  try {
-    mesh.emplace(comm, box, root ? std::span<const Point<d>>(initial->file.points) : std::span<const Point<d>>{},
-                 options);
-  } catch (const InputError& e) {
-    if (!root) return 1;
-    try {
-      const int level = dynmesh::detail::BasicMeshGrid<d>::resolution_level(box);
-      rethrow_construction_error<d>(e, *initial, level >= 2 ? level : -1);
-    } catch (const std::exception& labelled) {
-      print_error(labelled.what());
-    }
+  // The mesh resolves points only down to its level R (none below 2: the box is unusable).
+  const int level = dynmesh::detail::BasicMeshGrid<d>::resolution_level(box);
+  if (!build_or_report<d>(comm, in, level >= 2 ? level : -1, mesh,
+                          [&](auto& m) { m.emplace(comm, box, in.points(root), options); }))
     return 1;
-  }
 
   // The feed streams to its file aside as the edits propagate.
   AtomicOutputs out;
@@ -362,20 +379,7 @@ int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
                                                 });
       });
   };
-  const std::size_t step = o.batch == 0 ? 1 : o.batch;
-  const std::span<const Edit<d>> all(script.edits);
-  for (std::uint64_t i = 0; i < nedits; i += step) {
-    const std::size_t k = static_cast<std::size_t>(std::min<std::uint64_t>(step, nedits - i));
-    try {
-      mesh->apply(root ? all.subspan(static_cast<std::size_t>(i), k) : std::span<const Edit<d>>{});
-    } catch (const InputError& err) {
-      if (!root) return 1;
-      const std::size_t at = err.point_indices().empty() ? 0 : err.point_indices().back();
-      print_error(edit_error<d>(script, static_cast<std::size_t>(i) + at, err).what());
-      return 1;
-    }
-    write_update();
-  }
+  if (!apply_script<d>(comm, o, in, *mesh, write_update)) return 1;
 
   MpiRankStats rank_stats;
   int partition_level = 0;

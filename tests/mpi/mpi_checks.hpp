@@ -1,12 +1,20 @@
 // mpi_checks.hpp — what the plain-main MPI tests share (tests/mpi/): each rank counts its
 // failed checks and prints them on stderr; at the end every rank learns the total, rank 0
-// prints one verdict line, and the exit status is that total's.
+// prints one verdict line, and the exit status is that total's. Also each rank's slice of a
+// batch, and the random batches of the differential tests.
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
+#include <span>
 #include <string>
+#include <vector>
 
 #include <mpi.h>
+
+#include "dynmesh/distributions.hpp"
+#include "dynmesh/edit.hpp"
+#include "dynmesh/point.hpp"
 
 namespace mpi_checks {
 
@@ -23,6 +31,41 @@ inline void check(bool ok, const std::string& what) {
   if (ok) return;
   ++g_failures;
   std::fprintf(stderr, "FAIL (rank %d): %s\n", g_rank, what.c_str());
+}
+
+/// Rank r's contiguous share of v: every rank passes its own slice of the same batch, so
+/// the global order (rank 0's slice first) is the batch's order.
+template <class T>
+std::span<const T> share(const std::vector<T>& v) {
+  const std::size_t lo = v.size() * static_cast<std::size_t>(g_rank) / static_cast<std::size_t>(g_ranks);
+  const std::size_t hi = v.size() * static_cast<std::size_t>(g_rank + 1) / static_cast<std::size_t>(g_ranks);
+  return std::span<const T>(v).subspan(lo, hi - lo);
+}
+
+/// A batch of about k random edits (the same on every rank for the same rng): each deletes a
+/// present point or inserts a spare one, half and half while both last; `points` and
+/// `spare` follow.
+template <std::size_t d>
+std::vector<dynmesh::Edit<d>> random_batch(dynmesh::Rng& rng, std::size_t k, std::vector<dynmesh::Point<d>>& points,
+                                           std::vector<dynmesh::Point<d>>& spare) {
+  using dynmesh::EditOp;
+  std::vector<dynmesh::Edit<d>> batch;
+  for (std::size_t i = 0; i < k; ++i) {
+    if ((rng.below(2) == 0 || spare.empty()) && !points.empty()) {
+      const std::size_t j = static_cast<std::size_t>(rng.below(points.size()));
+      batch.push_back(dynmesh::Edit<d>{EditOp::Delete, points[j]});
+      spare.push_back(points[j]);
+      points[j] = points.back();
+      points.pop_back();
+    } else if (!spare.empty()) {
+      const std::size_t j = static_cast<std::size_t>(rng.below(spare.size()));
+      batch.push_back(dynmesh::Edit<d>{EditOp::Insert, spare[j]});
+      points.push_back(spare[j]);
+      spare[j] = spare.back();
+      spare.pop_back();
+    }
+  }
+  return batch;
 }
 
 /// Collective: the verdict of every rank's checks (rank 0 prints it), then MPI_Finalize;

@@ -34,13 +34,8 @@ using namespace dynmesh;
 using mpi_checks::check;
 using mpi_checks::g_rank;
 using mpi_checks::g_ranks;
-
-template <class T>
-std::span<const T> share(const std::vector<T>& v) {
-  const std::size_t lo = v.size() * static_cast<std::size_t>(g_rank) / static_cast<std::size_t>(g_ranks);
-  const std::size_t hi = v.size() * static_cast<std::size_t>(g_rank + 1) / static_cast<std::size_t>(g_ranks);
-  return std::span<const T>(v).subspan(lo, hi - lo);
-}
+using mpi_checks::random_batch;
+using mpi_checks::share;
 
 std::vector<Triangle> twin(const Box<2>& box, const std::vector<Point<2>>& points) {
   return QuadtreeMesh(box, points).triangles();
@@ -87,23 +82,8 @@ void differential(Distribution dist, std::uint64_t seed, std::size_t n, const Mp
   check(exact(mesh, points), label + ": after construction");
   Rng rng(seed * 31 + 7);
   for (int b = 0; b < 12; ++b) {
-    std::vector<Edit<d>> batch;
     const std::size_t k = 1 + static_cast<std::size_t>(rng.below(b % 4 == 0 ? 20 : 4));
-    for (std::size_t i = 0; i < k; ++i) {
-      if ((rng.below(2) == 0 || spare.empty()) && !points.empty()) {
-        const std::size_t j = static_cast<std::size_t>(rng.below(points.size()));
-        batch.push_back(Edit<d>{EditOp::Delete, points[j]});
-        spare.push_back(points[j]);
-        points[j] = points.back();
-        points.pop_back();
-      } else if (!spare.empty()) {
-        const std::size_t j = static_cast<std::size_t>(rng.below(spare.size()));
-        batch.push_back(Edit<d>{EditOp::Insert, spare[j]});
-        points.push_back(spare[j]);
-        spare[j] = spare.back();
-        spare.pop_back();
-      }
-    }
+    const std::vector<Edit<d>> batch = random_batch<d>(rng, k, points, spare);
     mesh.apply(share(batch));
     if (!exact(mesh, points)) {
       check(false, label + ": batch " + std::to_string(b) + " differs from the static twin");

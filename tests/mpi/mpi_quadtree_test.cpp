@@ -32,15 +32,10 @@ using namespace dynmesh;
 using mpi_checks::check;
 using mpi_checks::g_rank;
 using mpi_checks::g_ranks;
+using mpi_checks::random_batch;
+using mpi_checks::share;
 
 /// Rank r's contiguous share of v.
-template <class T>
-std::span<const T> share(const std::vector<T>& v) {
-  const std::size_t lo = v.size() * static_cast<std::size_t>(g_rank) / static_cast<std::size_t>(g_ranks);
-  const std::size_t hi = v.size() * static_cast<std::size_t>(g_rank + 1) / static_cast<std::size_t>(g_ranks);
-  return std::span<const T>(v).subspan(lo, hi - lo);
-}
-
 /// The gathered leaves equal the static oracle's on `points` (checked on rank 0, agreed).
 template <std::size_t d>
 bool exact(const MpiQuadtree<d>& tree, const std::vector<Point<d>>& points) {
@@ -66,24 +61,8 @@ void differential(Distribution dist, std::uint64_t seed, const MpiQuadtreeOption
   check(exact(tree, points), label + ": after construction");
   Rng rng(seed * 31 + 7);
   for (int b = 0; b < 25; ++b) {
-    std::vector<Edit<d>> batch;
     const std::size_t k = 1 + static_cast<std::size_t>(rng.below(b % 5 == 0 ? 40 : 6));
-    for (std::size_t i = 0; i < k; ++i) {
-      if ((rng.below(2) == 0 || spare.empty()) && !points.empty()) {
-        const std::size_t j = static_cast<std::size_t>(rng.below(points.size()));
-        batch.push_back(Edit<d>{EditOp::Delete, points[j]});
-        spare.push_back(points[j]);
-        points[j] = points.back();
-        points.pop_back();
-      } else if (!spare.empty()) {
-        // Not the point just deleted in this batch (that is allowed, but rare by chance).
-        const std::size_t j = static_cast<std::size_t>(rng.below(spare.size()));
-        batch.push_back(Edit<d>{EditOp::Insert, spare[j]});
-        points.push_back(spare[j]);
-        spare[j] = spare.back();
-        spare.pop_back();
-      }
-    }
+    const std::vector<Edit<d>> batch = random_batch<d>(rng, k, points, spare);
     tree.apply(share(batch));
     if (!exact(tree, points)) {
       check(false, label + ": batch " + std::to_string(b) + " differs from StaticQuadtree");

@@ -135,13 +135,7 @@ std::vector<Leaf<d>> MpiQuadtree<d>::gather_leaves(int root) const {
 template <std::size_t d>
   requires SupportedDim<d>
 MpiRankStats MpiQuadtree<d>::rank_stats() const {
-  const auto& s = *s_;
-  MpiRankStats st = s.stats;
-  st.owned_points = s.owned_points();
-  st.ghost_points = s.tree->size() - st.owned_points;
-  st.owned_roots = s.starts[s.rank + 1] - s.starts[s.rank];
-  st.trace_bytes = s.tree->trace_bytes();
-  return st;
+  return s_->rank_stats();
 }
 
 template <std::size_t d>

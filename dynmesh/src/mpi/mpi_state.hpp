@@ -327,6 +327,16 @@ struct MpiState {
     return l0 == 0 || (coarse[static_cast<std::size_t>(l0 - 1)][m >> d] & kSplit);
   }
 
+  /// This rank's figures (MpiQuadtree::rank_stats, MpiMesh::rank_stats).
+  MpiRankStats rank_stats() const {
+    MpiRankStats st = stats;
+    st.owned_points = owned_points();
+    st.ghost_points = tree->size() - st.owned_points;
+    st.owned_roots = starts[rank + 1] - starts[rank];
+    st.trace_bytes = tree->trace_bytes();
+    return st;
+  }
+
   std::size_t owned_points() const {
     std::size_t k = 0;
     for (std::uint64_t m = starts[rank]; m < starts[rank + 1]; ++m) k += counts[m];
