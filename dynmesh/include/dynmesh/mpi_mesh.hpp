@@ -6,7 +6,7 @@
 // argument). Every call is collective over the communicator.
 //   * Partition and routing are MpiQuadtree's (root cells of a partition level l0 in Morton
 //     order, runs balanced by point count), with a wider ghost ring (kMeshGhostRing) and l0
-//     kept at or above every leaf of T*: no leaf of T* is coarser than a root cell.
+//     never finer than T*'s coarsest leaf: no leaf of T* is coarser than a root cell.
 //   * Each rank runs the single-process dynamic mesh (DynamicMesh with the quadtree
 //     postprocess, or DynamicOctreeMesh) on the points of its own and its ghost root cells,
 //     its tree splitting every cell coarser than l0 (DynamicQuadtreeOptions::split_below).
