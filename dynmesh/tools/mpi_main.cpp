@@ -459,35 +459,46 @@ int run_mesh(MPI_Comm comm, const Options& o, Columns columns) {
   return 0;
 }
 
-int parse_and_run(MPI_Comm comm, int argc, char** argv) {
-  const bool root = rank_of(comm) == 0;
-  CLI::App app{"dynmesh-mpi: the dynamic quadtree T* on MPI ranks, equal to `dynmesh quadtree` "
-               "(docs/FORMATS.md, docs/DISTRIBUTED.md)"};
-  app.require_subcommand(1);
-  Options o;
-  CLI::App* q = app.add_subcommand("quadtree", "Build T* of a point file on the ranks, apply an edit script, write the leaves");
-  q->add_option("POINTS", o.points, "point file: .node, the vertices of a .poly, or plain text; read by rank 0")->required();
-  CLI::Option* dim = q->add_option("--dim", o.dim,
+/// The options both subcommands take: the points, their dimension and box, duplicates, the
+/// edit script and its batches. Returns --dim.
+CLI::Option* add_inputs(CLI::App* c, Options& o) {
+  c->add_option("POINTS", o.points, "point file: .node, the vertices of a .poly, or plain text; read by rank 0")->required();
+  CLI::Option* dim = c->add_option("--dim", o.dim,
                                    "dimension (default: a .node header's, or the count of numbers on the first line "
                                    "of plain text; given, the first 2 or 3 numbers of each line are the coordinates)")
                          ->check(CLI::IsMember({2, 3}));
-  q->add_option("--box", o.box, "domain box: origin and side length (default: derived from the initial points)")
+  c->add_option("--box", o.box, "domain box: origin and side length (default: derived from the initial points)")
       ->expected(3, 4)
       ->type_name("o1 o2 [o3] L");
-  q->add_option_function<std::string>(
+  c->add_option_function<std::string>(
        "--duplicates", [&o](const std::string& v) { o.skip_duplicates = v == "skip"; },
        "error (the default) or skip: drop later copies of a point")
       ->check(CLI::IsMember({"error", "skip"}));
-  q->add_option("--edits", o.edits, "edit script: '+ x y [z]' inserts, '- x y [z]' deletes");
-  q->add_option("--batch", o.batch, "propagate K consecutive edits together on all ranks (default: each alone)")
+  c->add_option("--edits", o.edits, "edit script: '+ x y [z]' inserts, '- x y [z]' deletes");
+  c->add_option("--batch", o.batch, "propagate K consecutive edits together on all ranks (default: each alone)")
       ->check(whole_number(1, std::numeric_limits<std::size_t>::max()));
+  return dim;
+}
+
+/// Test and experiment knobs, not part of the contract: hidden from --help.
+void add_knobs(CLI::App* c, Options& o) {
+  c->add_option("--partition-level", o.partition_level)->check(CLI::Range(0, 10))->group("");
+  c->add_option("--ghost-ring", o.ghost_ring)->check(CLI::Range(0, 3))->group("");
+  c->add_option("--rebalance", o.rebalance)->check(CLI::Range(0.0, 1e9))->group("");
+}
+
+int parse_and_run(MPI_Comm comm, int argc, char** argv) {
+  const bool root = rank_of(comm) == 0;
+  CLI::App app{"dynmesh-mpi: the dynamic quadtree T* and its meshes on MPI ranks, equal to `dynmesh quadtree` and "
+               "`dynmesh mesh --postprocess quadtree` (docs/FORMATS.md, docs/DISTRIBUTED.md)"};
+  app.require_subcommand(1);
+  Options o;
+  CLI::App* q = app.add_subcommand("quadtree", "Build T* of a point file on the ranks, apply an edit script, write the leaves");
+  CLI::Option* dim = add_inputs(q, o);
   q->add_option("--cells", o.cells, "output: the final leaves as .cells (written by rank 0)")->required();
   q->add_flag("--stats", o.stats, "per rank on stderr: points owned, ghost points, trace bytes, mean propagation time, peak "
               "resident memory");
-  // Test and experiment knobs, not part of the contract: hidden from --help.
-  q->add_option("--partition-level", o.partition_level)->check(CLI::Range(0, 10))->group("");
-  q->add_option("--ghost-ring", o.ghost_ring)->check(CLI::Range(0, 3))->group("");
-  q->add_option("--rebalance", o.rebalance)->check(CLI::Range(0.0, 1e9))->group("");
+  add_knobs(q, o);
   q->add_flag("--measure-writing", o.measure_writing)->group("");
   q->parse_complete_callback([&o] {
     const std::string clash = output_overwrites_input({{"POINTS", o.points}, {"--edits", o.edits}}, {{"--cells", o.cells}});
@@ -497,30 +508,17 @@ int parse_and_run(MPI_Comm comm, int argc, char** argv) {
   CLI::App* m = app.add_subcommand(
       "mesh", "Mesh the box of a point file on the ranks (the quadtree mesh in 2D, the octree's tetrahedra in 3D), "
               "apply an edit script, write the final mesh");
-  m->add_option("POINTS", o.points, "point file: .node, the vertices of a .poly, or plain text; read by rank 0")->required();
-  CLI::Option* mesh_dim = m->add_option("--dim", o.dim, "dimension (default: as `dynmesh mesh`)")->check(CLI::IsMember({2, 3}));
-  m->add_option("--box", o.box, "domain box: origin and side length (default: derived from the initial points)")
-      ->expected(3, 4)
-      ->type_name("o1 o2 [o3] L");
+  CLI::Option* mesh_dim = add_inputs(m, o);
   m->add_option("--postprocess", o.postprocess,
                 "quadtree: the quadtree mesh (2D) or the octree's tetrahedral mesh (3D); hpu does not run on ranks yet");
   CLI::Option* min_angle = m->add_option("--min-angle", o.min_angle, "2D: at most the quadtree mesh's bound");
-  m->add_option_function<std::string>(
-       "--duplicates", [&o](const std::string& v) { o.skip_duplicates = v == "skip"; },
-       "error (the default) or skip: drop later copies of a point")
-      ->check(CLI::IsMember({"error", "skip"}));
-  m->add_option("--edits", o.edits, "edit script: '+ x y [z]' inserts, '- x y [z]' deletes");
-  m->add_option("--batch", o.batch, "propagate K consecutive edits together on all ranks (default: each alone)")
-      ->check(whole_number(1, std::numeric_limits<std::size_t>::max()));
   m->add_option("-o", o.outbase, "output: OUTBASE.node and OUTBASE.ele (written by rank 0)")->required();
   m->add_option("--feed", o.feed, "output: the change feed of every propagation");
   m->add_option("--vtk", o.vtk, "also write the mesh as legacy VTK");
   m->add_option("--msh", o.msh, "also write the mesh as Gmsh 2.2 ASCII");
   m->add_flag("--stats", o.stats, "per rank on stderr: points owned, ghost points, simplices owned, trace bytes, mean "
               "propagation time, peak resident memory");
-  m->add_option("--partition-level", o.partition_level)->check(CLI::Range(0, 10))->group("");
-  m->add_option("--ghost-ring", o.ghost_ring)->check(CLI::Range(0, 3))->group("");
-  m->add_option("--rebalance", o.rebalance)->check(CLI::Range(0.0, 1e9))->group("");
+  add_knobs(m, o);
   m->parse_complete_callback([&o] {
     if (o.outbase.empty()) throw CLI::ValidationError("-o needs a non-empty OUTBASE");
     const std::string clash = output_overwrites_input(

@@ -4,6 +4,8 @@
 // batch, and the random batches of the differential tests.
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <span>
@@ -66,6 +68,41 @@ std::vector<dynmesh::Edit<d>> random_batch(dynmesh::Rng& rng, std::size_t k, std
     }
   }
   return batch;
+}
+
+/// The repartition check of the differential tests: every point of `points` below y = 0.5
+/// (the last axis: the Morton order's first halving) moves to y/2 + 0.5, deleted then
+/// inserted, in batches of `batch` edits; after each, exact(structure, current points) must
+/// hold; at the end check_invariants() passes and some rank has repartitioned.
+template <class Structure, class Exact>
+void check_repartition(Structure& structure, std::vector<dynmesh::Point<2>> points, std::size_t batch, Exact&& exact,
+                       const std::string& against) {
+  using dynmesh::Edit;
+  using dynmesh::EditOp;
+  std::vector<Edit<2>> moves;
+  std::vector<dynmesh::Point<2>> now = points;
+  for (dynmesh::Point<2>& p : points)
+    if (p[1] < 0.5) {
+      moves.push_back(Edit<2>{EditOp::Delete, p});
+      p[1] = p[1] / 2 + 0.5;
+      moves.push_back(Edit<2>{EditOp::Insert, p});
+    }
+  for (std::size_t i = 0; i < moves.size(); i += batch) {
+    const std::vector<Edit<2>> part(moves.begin() + static_cast<std::ptrdiff_t>(i),
+                                    moves.begin() + static_cast<std::ptrdiff_t>(std::min(moves.size(), i + batch)));
+    for (const Edit<2>& e : part) {
+      if (e.op == EditOp::Delete)
+        now.erase(std::find(now.begin(), now.end(), e.point));
+      else
+        now.push_back(e.point);
+    }
+    structure.apply(share(part));
+    check(exact(structure, now), "repartition: batch at edit " + std::to_string(i) + " differs from " + against);
+  }
+  structure.check_invariants();
+  unsigned long mine = structure.rank_stats().repartitions, most = 0;
+  MPI_Allreduce(&mine, &most, 1, MPI_UNSIGNED_LONG, MPI_MAX, MPI_COMM_WORLD);
+  check(g_ranks == 1 || most > 0, "repartition: no repartition happened");
 }
 
 /// Collective: the verdict of every rank's checks (rank 0 prints it), then MPI_Finalize;

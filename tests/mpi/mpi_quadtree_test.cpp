@@ -109,35 +109,11 @@ bool narrow_ring_fails() {
 
 /// Emptying half of the box makes the ranks repartition; the tree stays exact throughout.
 void repartition() {
-  std::vector<Point<2>> points = generate<2>(Distribution::Uniform, 800, 11);
-  const Box<2> box{{0.0, 0.0}, 1.0};
+  const std::vector<Point<2>> points = generate<2>(Distribution::Uniform, 800, 11);
   MpiQuadtreeOptions options;
   options.rebalance_factor = 1.2;
-  MpiQuadtree<2> tree(MPI_COMM_WORLD, box, share(points), options);
-  std::vector<Edit<2>> moves;
-  for (Point<2>& p : points)
-    if (p[1] < 0.5) {  // the last axis: the Morton order's first halving
-      moves.push_back(Edit<2>{EditOp::Delete, p});
-      p[1] = p[1] / 2 + 0.5;
-      moves.push_back(Edit<2>{EditOp::Insert, p});
-    }
-  std::vector<Point<2>> now = generate<2>(Distribution::Uniform, 800, 11);
-  for (std::size_t i = 0; i < moves.size(); i += 60) {
-    const std::vector<Edit<2>> batch(moves.begin() + static_cast<std::ptrdiff_t>(i),
-                                     moves.begin() + static_cast<std::ptrdiff_t>(std::min(moves.size(), i + 60)));
-    for (const Edit<2>& e : batch) {
-      if (e.op == EditOp::Delete)
-        now.erase(std::find(now.begin(), now.end(), e.point));
-      else
-        now.push_back(e.point);
-    }
-    tree.apply(share(batch));
-    check(exact(tree, now), "repartition: batch at edit " + std::to_string(i) + " differs from StaticQuadtree");
-  }
-  tree.check_invariants();
-  unsigned long mine = tree.rank_stats().repartitions, most = 0;
-  MPI_Allreduce(&mine, &most, 1, MPI_UNSIGNED_LONG, MPI_MAX, MPI_COMM_WORLD);
-  check(g_ranks == 1 || most > 0, "repartition: no repartition happened");
+  MpiQuadtree<2> tree(MPI_COMM_WORLD, Box<2>{{0.0, 0.0}, 1.0}, share(points), options);
+  mpi_checks::check_repartition(tree, points, 60, exact<2>, "StaticQuadtree");
 }
 
 }  // namespace
