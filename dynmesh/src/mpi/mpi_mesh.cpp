@@ -72,16 +72,19 @@ struct MpiMeshState : MpiState<d, LocalMesh<d>> {
     return l0;
   }
 
-  /// Collective: the partition moved to the coarser `level`, the counts summed up to it, the
-  /// local meshes rebuilt on the same points.
+  /// Collective: the partition moved to the coarser `level` and the local meshes rebuilt on
+  /// the points the ranks own. The summaries are recounted from those points, so they hold
+  /// for them whatever the tables said before (apply() comes here with a batch put back).
   void rebuild_at(int level) {
     const std::vector<Routed<d>> mine = this->owned_routed();
-    const std::size_t shift = d * static_cast<std::size_t>(l0 - level);
-    std::vector<std::uint32_t> summed(std::uint64_t{1} << (d * static_cast<std::size_t>(level)), 0);
-    for (std::uint64_t m = 0; m < nroots; ++m) summed[m >> shift] += counts[m];
+    std::vector<std::uint32_t> here(std::uint64_t{1} << (d * static_cast<std::size_t>(level)), 0);
+    for (const Routed<d>& p : mine) ++here[morton(cell_of(dynmesh::locate(box, p.point), level))];
+    counts.assign(here.size(), 0);
+    MPI_Allreduce(here.data(), counts.data(), static_cast<int>(here.size()), MPI_UINT32_T, MPI_SUM, this->comm);
     l0 = level;
-    nroots = summed.size();
-    counts = std::move(summed);
+    nroots = counts.size();
+    this->total = 0;
+    for (const std::uint32_t k : counts) this->total += k;
     this->redistribute(mine);
     this->gather_root_split();
     this->compute_coarse();
@@ -111,27 +114,15 @@ struct MpiMeshState : MpiState<d, LocalMesh<d>> {
   }
 
   void apply(std::span<const Edit<d>> edits) {
-    const auto saved_counts = counts;
-    const auto saved_split = this->root_split;
-    const auto saved_coarse = coarse;
-    const std::size_t saved_total = this->total;
     std::vector<Routed<d>> in = this->apply_batch(edits);
     if (!top_split()) {
       // A leaf of T* is now coarser than l0: put the batch back, move l0 up to that leaf's
       // level, and apply it again on the new partition, so that its change is taken from
       // local meshes that are right for both point sets.
       const int level = coarsest_leaf();
-      if (!in.empty()) {
-        std::vector<Edit<d>> undo;
-        for (auto it = in.rbegin(); it != in.rend(); ++it)
-          undo.push_back(Edit<d>{static_cast<EditOp>(it->op) == EditOp::Insert ? EditOp::Delete : EditOp::Insert,
-                                 it->point});
-        tree->apply(undo);
-      }
-      counts = saved_counts;
-      this->root_split = saved_split;
-      coarse = saved_coarse;
-      this->total = saved_total;
+      std::vector<Edit<d>> batch;
+      for (const Routed<d>& r : in) batch.push_back(Edit<d>{static_cast<EditOp>(r.op), r.point});
+      if (!batch.empty()) this->put_back(batch);
       rebuild_at(level);
       in = this->apply_batch(edits);
     }

@@ -360,6 +360,14 @@ struct MpiState {
     ++stats.repartitions;
   }
 
+  /// Applies the inverse of `batch` (edits this rank applied, in order) to the local
+  /// structure: it is a function of the point set, so this restores it exactly.
+  void put_back(const std::vector<Edit<d>>& batch) {
+    std::vector<Edit<d>> undo(batch.rbegin(), batch.rend());
+    for (Edit<d>& e : undo) e.op = e.op == EditOp::Insert ? EditOp::Delete : EditOp::Insert;
+    tree->apply(undo);
+  }
+
   /// The first failure found, as an invariant failure naming this rank.
   void fail(std::optional<Failure>& failure, const std::string& text) const {
     if (failure) return;
@@ -553,11 +561,7 @@ struct MpiState {
     }
     if (const auto agreed = agree(s.comm, failure)) {
       // Put the point set back: the tree is a function of it, so this restores it exactly.
-      if (applied) {
-        std::vector<Edit<d>> undo(batch.rbegin(), batch.rend());
-        for (Edit<d>& e : undo) e.op = e.op == EditOp::Insert ? EditOp::Delete : EditOp::Insert;
-        s.tree->apply(undo);
-      }
+      if (applied) s.put_back(batch);
       agreed->raise();
     }
 
